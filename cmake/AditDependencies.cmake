@@ -1,0 +1,26 @@
+# Every third-party dependency comes from a Debian package installed by
+# scripts/install-deps.sh; nothing is downloaded at configure or build time.
+
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(yaml-cpp REQUIRED)
+find_package(fmt REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(PCAP REQUIRED IMPORTED_TARGET libpcap)
+pkg_check_modules(GPIODCXX REQUIRED IMPORTED_TARGET libgpiodcxx)
+pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+if(ADIT_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(ADIT_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()
+
+# Where the read-only real recordings live (beside the project root). Tests
+# read ADIT_SHARED_DATA from the environment first, so a checkout elsewhere can
+# point at them; when neither exists the realdata tests skip with a message.
+set(ADIT_SHARED_DATA_DEFAULT "${CMAKE_SOURCE_DIR}/../shared/data")

@@ -1,0 +1,12 @@
+#pragma once
+// Each `adit` subcommand lives in its own cmd_*.cpp and registers itself on the
+// top-level CLI11 app through one of these functions (called from main.cpp).
+// A registration adds the subcommand and its options and sets a callback that
+// stores the exit status in `status`; errors are thrown as adit::InputError.
+
+#include <CLI/CLI.hpp>
+
+namespace adit::tools {
+
+
+}  // namespace adit::tools

@@ -1,0 +1,31 @@
+// adit: the command-line client and tools (the tablet's reference).
+
+#include <CLI/CLI.hpp>
+
+#include "adit/common/log.hpp"
+#include "adit/common/main.hpp"
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  return adit::guarded_main("adit", [&]() -> int {
+    CLI::App app{"adit: command-line client and tools for the adit LiDAR mapping daemon"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Print help for every subcommand and exit");
+    app.fallthrough();  // global options may follow the subcommand
+    adit::log::init("adit", adit::log::Level::info);
+    app.add_option_function<std::string>(
+           "--log-level", [](const std::string& name) { adit::log::set_level(*adit::log::parse_level(name)); },
+           "Log level: trace, debug, info, warn, error, off (default info)")
+        ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+    int status = adit::kExitOk;
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::Success& e) {
+      return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+      app.exit(e);
+      return adit::kExitBadInput;
+    }
+    return status;
+  });
+}
