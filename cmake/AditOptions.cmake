@@ -20,6 +20,15 @@ if(ADIT_USE_CCACHE)
   endif()
 endif()
 
+if(ADIT_BUILD_FUZZERS)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "ADIT_BUILD_FUZZERS needs clang: CC=clang CXX=clang++ cmake ...")
+  endif()
+  # Every library is instrumented for coverage; only the fuzz executables link
+  # libFuzzer's main (adit_fuzzer in tests/CMakeLists.txt).
+  add_compile_options(-fsanitize=fuzzer-no-link)
+endif()
+
 if(ADIT_SANITIZE_ADDRESS)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
