@@ -8,5 +8,7 @@
 
 namespace adit::tools {
 
+void register_config_commands(CLI::App& app, int& status);
+
 
 }  // namespace adit::tools
