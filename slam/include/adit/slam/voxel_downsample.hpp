@@ -1,0 +1,38 @@
+#pragma once
+// Voxel-grid downsampling that keeps the first point to land in each voxel
+// (KISS-ICP, Vizzo et al. 2023, §III-B: the original points, not centroids, so
+// no point is invented). Storage is fixed at construction: a key table marked
+// with a generation number, so a new scan needs no clearing and no allocation.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "adit/slam/voxel_key.hpp"
+
+namespace adit::slam {
+
+class VoxelDownsampler {
+ public:
+  // max_points: the most points one call may keep; larger inputs keep the
+  // first max_points voxels' representatives.
+  explicit VoxelDownsampler(std::size_t max_points);
+
+  // Writes into `out` (which must have capacity, see reserve_output) one point
+  // per occupied voxel of edge voxel_size_m, in input order; returns the count.
+  std::size_t downsample(std::span<const Eigen::Vector3f> in, float voxel_size_m, std::vector<Eigen::Vector3f>& out);
+
+ private:
+  struct Slot {
+    VoxelKey key;
+    std::uint32_t generation = 0;  // the slot is taken in this call only if equal to generation_
+  };
+  std::size_t mask_;
+  std::size_t max_points_;
+  std::uint32_t generation_ = 0;
+  std::vector<Slot> slots_;
+};
+
+}  // namespace adit::slam

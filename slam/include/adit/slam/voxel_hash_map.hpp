@@ -1,0 +1,92 @@
+#pragma once
+// The local map of the odometry: points kept in a hash of cubic voxels, at most
+// kMaxPointsPerVoxel per voxel, bounded by distance from the sensor, as in
+// KISS-ICP (Vizzo et al., RA-L 2023, §III-C). Unlike KISS-ICP's hash map it
+// has a fixed capacity set at construction and never allocates afterwards, so
+// the odometry thread can own it in steady state (open addressing, linear
+// probing, backward-shift deletion: Knuth, TAOCP vol. 3, §6.4, Algorithm R).
+//
+// Each voxel also keeps the plane fitted to its points (normal and a flatness
+// score), refreshed when the voxel changes; voxels fill up and then stop
+// changing, so the cost is paid a bounded number of times per voxel.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "adit/slam/voxel_key.hpp"
+
+namespace adit::slam {
+
+struct MapNeighbor {
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();  // the nearest map point
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero(); // its voxel's plane normal, zero when not planar
+  float distance_sq = 0.0F;
+  bool found = false;
+};
+
+class VoxelHashMap {
+ public:
+  static constexpr int kMaxPointsPerVoxel = 20;
+  static constexpr int kMinPointsForPlane = 6;
+
+  // capacity_voxels is rounded up to a power of two; the table is kept at
+  // most 3/4 full (beyond that new voxels are refused and counted).
+  VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels);
+
+  // Adds points (map frame). A point lands in its voxel unless the voxel is
+  // full, or the table is; refused points are counted in dropped_points().
+  void add(std::span<const Eigen::Vector3f> points);
+
+  // Removes every voxel whose first point is farther than max_distance_m from origin.
+  void remove_far(const Eigen::Vector3f& origin, float max_distance_m);
+
+  // The nearest point among the 27 voxels around `query`.
+  MapNeighbor nearest(const Eigen::Vector3f& query) const;
+
+  void clear();
+  bool empty() const { return voxel_count_ == 0; }
+  std::size_t voxel_count() const { return voxel_count_; }
+  std::size_t point_count() const;
+  std::uint64_t dropped_points() const { return dropped_points_; }
+  float voxel_size() const { return voxel_size_; }
+  std::size_t capacity() const { return slots_.size(); }
+
+  template <typename F>
+  void for_each_point(F&& f) const {
+    for (const Voxel& v : slots_)
+      if (v.count > 0)
+        for (int i = 0; i < v.count; ++i) f(v.points[static_cast<std::size_t>(i)]);
+  }
+
+  VoxelKey key_of(const Eigen::Vector3f& p) const { return voxel_key(p, inverse_voxel_size_); }
+
+ private:
+  struct Voxel {
+    VoxelKey key;
+    std::int32_t count = 0;  // 0 = empty slot
+    Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+    std::array<Eigen::Vector3f, kMaxPointsPerVoxel> points;
+  };
+
+  std::size_t home_of(const VoxelKey& key) const;
+  std::size_t index_of(const VoxelKey& key) const;  // its slot, or the empty slot ending its probe run
+  const Voxel* find(const VoxelKey& key) const;
+  Voxel* find_or_insert(const VoxelKey& key);
+  void erase_at(std::size_t index);
+  static void refit_plane(Voxel& voxel);
+
+  float voxel_size_;
+  float inverse_voxel_size_;
+  std::size_t mask_;
+  std::size_t max_voxels_;
+  std::size_t voxel_count_ = 0;
+  std::uint64_t dropped_points_ = 0;
+  std::vector<Voxel> slots_;
+  std::vector<VoxelKey> doomed_;  // remove_far's scratch, reserved to capacity
+};
+
+}  // namespace adit::slam

@@ -1,0 +1,31 @@
+#pragma once
+// Integer voxel coordinates of a point and their spatial hash.
+
+#include <cmath>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+namespace adit::slam {
+
+struct VoxelKey {
+  std::int32_t x = 0;
+  std::int32_t y = 0;
+  std::int32_t z = 0;
+  friend bool operator==(const VoxelKey&, const VoxelKey&) = default;
+};
+
+inline VoxelKey voxel_key(const Eigen::Vector3f& p, float inverse_voxel_size) {
+  return {static_cast<std::int32_t>(std::floor(p.x() * inverse_voxel_size)),
+          static_cast<std::int32_t>(std::floor(p.y() * inverse_voxel_size)),
+          static_cast<std::int32_t>(std::floor(p.z() * inverse_voxel_size))};
+}
+
+// Teschner et al., "Optimized Spatial Hashing for Collision Detection of
+// Deformable Objects", VMV 2003: XOR of the coordinates times large primes.
+inline std::uint32_t voxel_hash(const VoxelKey& key) {
+  return (static_cast<std::uint32_t>(key.x) * 73856093U) ^ (static_cast<std::uint32_t>(key.y) * 19349663U) ^
+         (static_cast<std::uint32_t>(key.z) * 83492791U);
+}
+
+}  // namespace adit::slam

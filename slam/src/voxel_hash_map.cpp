@@ -1,0 +1,145 @@
+#include "adit/slam/voxel_hash_map.hpp"
+
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
+
+namespace adit::slam {
+
+VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels)
+    : voxel_size_(voxel_size_m),
+      inverse_voxel_size_(1.0F / voxel_size_m),
+      mask_(std::bit_ceil(std::max<std::size_t>(capacity_voxels, 16)) - 1),
+      max_voxels_((mask_ + 1) * 3 / 4),
+      slots_(mask_ + 1) {
+  doomed_.reserve(slots_.size());
+}
+
+std::size_t VoxelHashMap::home_of(const VoxelKey& key) const { return voxel_hash(key) & mask_; }
+
+std::size_t VoxelHashMap::index_of(const VoxelKey& key) const {
+  for (std::size_t i = home_of(key);; i = (i + 1) & mask_) {
+    const Voxel& v = slots_[i];
+    if (v.count == 0 || v.key == key) return i;
+  }
+}
+
+const VoxelHashMap::Voxel* VoxelHashMap::find(const VoxelKey& key) const {
+  const Voxel& v = slots_[index_of(key)];
+  return v.count > 0 ? &v : nullptr;
+}
+
+VoxelHashMap::Voxel* VoxelHashMap::find_or_insert(const VoxelKey& key) {
+  for (std::size_t i = home_of(key);; i = (i + 1) & mask_) {
+    Voxel& v = slots_[i];
+    if (v.count > 0) {
+      if (v.key == key) return &v;
+      continue;
+    }
+    if (voxel_count_ >= max_voxels_) return nullptr;
+    v.key = key;
+    v.normal.setZero();
+    ++voxel_count_;
+    return &v;  // count stays 0 until the caller stores a point
+  }
+}
+
+void VoxelHashMap::add(std::span<const Eigen::Vector3f> points) {
+  for (const Eigen::Vector3f& p : points) {
+    Voxel* v = find_or_insert(key_of(p));
+    if (v == nullptr || v->count >= kMaxPointsPerVoxel) {
+      ++dropped_points_;
+      continue;
+    }
+    v->points[static_cast<std::size_t>(v->count++)] = p;
+    if (v->count >= kMinPointsForPlane) refit_plane(*v);
+  }
+}
+
+// The plane of a voxel's points: the covariance's eigenvector of the smallest
+// eigenvalue. Accepted only when the points are clearly flat (smallest
+// eigenvalue well below the middle one), else the normal stays zero and the
+// registration falls back to point-to-point for this voxel.
+void VoxelHashMap::refit_plane(Voxel& voxel) {
+  const int n = voxel.count;
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  for (int i = 0; i < n; ++i) mean += voxel.points[static_cast<std::size_t>(i)];
+  mean /= static_cast<float>(n);
+  Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3f d = voxel.points[static_cast<std::size_t>(i)] - mean;
+    covariance.noalias() += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance, Eigen::ComputeEigenvectors);
+  const Eigen::Vector3f& eigenvalues = solver.eigenvalues();  // ascending
+  constexpr float kFlatness = 0.1F;                            // λ0 / λ1
+  voxel.normal = eigenvalues(0) < kFlatness * eigenvalues(1) ? Eigen::Vector3f(solver.eigenvectors().col(0))
+                                                              : Eigen::Vector3f::Zero();
+}
+
+MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query) const {
+  MapNeighbor best;
+  best.distance_sq = std::numeric_limits<float>::max();
+  const VoxelKey center = key_of(query);
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const Voxel* v = find({center.x + dx, center.y + dy, center.z + dz});
+        if (v == nullptr) continue;
+        for (int i = 0; i < v->count; ++i) {
+          const Eigen::Vector3f& p = v->points[static_cast<std::size_t>(i)];
+          const float d = (p - query).squaredNorm();
+          if (d < best.distance_sq) {
+            best.distance_sq = d;
+            best.point = p;
+            best.normal = v->normal;
+            best.found = true;
+          }
+        }
+      }
+    }
+  }
+  return best;
+}
+
+void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {
+  const float max_sq = max_distance_m * max_distance_m;
+  // Collect keys, not slot indices: each erase shifts later slots back.
+  doomed_.clear();
+  for (const Voxel& v : slots_)
+    if (v.count > 0 && (v.points[0] - origin).squaredNorm() > max_sq) doomed_.push_back(v.key);
+  for (const VoxelKey& key : doomed_) erase_at(index_of(key));
+}
+
+void VoxelHashMap::erase_at(std::size_t index) {
+  // Backward-shift deletion: pull later members of the probe run back so
+  // lookups never stop early at the hole (no tombstones needed).
+  std::size_t hole = index;
+  for (std::size_t j = (hole + 1) & mask_; slots_[j].count > 0; j = (j + 1) & mask_) {
+    const std::size_t home = home_of(slots_[j].key);
+    // Move j into the hole unless its home lies cyclically in (hole, j].
+    const bool home_between = hole <= j ? (hole < home && home <= j) : (hole < home || home <= j);
+    if (!home_between) {
+      slots_[hole] = slots_[j];
+      hole = j;
+    }
+  }
+  slots_[hole].count = 0;
+  --voxel_count_;
+}
+
+void VoxelHashMap::clear() {
+  for (Voxel& v : slots_) v.count = 0;
+  voxel_count_ = 0;
+  dropped_points_ = 0;
+}
+
+std::size_t VoxelHashMap::point_count() const {
+  std::size_t n = 0;
+  for (const Voxel& v : slots_) n += static_cast<std::size_t>(v.count);
+  return n;
+}
+
+}  // namespace adit::slam

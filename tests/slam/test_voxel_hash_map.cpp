@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "adit/slam/voxel_downsample.hpp"
+#include "adit/slam/voxel_hash_map.hpp"
+
+namespace adit::slam {
+namespace {
+
+std::vector<Eigen::Vector3f> random_points(std::size_t n, float extent, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-extent, extent);
+  std::vector<Eigen::Vector3f> points(n);
+  for (auto& p : points) p = {u(rng), u(rng), u(rng)};
+  return points;
+}
+
+// The nearest point by brute force, restricted like the map to the 27 voxels around the query.
+float brute_nearest_sq(const VoxelHashMap& map, const Eigen::Vector3f& q) {
+  const VoxelKey c = map.key_of(q);
+  float best = std::numeric_limits<float>::max();
+  map.for_each_point([&](const Eigen::Vector3f& p) {
+    const VoxelKey k = map.key_of(p);
+    if (std::abs(k.x - c.x) <= 1 && std::abs(k.y - c.y) <= 1 && std::abs(k.z - c.z) <= 1)
+      best = std::min(best, (p - q).squaredNorm());
+  });
+  return best;
+}
+
+TEST(VoxelHashMap, NearestFindsTheStoredPoint) {
+  VoxelHashMap map(1.0F, 1024);
+  const std::vector<Eigen::Vector3f> points{{0.5F, 0.5F, 0.5F}, {3.2F, -1.0F, 0.1F}};
+  map.add(points);
+  const MapNeighbor n = map.nearest({3.0F, -1.1F, 0.0F});
+  ASSERT_TRUE(n.found);
+  EXPECT_TRUE(n.point.isApprox(points[1]));
+  EXPECT_NEAR(n.distance_sq, 0.04F + 0.01F + 0.01F, 1e-5F);
+  EXPECT_FALSE(map.nearest({10.0F, 10.0F, 10.0F}).found);
+}
+
+TEST(VoxelHashMap, KeepsAtMostTheVoxelCapacityAndCountsTheRest) {
+  VoxelHashMap map(1.0F, 64);
+  std::vector<Eigen::Vector3f> same_voxel(VoxelHashMap::kMaxPointsPerVoxel + 5, Eigen::Vector3f(0.1F, 0.2F, 0.3F));
+  map.add(same_voxel);
+  EXPECT_EQ(map.voxel_count(), 1U);
+  EXPECT_EQ(map.point_count(), static_cast<std::size_t>(VoxelHashMap::kMaxPointsPerVoxel));
+  EXPECT_EQ(map.dropped_points(), 5U);
+}
+
+TEST(VoxelHashMap, RefusesNewVoxelsBeyondThreeQuartersOfTheTable) {
+  VoxelHashMap map(1.0F, 16);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 20; ++i) points.emplace_back(static_cast<float>(i) + 0.5F, 0.5F, 0.5F);
+  map.add(points);
+  EXPECT_EQ(map.voxel_count(), 12U);
+  EXPECT_EQ(map.dropped_points(), 8U);
+}
+
+TEST(VoxelHashMap, FlatVoxelsGetTheirPlaneNormalAndCornersNone) {
+  VoxelHashMap map(1.0F, 64);
+  std::vector<Eigen::Vector3f> floor;  // z = 0.2 plane inside voxel (0,0,0)
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) floor.emplace_back(0.1F + 0.2F * static_cast<float>(i), 0.1F + 0.2F * static_cast<float>(j), 0.2F);
+  map.add(floor);
+  const MapNeighbor n = map.nearest({0.5F, 0.5F, 0.25F});
+  ASSERT_TRUE(n.found);
+  EXPECT_NEAR(std::abs(n.normal.z()), 1.0F, 1e-4F);
+
+  std::vector<Eigen::Vector3f> blob = random_points(VoxelHashMap::kMaxPointsPerVoxel, 0.45F, 3);
+  for (auto& p : blob) p += Eigen::Vector3f(5.5F, 5.5F, 5.5F);
+  map.add(blob);
+  EXPECT_EQ(map.nearest({5.5F, 5.5F, 5.5F}).normal, Eigen::Vector3f::Zero());
+}
+
+// remove_far under heavy hash collisions (a small, nearly full table): every
+// far voxel goes, every near one stays findable, and nearest() agrees with
+// brute force afterwards. This exercises the backward-shift deletion.
+TEST(VoxelHashMap, RemoveFarKeepsEveryNearVoxelFindable) {
+  VoxelHashMap map(0.5F, 4096);
+  const auto points = random_points(20000, 12.0F, 7);
+  map.add(points);
+  const Eigen::Vector3f origin(2.0F, -1.0F, 0.5F);
+  map.remove_far(origin, 8.0F);
+  std::size_t remaining = 0;
+  map.for_each_point([&](const Eigen::Vector3f&) { ++remaining; });
+  EXPECT_EQ(remaining, map.point_count());
+  EXPECT_GT(map.voxel_count(), 100U);
+  for (const auto& q : random_points(500, 12.0F, 11)) {
+    const MapNeighbor n = map.nearest(q);
+    const float expected = brute_nearest_sq(map, q);
+    if (expected == std::numeric_limits<float>::max()) {
+      EXPECT_FALSE(n.found);
+    } else {
+      ASSERT_TRUE(n.found);
+      EXPECT_FLOAT_EQ(n.distance_sq, expected);
+    }
+  }
+  // Nothing left is far: each remaining voxel's first point was within 8 m,
+  // so every point is within 8 m plus a voxel diagonal.
+  map.for_each_point([&](const Eigen::Vector3f& p) { EXPECT_LE((p - origin).norm(), 8.0F + 0.87F); });
+}
+
+TEST(VoxelHashMap, ClearEmptiesTheMap) {
+  VoxelHashMap map(1.0F, 256);
+  map.add(random_points(100, 5.0F, 1));
+  map.clear();
+  EXPECT_TRUE(map.empty());
+  EXPECT_EQ(map.point_count(), 0U);
+  EXPECT_FALSE(map.nearest({0.0F, 0.0F, 0.0F}).found);
+}
+
+TEST(VoxelDownsampler, KeepsTheFirstPointOfEachVoxelInInputOrder) {
+  VoxelDownsampler downsampler(100);
+  const std::vector<Eigen::Vector3f> in{{0.1F, 0.1F, 0.1F}, {0.2F, 0.2F, 0.2F}, {1.5F, 0.1F, 0.1F},
+                                        {-0.1F, 0.1F, 0.1F}, {1.9F, 0.9F, 0.9F}};
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(100);
+  ASSERT_EQ(downsampler.downsample(in, 1.0F, out), 3U);
+  EXPECT_EQ(out[0], in[0]);
+  EXPECT_EQ(out[1], in[2]);
+  EXPECT_EQ(out[2], in[3]);  // x = -0.1 is voxel -1, not 0
+}
+
+TEST(VoxelDownsampler, CallsAreIndependentAndBoundedByMaxPoints) {
+  VoxelDownsampler downsampler(10);
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(10);
+  const auto points = random_points(1000, 50.0F, 5);
+  EXPECT_EQ(downsampler.downsample(points, 0.1F, out), 10U);
+  const std::vector<Eigen::Vector3f> one{{0.0F, 0.0F, 0.0F}};
+  EXPECT_EQ(downsampler.downsample(one, 0.1F, out), 1U);
+  EXPECT_EQ(downsampler.downsample(one, 0.1F, out), 1U);  // not remembered from the previous call
+}
+
+}  // namespace
+}  // namespace adit::slam
