@@ -40,7 +40,7 @@ VoxelHashMap::Voxel* VoxelHashMap::find_or_insert(const VoxelKey& key) {
     }
     if (voxel_count_ >= max_voxels_) return nullptr;
     v.key = key;
-    v.normal.setZero();
+    v.plane = {};
     ++voxel_count_;
     return &v;  // count stays 0 until the caller stores a point
   }
@@ -74,9 +74,12 @@ void VoxelHashMap::refit_plane(Voxel& voxel) {
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance, Eigen::ComputeEigenvectors);
   const Eigen::Vector3f& eigenvalues = solver.eigenvalues();  // ascending
-  constexpr float kFlatness = 0.1F;                            // λ0 / λ1
-  voxel.normal = eigenvalues(0) < kFlatness * eigenvalues(1) ? Eigen::Vector3f(solver.eigenvectors().col(0))
-                                                              : Eigen::Vector3f::Zero();
+  // 0.25 still accepts rock walls with a few cm of roughness over a voxel,
+  // and refuses voxels that straddle an edge or hold clutter.
+  constexpr float kFlatness = 0.25F;  // λ0 / λ1
+  voxel.plane.mean = mean;
+  voxel.plane.normal = eigenvalues(0) < kFlatness * eigenvalues(1) ? Eigen::Vector3f(solver.eigenvectors().col(0))
+                                                                    : Eigen::Vector3f::Zero();
 }
 
 MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query) const {
@@ -94,7 +97,7 @@ MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query) const {
           if (d < best.distance_sq) {
             best.distance_sq = d;
             best.point = p;
-            best.normal = v->normal;
+            best.normal = v->plane.normal;
             best.found = true;
           }
         }
@@ -102,6 +105,11 @@ MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query) const {
     }
   }
   return best;
+}
+
+const VoxelPlane* VoxelHashMap::plane_at(const Eigen::Vector3f& query) const {
+  const Voxel* v = find(key_of(query));
+  return v != nullptr && v->count >= kMinPointsForPlane && !v->plane.normal.isZero() ? &v->plane : nullptr;
 }
 
 void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {

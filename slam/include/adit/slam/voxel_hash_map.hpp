@@ -21,6 +21,12 @@
 
 namespace adit::slam {
 
+// A voxel's fitted plane: a point on it (the points' mean) and its normal.
+struct VoxelPlane {
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+};
+
 struct MapNeighbor {
   Eigen::Vector3f point = Eigen::Vector3f::Zero();  // the nearest map point
   Eigen::Vector3f normal = Eigen::Vector3f::Zero(); // its voxel's plane normal, zero when not planar
@@ -47,6 +53,10 @@ class VoxelHashMap {
   // The nearest point among the 27 voxels around `query`.
   MapNeighbor nearest(const Eigen::Vector3f& query) const;
 
+  // The plane of the voxel containing `query`, when that voxel is flat: an
+  // O(1) correspondence for point-to-plane registration; nullptr otherwise.
+  const VoxelPlane* plane_at(const Eigen::Vector3f& query) const;
+
   void clear();
   bool empty() const { return voxel_count_ == 0; }
   std::size_t voxel_count() const { return voxel_count_; }
@@ -68,7 +78,7 @@ class VoxelHashMap {
   struct Voxel {
     VoxelKey key;
     std::int32_t count = 0;  // 0 = empty slot
-    Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+    VoxelPlane plane;        // normal is zero while the points are not clearly flat
     std::array<Eigen::Vector3f, kMaxPointsPerVoxel> points;
   };
 

@@ -1,0 +1,60 @@
+#pragma once
+// Scan-to-map registration: robust Gauss-Newton on SE(3) minimising
+// point-to-plane distances to the local map's voxel planes (Chen & Medioni
+// 1992; the query's voxel, else its nearest map point's voxel), with a
+// Geman-McClure kernel (Black & Rangarajan 1996; scale as in KISS-ICP) and an
+// optional Gaussian prior on the pose (wheel odometry or constant velocity).
+//
+// Degeneracy (Zhang, Kaess & Singh, ICRA 2016): the data term's Hessian is
+// split into its translation and rotation blocks, each normalised per unit
+// weight so the threshold means the same for any number of points (rotation
+// eigenvalues then read as squared lever arm in m²).
+// Eigen-directions below `degeneracy_threshold` are the ones the scan cannot
+// constrain; there the update is projected out ("solution remapping"), so the
+// pose keeps the prior's estimate, and the result reports the weakest one.
+
+#include <cstdint>
+#include <span>
+
+#include <Eigen/Geometry>
+
+#include "adit/slam/lie.hpp"
+#include "adit/slam/voxel_hash_map.hpp"
+
+namespace adit::slam {
+
+struct RegistrationConfig {
+  int max_iterations = 30;
+  double convergence_norm = 1e-4;       // settle when the update is below this (m, rad)
+  double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
+  double degeneracy_threshold = 0.03;   // normalised eigenvalue below which a direction is degenerate
+};
+
+// A Gaussian prior on the pose: mean and information (inverse covariance) in
+// the tangent space at the mean, twist order [v; ω].
+struct PosePrior {
+  Eigen::Isometry3d mean = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Zero();
+};
+
+struct RegistrationResult {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Identity();  // of the pose, tangent space, [v; ω]
+  int iterations = 0;
+  int correspondences = 0;      // points with a map neighbour within the threshold
+  double inlier_ratio = 0.0;    // correspondences / points
+  double rmse_m = 0.0;          // robust-weighted RMS of the residuals: sqrt(Σw·r² / Σw)
+  bool degenerate = false;
+  Vector6d weakest_direction = Vector6d::Zero();  // unit twist of the least constrained direction
+  double weakest_eigenvalue = 0.0;                // its normalised eigenvalue (the smaller is weaker)
+};
+
+// `points` are in the body frame at the scan time (deskewed); `prior.mean`
+// also serves as the initial guess. `max_distance_m` bounds correspondences;
+// `kernel_scale_m` is the robust kernel's starting scale (the adaptive
+// threshold's σ/3, as in KISS-ICP), narrowed to config.min_kernel_scale_m.
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config = {});
+
+}  // namespace adit::slam
