@@ -18,6 +18,12 @@ struct NormalEquations {
   Matrix6d H = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
   double weight_sum = 0.0;
+  // The point-to-plane part alone, for the degeneracy analysis: point-to-point
+  // residuals against a sparse map "constrain" every direction through the
+  // sampling pattern, which would hide a tunnel's axis.
+  Matrix6d H_plane = Matrix6d::Zero();
+  double plane_weight_sum = 0.0;
+  int plane_count = 0;
   double residual2_sum = 0.0;  // Σ w·r², robust-weighted
   int count = 0;
 };
@@ -28,11 +34,15 @@ void accumulate_plane(NormalEquations& ne, const Eigen::Vector3d& q, const Eigen
   Vector6d J;
   J << n, q.cross(n);
   const double w = geman_mcclure_weight(r * r, kappa2);
-  ne.H.noalias() += w * J * J.transpose();
+  const Matrix6d JJ = w * J * J.transpose();
+  ne.H += JJ;
+  ne.H_plane += JJ;
   ne.g.noalias() += w * J * r;
   ne.weight_sum += w;
+  ne.plane_weight_sum += w;
   ne.residual2_sum += w * r * r;
   ++ne.count;
+  ++ne.plane_count;
 }
 
 // One pass over the points at pose T: linearised residuals and their weights.
@@ -52,14 +62,24 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
     }
     const MapNeighbor nb = map.nearest(q);
     if (!nb.found || nb.distance_sq > max_d2) continue;
-    if (nb.normal.isZero()) continue;
-    // The query's own voxel is not flat (or is empty) but its nearest
-    // neighbour's is: point-to-plane through that neighbour. There is no
-    // point-to-point fallback on purpose: against a sparse map it constrains
-    // every direction by the sampling pattern alone, which would hide exactly
-    // the degeneracy (a plain tunnel's axis) that must be reported.
-    const Eigen::Vector3d n = nb.normal.cast<double>();
-    accumulate_plane(ne, qd, n, n.dot(qd - nb.point.cast<double>()), kappa2);
+    if (!nb.normal.isZero()) {
+      // The query's own voxel is not flat (or is empty) but its nearest
+      // neighbour's is: point-to-plane through that neighbour.
+      const Eigen::Vector3d n = nb.normal.cast<double>();
+      accumulate_plane(ne, qd, n, n.dot(qd - nb.point.cast<double>()), kappa2);
+      continue;
+    }
+    // Point-to-point where the map has no plane yet (a sparse start, clutter):
+    // r = q − p; ∂r/∂[v; ω] = [I, −[q]×] (Besl & McKay 1992).
+    const Eigen::Vector3d r = qd - nb.point.cast<double>();
+    Eigen::Matrix<double, 3, 6> J;
+    J << Eigen::Matrix3d::Identity(), -skew(qd);
+    const double w = geman_mcclure_weight(r.squaredNorm(), kappa2);
+    ne.H.noalias() += w * J.transpose() * J;
+    ne.g.noalias() += w * J.transpose() * r;
+    ne.weight_sum += w;
+    ne.residual2_sum += w * r.squaredNorm();
+    ++ne.count;
   }
   return ne;
 }
@@ -73,10 +93,14 @@ struct Degeneracy {
 };
 
 // Zhang, Kaess & Singh 2016, per block: eigen-directions of the normalised
-// data Hessian below the threshold are not constrained by the scan.
-Degeneracy analyse(const NormalEquations& ne, double threshold) {
+// data Hessian below the threshold are not constrained by the scan. Judged on
+// the point-to-plane part when there is enough of it (see NormalEquations).
+Degeneracy analyse(const NormalEquations& ne, double threshold, int min_plane_correspondences) {
   Degeneracy d;
-  if (ne.weight_sum <= 0.0) {
+  const bool planes = ne.plane_count >= min_plane_correspondences && ne.plane_weight_sum > 0.0;
+  const Matrix6d& H = planes ? ne.H_plane : ne.H;
+  const double weight_sum = planes ? ne.plane_weight_sum : ne.weight_sum;
+  if (weight_sum <= 0.0) {
     d.degenerate = true;
     d.translation_projector.setZero();
     d.rotation_projector.setZero();
@@ -86,8 +110,8 @@ Degeneracy analyse(const NormalEquations& ne, double threshold) {
   // Per unit weight: translation eigenvalues are the share of residuals that
   // watch a direction (0..1); rotation ones are that share times the squared
   // lever arm in m², i.e. displacement per radian judged at 1 m.
-  const Eigen::Matrix3d Ht = ne.H.topLeftCorner<3, 3>() / ne.weight_sum;
-  const Eigen::Matrix3d Hr = ne.H.bottomRightCorner<3, 3>() / ne.weight_sum;
+  const Eigen::Matrix3d Ht = H.topLeftCorner<3, 3>() / weight_sum;
+  const Eigen::Matrix3d Hr = H.bottomRightCorner<3, 3>() / weight_sum;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(Ht);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> er(Hr);
   d.weakest_eigenvalue = std::numeric_limits<double>::max();
@@ -127,7 +151,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
   Degeneracy degeneracy;
   for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
     ne = build(points, map, result.pose, max_distance_m, kappa * kappa);
-    degeneracy = analyse(ne, config.degeneracy_threshold);
+    degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
     // Prior residual in the left tangent space: e = log(T · mean⁻¹), ∂e/∂δ ≈ I.
     const Vector6d e = log_se3(result.pose * prior.mean.inverse());
     const Matrix6d H = ne.H + prior.information;

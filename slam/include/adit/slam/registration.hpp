@@ -1,7 +1,8 @@
 #pragma once
 // Scan-to-map registration: robust Gauss-Newton on SE(3) minimising
 // point-to-plane distances to the local map's voxel planes (Chen & Medioni
-// 1992; the query's voxel, else its nearest map point's voxel), with a
+// 1992; the query's voxel, else its nearest map point's voxel), point-to-point
+// where the map has no plane yet (Besl & McKay 1992), with a
 // Geman-McClure kernel (Black & Rangarajan 1996; scale as in KISS-ICP) and an
 // optional Gaussian prior on the pose (wheel odometry or constant velocity).
 //
@@ -28,6 +29,7 @@ struct RegistrationConfig {
   double convergence_norm = 1e-4;       // settle when the update is below this (m, rad)
   double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
   double degeneracy_threshold = 0.03;   // normalised eigenvalue below which a direction is degenerate
+  int min_plane_correspondences = 100;  // fewer: degeneracy is judged on all residuals
 };
 
 // A Gaussian prior on the pose: mean and information (inverse covariance) in

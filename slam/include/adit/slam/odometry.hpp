@@ -1,0 +1,110 @@
+#pragma once
+// LiDAR odometry, one scan at a time: predict, deskew, downsample, register
+// against the local map, update the map (the pipeline of KISS-ICP, Vizzo et
+// al. 2023, with point-to-plane registration, a pose prior from wheel
+// odometry or constant velocity, and degeneracy handling; see registration.hpp).
+//
+// Every buffer is sized at construction from OdometryConfig, so process()
+// allocates nothing, takes no lock and never throws: bad scans come back with
+// valid = false and a reason, and the pose is held on the prediction.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/slam/adaptive_threshold.hpp"
+#include "adit/slam/deskew.hpp"
+#include "adit/slam/registration.hpp"
+#include "adit/slam/voxel_downsample.hpp"
+#include "adit/slam/voxel_hash_map.hpp"
+
+namespace adit::slam {
+
+struct OdometryConfig {
+  float min_range_m = 0.5F;
+  float max_range_m = 100.0F;
+  float map_voxel_m = 0.5F;              // local map voxel; the scan is kept at half of it
+  float registration_voxel_m = 0.75F;    // points used for registration (1.5 × map voxel)
+  std::size_t map_capacity_voxels = std::size_t{1} << 17;
+  std::size_t max_scan_points = 400'000; // beyond this a scan is cut (counted)
+  std::size_t min_registration_points = 100;
+  double initial_threshold_m = 2.0;
+  double min_motion_m = 0.1;
+  double max_scan_gap_s = 1.0;           // a longer gap forgets the velocity
+  // The constant-velocity prediction's standard deviation per scan, used as a
+  // weak prior so that degenerate directions stay anchored to the prediction.
+  double constant_velocity_sigma_m = 0.5;
+  double constant_velocity_sigma_rad = 0.2;
+  RegistrationConfig registration;
+};
+
+// Body motion since the previous scan from wheel odometry, with its
+// covariance in the body frame (tangent space at the motion, [v; ω]).
+struct MotionPrior {
+  Eigen::Isometry3d delta = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Identity();
+};
+
+struct ScanInput {
+  std::int64_t stamp_ns = 0;                  // the scan's start time
+  std::span<const Eigen::Vector3f> points;    // body frame, as measured
+  std::span<const float> times_s;             // per point, after stamp; empty = no deskewing
+};
+
+enum class OdometryStatus : std::uint8_t {
+  ok,
+  first_scan,         // the map starts here
+  too_few_points,     // held on the prediction
+  time_went_back,     // scan ignored
+  degenerate,         // valid, but some directions come from the prior only
+};
+
+std::string_view to_string(OdometryStatus status);
+
+struct OdometryResult {
+  std::int64_t stamp_ns = 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // body in the odometry frame
+  Matrix6d covariance = Matrix6d::Identity();
+  OdometryStatus status = OdometryStatus::ok;
+  bool valid = false;       // the pose comes from registration
+  RegistrationResult registration;
+  std::size_t input_points = 0;
+  std::size_t registration_points = 0;
+};
+
+class Odometry {
+ public:
+  explicit Odometry(const OdometryConfig& config);
+
+  OdometryResult process(const ScanInput& scan, const std::optional<MotionPrior>& wheel = std::nullopt);
+
+  const VoxelHashMap& local_map() const { return map_; }
+  // The last scan, deskewed, downsampled at the map resolution, in the
+  // odometry frame: what mapping accumulates. Valid until the next process().
+  std::span<const Eigen::Vector3f> last_registered_points() const { return registered_; }
+  const OdometryConfig& config() const { return config_; }
+
+ private:
+  OdometryConfig config_;
+  VoxelHashMap map_;
+  VoxelDownsampler downsampler_;
+  Deskewer deskewer_;
+  AdaptiveThreshold threshold_;
+  std::vector<Eigen::Vector3f> filtered_;   // in range, finite
+  std::vector<float> filtered_times_;
+  std::vector<Eigen::Vector3f> deskewed_;
+  std::vector<Eigen::Vector3f> frame_;       // map-resolution points
+  std::vector<Eigen::Vector3f> source_;      // registration-resolution points
+  std::vector<Eigen::Vector3f> registered_;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  Vector6d velocity_ = Vector6d::Zero();     // body twist per second
+  std::int64_t last_stamp_ns_ = 0;
+  bool started_ = false;
+  bool reacquire_ = false;  // the next registration uses the initial threshold
+};
+
+}  // namespace adit::slam

@@ -1,0 +1,29 @@
+#include "adit/slam/deskew.hpp"
+
+#include <algorithm>
+
+namespace adit::slam {
+
+void Deskewer::deskew(std::span<const Eigen::Vector3f> points, std::span<const float> times_s,
+                      const Vector6d& velocity, std::span<Eigen::Vector3f> out) {
+  float duration = 0.0F;
+  for (const float t : times_s) duration = std::max(duration, t);
+  if (duration <= 0.0F || velocity.isZero()) {
+    std::copy(points.begin(), points.end(), out.begin());
+    return;
+  }
+  const float bin_width = duration / static_cast<float>(kBins - 1);
+  for (int i = 0; i < kBins; ++i) {
+    const Eigen::Isometry3d T = exp_se3(velocity * static_cast<double>(static_cast<float>(i) * bin_width));
+    rotations_[static_cast<std::size_t>(i)] = T.linear().cast<float>();
+    translations_[static_cast<std::size_t>(i)] = T.translation().cast<float>();
+  }
+  const float inverse_bin = 1.0F / bin_width;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const int bin = std::clamp(static_cast<int>(times_s[k] * inverse_bin + 0.5F), 0, kBins - 1);
+    const auto b = static_cast<std::size_t>(bin);
+    out[k] = rotations_[b] * points[k] + translations_[b];
+  }
+}
+
+}  // namespace adit::slam

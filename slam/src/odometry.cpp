@@ -1,0 +1,145 @@
+#include "adit/slam/odometry.hpp"
+
+#include <cmath>
+
+namespace adit::slam {
+namespace {
+
+// The adjoint of SE(3) for twists ordered [v; ω] (Barfoot 2017, eq. 7.32):
+// maps a body-frame perturbation into the world frame.
+Matrix6d adjoint(const Eigen::Isometry3d& T) {
+  Matrix6d Ad = Matrix6d::Zero();
+  const Eigen::Matrix3d R = T.linear();
+  Ad.topLeftCorner<3, 3>() = R;
+  Ad.topRightCorner<3, 3>() = skew(T.translation()) * R;
+  Ad.bottomRightCorner<3, 3>() = R;
+  return Ad;
+}
+
+void transform_into(std::span<const Eigen::Vector3f> in, const Eigen::Isometry3d& T, std::vector<Eigen::Vector3f>& out) {
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  out.clear();
+  for (const auto& p : in) out.push_back(Tf * p);
+}
+
+}  // namespace
+
+std::string_view to_string(OdometryStatus status) {
+  switch (status) {
+    case OdometryStatus::ok: return "ok";
+    case OdometryStatus::first_scan: return "first scan";
+    case OdometryStatus::too_few_points: return "too few points";
+    case OdometryStatus::time_went_back: return "time went backwards";
+    case OdometryStatus::degenerate: return "degenerate";
+  }
+  return "?";
+}
+
+Odometry::Odometry(const OdometryConfig& config)
+    : config_(config),
+      map_(config.map_voxel_m, config.map_capacity_voxels),
+      downsampler_(config.max_scan_points),
+      threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
+  for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
+  filtered_times_.reserve(config.max_scan_points);
+}
+
+OdometryResult Odometry::process(const ScanInput& scan, const std::optional<MotionPrior>& wheel) {
+  OdometryResult result;
+  result.stamp_ns = scan.stamp_ns;
+  result.input_points = scan.points.size();
+  if (started_ && scan.stamp_ns <= last_stamp_ns_) {
+    result.pose = pose_;
+    result.status = OdometryStatus::time_went_back;
+    return result;
+  }
+  const double dt = started_ ? 1e-9 * static_cast<double>(scan.stamp_ns - last_stamp_ns_) : 0.0;
+  if (dt > config_.max_scan_gap_s) {  // the sensor stopped: old motion means nothing
+    velocity_.setZero();
+    reacquire_ = true;
+  }
+
+  // Keep finite points within range.
+  filtered_.clear();
+  filtered_times_.clear();
+  const float min2 = config_.min_range_m * config_.min_range_m;
+  const float max2 = config_.max_range_m * config_.max_range_m;
+  const bool timed = scan.times_s.size() == scan.points.size();
+  for (std::size_t i = 0; i < scan.points.size() && filtered_.size() < config_.max_scan_points; ++i) {
+    const Eigen::Vector3f& p = scan.points[i];
+    const float r2 = p.squaredNorm();
+    if (!std::isfinite(r2) || r2 < min2 || r2 > max2) continue;
+    filtered_.push_back(p);
+    filtered_times_.push_back(timed ? scan.times_s[i] : 0.0F);
+  }
+
+  // Prediction: wheel odometry when given, else constant velocity.
+  const Eigen::Isometry3d delta = wheel ? wheel->delta : exp_se3(velocity_ * dt);
+  const Eigen::Isometry3d predicted = pose_ * delta;
+  const Vector6d scan_velocity = wheel && dt > 0.0 ? Vector6d(log_se3(wheel->delta) / dt) : velocity_;
+
+  deskewed_.resize(filtered_.size());
+  deskewer_.deskew(filtered_, filtered_times_, scan_velocity, deskewed_);
+  downsampler_.downsample(deskewed_, 0.5F * config_.map_voxel_m, frame_);
+  downsampler_.downsample(frame_, config_.registration_voxel_m, source_);
+  result.registration_points = source_.size();
+
+  if (source_.size() < config_.min_registration_points) {
+    reacquire_ = true;
+    pose_ = predicted;
+    last_stamp_ns_ = scan.stamp_ns;
+    started_ = true;
+    result.pose = pose_;
+    result.status = OdometryStatus::too_few_points;
+    return result;
+  }
+
+  if (!started_ || map_.empty()) {
+    transform_into(frame_, pose_, registered_);
+    map_.add(registered_);
+    started_ = true;
+    last_stamp_ns_ = scan.stamp_ns;
+    result.pose = pose_;
+    result.covariance = Matrix6d::Zero();  // the origin of the odometry frame, by definition
+    result.status = OdometryStatus::first_scan;
+    result.valid = true;
+    return result;
+  }
+
+  PosePrior prior;
+  prior.mean = predicted;
+  if (wheel) {
+    // Body-frame covariance of the motion, carried to the world (left) tangent at the prediction.
+    const Matrix6d Ad = adjoint(predicted);
+    prior.information = (Ad * wheel->covariance * Ad.transpose()).inverse();
+  } else {
+    Vector6d information;
+    information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
+    information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
+    prior.information = information.asDiagonal();
+  }
+  if (!prior.information.allFinite()) prior.information.setZero();
+
+  // After a gap or a lost scan the prediction is poor: search as widely as at the start.
+  const double sigma = reacquire_ ? config_.initial_threshold_m / 3.0 : threshold_.sigma();
+  reacquire_ = false;
+  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration);
+  const Eigen::Isometry3d corrected = result.registration.pose;
+
+  threshold_.update(predicted.inverse() * corrected, pose_.inverse() * corrected);
+  if (dt > 0.0) velocity_ = log_se3(pose_.inverse() * corrected) / dt;
+  pose_ = corrected;
+  last_stamp_ns_ = scan.stamp_ns;
+
+  transform_into(frame_, pose_, registered_);
+  map_.add(registered_);
+  map_.remove_far(pose_.translation().cast<float>(), config_.max_range_m);
+
+  result.pose = pose_;
+  result.covariance = result.registration.covariance;
+  result.valid = true;
+  result.status = result.registration.degenerate ? OdometryStatus::degenerate : OdometryStatus::ok;
+  return result;
+}
+
+}  // namespace adit::slam
