@@ -190,8 +190,6 @@ void check_angles(const Reader& r, const std::string& prefix, OusterMetadata& m)
   if (m.pixel_shift_by_row.size() != m.beam_altitude_deg.size())
     r.fail(Reader::join(prefix, "pixel_shift_by_row"),
            fmt::format("{} shifts for {} beams", m.pixel_shift_by_row.size(), m.beam_altitude_deg.size()));
-  if (m.column_window[0] > m.column_window[1])
-    r.fail("column_window", fmt::format("[{}, {}] is empty", m.column_window[0], m.column_window[1]));
 }
 
 // Fills what a file may omit (fw 1.x, reduced configs) from the documented defaults.
