@@ -27,7 +27,7 @@ template <OusterProfile kProfile>
 struct ColumnDecoder {
   static std::size_t run(const OusterPacketLayout& layout, const std::uint8_t* packet, int width, int height,
                          const auto* rays, const float* azimuth_deg, const std::uint16_t* ring,
-                         DecodedPoint* points, OusterRawPoint* raw, std::uint64_t& invalid_columns) {
+                         DecodedPoint* points, std::uint64_t& invalid_columns) {
     constexpr int kReturns = kProfile == OusterProfile::rng19_rfl8_sig16_nir16_dual ? 2 : 1;
     constexpr float kMetresPerMm = 0.001F;
     std::size_t n = 0;
@@ -56,10 +56,10 @@ struct ColumnDecoder {
           dp.point.time_offset_ns = 0;
           dp.point.ring = ring[row];
           dp.point.return_index = static_cast<std::uint8_t>(ret);
+          dp.point.signal = r.signal;
+          dp.point.near_ir = r.near_ir;
           dp.azimuth_deg = azimuth;
           dp.sensor_time_ns = time_ns;
-          raw[n] = {r.range_mm, r.signal, r.near_ir, static_cast<std::uint16_t>(row), h.measurement_id,
-                    r.reflectivity, r.flags};
           ++n;
         }
       }
@@ -112,12 +112,11 @@ OusterDecoder::OusterDecoder(const OusterMetadata& m)
   const std::size_t capacity =
       static_cast<std::size_t>(layout_.columns_per_packet) * static_cast<std::size_t>(height_) * layout_.returns;
   points_.resize(capacity);
-  raw_.resize(capacity);
 }
 
 DecodedPacket OusterDecoder::decode(std::span<const std::uint8_t> payload, std::int64_t /*host_time_ns*/) {
   DecodedPacket out;
-  last_count_ = 0;
+  std::size_t count = 0;
   const std::uint8_t* p = payload.data();
   if (payload.size() == kOusterImuPacketBytes && layout_.packet_bytes != kOusterImuPacketBytes) {
     decode_ouster_imu(payload, imu_);
@@ -155,20 +154,20 @@ DecodedPacket OusterDecoder::decode(std::span<const std::uint8_t> payload, std::
 
   const auto run = [&](auto decoder) {
     return decltype(decoder)::run(layout_, p, width_, height_, rays_.data(), column_azimuth_deg_.data(),
-                                  rings_.data(), points_.data(), raw_.data(), counters_.invalid_columns);
+                                  rings_.data(), points_.data(), counters_.invalid_columns);
   };
   switch (layout_.profile) {
-    case OusterProfile::legacy: last_count_ = run(ColumnDecoder<OusterProfile::legacy>{}); break;
+    case OusterProfile::legacy: count = run(ColumnDecoder<OusterProfile::legacy>{}); break;
     case OusterProfile::rng19_rfl8_sig16_nir16:
-      last_count_ = run(ColumnDecoder<OusterProfile::rng19_rfl8_sig16_nir16>{});
+      count = run(ColumnDecoder<OusterProfile::rng19_rfl8_sig16_nir16>{});
       break;
-    case OusterProfile::rng15_rfl8_nir8: last_count_ = run(ColumnDecoder<OusterProfile::rng15_rfl8_nir8>{}); break;
+    case OusterProfile::rng15_rfl8_nir8: count = run(ColumnDecoder<OusterProfile::rng15_rfl8_nir8>{}); break;
     case OusterProfile::rng19_rfl8_sig16_nir16_dual:
-      last_count_ = run(ColumnDecoder<OusterProfile::rng19_rfl8_sig16_nir16_dual>{});
+      count = run(ColumnDecoder<OusterProfile::rng19_rfl8_sig16_nir16_dual>{});
       break;
   }
   out.status = PacketStatus::ok;
-  out.points = {points_.data(), last_count_};
+  out.points = {points_.data(), count};
   return out;
 }
 

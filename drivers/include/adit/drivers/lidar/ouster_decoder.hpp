@@ -13,13 +13,13 @@
 // then lidar_to_sensor_transform, then mm -> m. All of it except r is
 // precomputed per (row, column) at construction: a point is r·d + o.
 //
-// Per point: intensity = reflectivity, range_m = range, ring = beam index
-// counted from the lowest beam, sensor_time_ns = the column's timestamp,
-// azimuth_deg = 360·mid/W (the column's encoder angle in the direction of
-// rotation, so scans are cut between columns, never through one). The raw
-// fields (range mm, signal, reflectivity, near-IR, row, column) are kept
-// exactly in raw(), parallel to the points: LidarPoint is shared by every
-// family and stays small, and the exact integers are what Ouster tools compare.
+// Per point: intensity = reflectivity, range_m = range (exactly range_mm/1000:
+// the integer comes back by rounding), signal and near_ir raw, ring = beam
+// index counted from the lowest beam, sensor_time_ns = the column's
+// timestamp, azimuth_deg = 360·mid/W (the column's encoder angle in the
+// direction of rotation, so scans are cut between columns, never through one).
+// The raw fields ride in LidarPoint (see point.hpp) rather than beside it, so
+// they survive the ScanAssembler like every other field.
 // sequence = frame_id·P + packet index in the frame (P = packets per frame),
 // so the ScanAssembler counts lost packets; it wraps at sequence_modulus().
 
@@ -33,16 +33,6 @@
 #include "adit/drivers/lidar/ouster_packet.hpp"
 
 namespace adit::drivers {
-
-struct OusterRawPoint {
-  std::uint32_t range_mm = 0;
-  std::uint16_t signal = 0;
-  std::uint16_t near_ir = 0;
-  std::uint16_t row = 0;     // pixel index in the column, 0 = the top beam
-  std::uint16_t column = 0;  // measurement id
-  std::uint8_t reflectivity = 0;
-  std::uint8_t flags = 0;
-};
 
 struct OusterDecoderCounters {
   std::uint64_t lidar_packets = 0;
@@ -59,8 +49,6 @@ class OusterDecoder final : public LidarDecoder {
   std::size_t max_points_per_packet() const override { return points_.size(); }
   DecodedPacket decode(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) override;
 
-  // Raw fields of the points of the last decode(), index for index.
-  std::span<const OusterRawPoint> raw() const { return {raw_.data(), last_count_}; }
   // The last IMU packet decoded (decode() returns `auxiliary` for them).
   const OusterImuSample& last_imu() const { return imu_; }
   const OusterDecoderCounters& counters() const { return counters_; }
@@ -86,8 +74,6 @@ class OusterDecoder final : public LidarDecoder {
   std::vector<float> column_azimuth_deg_;
   std::vector<std::uint16_t> rings_;
   std::vector<DecodedPoint> points_;
-  std::vector<OusterRawPoint> raw_;
-  std::size_t last_count_ = 0;
   OusterImuSample imu_;
   OusterDecoderCounters counters_;
 };
