@@ -127,12 +127,6 @@ std::vector<int> default_pixel_shift(int rows, int cols) {
   return shift;
 }
 
-struct Sections {
-  const json* angles = nullptr;        // object with beam_altitude_angles, beam_azimuth_angles
-  const json* data_format = nullptr;   // nullptr: firmware did not report one
-  std::string data_format_key;
-};
-
 void parse_data_format(const Reader& r, const json& df, const std::string& prefix, OusterMetadata& m) {
   const int mode_cols = m.columns_per_frame;
   m.columns_per_frame = r.integer(r.require(df, prefix, "columns_per_frame"), prefix + ".columns_per_frame", 1, 8192);

@@ -57,13 +57,13 @@ class OusterDecoder final : public LidarDecoder {
   std::uint64_t sequence_modulus() const { return std::uint64_t{65536} * packets_per_frame_; }
   std::uint32_t packets_per_frame() const { return packets_per_frame_; }
 
- // public for the column decoder in the .cpp; not part of the API.
-  struct Ray {  // point = range_mm * d + o, metres
+  // One pixel's precomputed ray: point = range_mm * d + o, in metres.
+  // Public only so the profile-templated loop in the .cpp can name it.
+  struct Ray {
     float dx, dy, dz, ox, oy, oz;
   };
 
  private:
-
   OusterPacketLayout layout_;
   std::string model_;
   std::uint16_t port_;
