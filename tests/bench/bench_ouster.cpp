@@ -128,6 +128,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
     for (const auto& [name, rate] : rates_) {
       const auto slash = name.find('/');
       if (!name.starts_with("BM_OusterDecode") || slash == std::string::npos) continue;
+      if (name.ends_with("_stddev") || name.ends_with("_cv")) continue;  // ratios of spreads mean nothing
       const auto base = rates_.find("BM_BaselineNaiveTrig" + name.substr(slash));
       if (base == rates_.end() || base->second <= 0) continue;
       std::printf("%s: %.1f M points/s, %.1fx the per-point trig baseline (%.1f M points/s)\n",
