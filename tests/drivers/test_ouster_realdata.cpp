@@ -113,6 +113,25 @@ TEST(OusterRealData, LegacyAndLowDataCapturesMatchTheManualGeometry) {
   }
 }
 
+TEST(OusterRealData, CutRealPacketsAreTruncatedAndOthersForeign) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/ouster");
+  for (const std::string name : {"OS-1-32-G_v2.1.1_1024x10", "OS-0-128-U1_v2.3.0_1024x10"}) {
+    SCOPED_TRACE(name);
+    const auto m = load_ouster_metadata(dir / (name + ".json"));
+    OusterDecoder decoder(m);
+    PcapReader reader(dir / (name + ".pcap"));
+    UdpDatagram d;
+    int lidar = 0;
+    while (reader.next(d)) {
+      if (d.payload.size() != decoder.layout().packet_bytes) continue;
+      ++lidar;
+      for (const std::size_t cut : {std::size_t{12}, std::size_t{100}, d.payload.size() / 2, d.payload.size() - 1})
+        EXPECT_EQ(decoder.decode(d.payload.first(cut), 0).status, PacketStatus::truncated) << cut;
+    }
+    EXPECT_EQ(lidar, 64);
+  }
+}
+
 TEST(OusterRealData, ImuPacketsShowGravityAndAStillSensor) {
   ADIT_REQUIRE_SHARED_DATA(dir, "lidar/ouster");
   const auto m = load_ouster_metadata(dir / "OS-0-128-U1_v2.3.0_1024x10.json");
