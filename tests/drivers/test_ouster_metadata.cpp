@@ -94,6 +94,7 @@ TEST(OusterMetadataRealData, CaptureMetadataFields) {
   EXPECT_EQ(m.firmware, "v2.3.0");
   EXPECT_EQ(m.lidar_profile, OusterProfile::rng15_rfl8_nir8);
   EXPECT_EQ(m.columns_per_frame, 1024);
+  EXPECT_EQ(m.frame_rate_hz, 10);
   EXPECT_EQ(m.columns_per_packet, 16);
   EXPECT_EQ(m.pixels_per_column, 128);
   EXPECT_EQ(m.pixel_shift_by_row[0], 64);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/ouster_decoder.hpp"
 #include "adit/drivers/lidar/scan_assembler.hpp"
 #include "adit/drivers/pcap_reader.hpp"
@@ -111,6 +112,41 @@ TEST(OusterRealData, LegacyAndLowDataCapturesMatchTheManualGeometry) {
     ASSERT_EQ(d.scans.size(), 1U);
     EXPECT_GT(d.scans[0].points.size(), 1024U * m.pixels_per_column / 4);
   }
+}
+
+// The shared decode loop (as the tools and the daemon run it), lidar and IMU
+// packets of one capture mixed, host times from the capture.
+TEST(OusterRealData, DecodeStreamGivesThreeScansOnTheHostClock) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/ouster");
+  const auto m = load_ouster_metadata(dir / "OS-1-128_v2.3.0_1024x10.json");
+  OusterDecoder decoder(m);
+  EXPECT_EQ(decoder.packet_period_ns(), 1'562'500);  // 100 ms / 64 packets
+  ScanAssemblerConfig config = assembler_config_for(decoder, decoder.packet_period_ns(), 0.0F);
+  config.sequence_modulus = decoder.sequence_modulus();
+  ScanAssembler assembler(config);
+  std::vector<ScanStats> stats;
+  std::vector<std::int64_t> starts;
+  DecodeStream stream(decoder, assembler, [&](LidarScan& s) {
+    stats.push_back(s.stats);
+    starts.push_back(s.start_time_ns);
+  });
+  PcapReader reader(dir / "OS-1-128_v2.3.0_1024x10_lb_n3.pcap");
+  UdpDatagram d;
+  std::int64_t first_capture_ns = 0;
+  while (reader.next(d)) {
+    if (first_capture_ns == 0) first_capture_ns = d.capture_time_ns;
+    stream.push(d.payload, d.capture_time_ns);
+  }
+  stream.finish();
+  EXPECT_EQ(stream.counters().count(PacketStatus::ok), 192U);
+  EXPECT_EQ(stream.counters().count(PacketStatus::auxiliary), 30U);
+  EXPECT_EQ(stream.counters().total(), 222U);
+  ASSERT_EQ(stats.size(), 3U);
+  EXPECT_TRUE(stats[1].complete);
+  EXPECT_EQ(stats[1].missing_packets, 0U);
+  // Scan starts on the host clock, 100 ms apart, near the capture's time.
+  EXPECT_NEAR(static_cast<double>(starts[2] - starts[1]), 100e6, 1e6);
+  EXPECT_NEAR(static_cast<double>(starts[0] - first_capture_ns), 0.0, 50e6);
 }
 
 TEST(OusterRealData, CutRealPacketsAreTruncatedAndOthersForeign) {

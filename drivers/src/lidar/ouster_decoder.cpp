@@ -78,6 +78,7 @@ OusterDecoder::OusterDecoder(const OusterMetadata& m)
       height_(m.pixels_per_column),
       packets_per_frame_(static_cast<std::uint32_t>((m.columns_per_frame + m.columns_per_packet - 1) /
                                                     m.columns_per_packet)),
+      packet_period_ns_(m.frame_rate_hz > 0 ? 1'000'000'000LL / m.frame_rate_hz / packets_per_frame_ : 0),
       rings_(rings_by_altitude(m.beam_altitude_deg)) {
   // The lookup table of the header comment, in double, stored as float.
   const auto& b2l = m.beam_to_lidar;

@@ -103,8 +103,8 @@ std::string optional_string(const Reader& r, const json& obj, const std::string&
   return it == obj.end() ? std::string() : r.string(*it, Reader::join(prefix, key));
 }
 
-// "1024x10" -> 1024 columns; the modes the firmware manual lists.
-int columns_of_mode(const Reader& r, const std::string& mode, const std::string& key) {
+// "1024x10" -> 1024 columns at 10 Hz; the modes the firmware manual lists.
+int columns_of_mode(const Reader& r, const std::string& mode, const std::string& key, int& rate_hz) {
   const auto x = mode.find('x');
   int cols = 0;
   int hz = 0;
@@ -114,6 +114,7 @@ int columns_of_mode(const Reader& r, const std::string& mode, const std::string&
   const bool known = (cols == 512 || cols == 1024 || cols == 2048 || cols == 4096) && (hz == 5 || hz == 10 || hz == 20);
   if (!parsed || !known)
     r.fail(key, fmt::format("unknown lidar_mode '{}' (expected 512x10, 1024x10, 2048x10, ...)", mode));
+  rate_hz = hz;
   return cols;
 }
 
@@ -221,7 +222,7 @@ OusterMetadata parse_legacy(const Reader& r, const json& root) {
   OusterMetadata m;
   m.legacy_layout = true;
   m.lidar_mode = r.string(r.require(root, "", "lidar_mode"), "lidar_mode");
-  m.columns_per_frame = columns_of_mode(r, m.lidar_mode, "lidar_mode");
+  m.columns_per_frame = columns_of_mode(r, m.lidar_mode, "lidar_mode", m.frame_rate_hz);
   m.prod_line = optional_string(r, root, "", "prod_line");
   m.prod_sn = optional_string(r, root, "", "prod_sn");
   m.firmware = optional_string(r, root, "", "build_rev");
@@ -258,7 +259,7 @@ OusterMetadata parse_non_legacy(const Reader& r, const json& root) {
   m.prod_sn = r.string(r.require(info, "sensor_info", "prod_sn"), "sensor_info.prod_sn");
   m.firmware = r.string(r.require(info, "sensor_info", "build_rev"), "sensor_info.build_rev");
   m.lidar_mode = r.string(r.require(config, "config_params", "lidar_mode"), "config_params.lidar_mode");
-  m.columns_per_frame = columns_of_mode(r, m.lidar_mode, "config_params.lidar_mode");
+  m.columns_per_frame = columns_of_mode(r, m.lidar_mode, "config_params.lidar_mode", m.frame_rate_hz);
   m.beam_altitude_deg = r.numbers(r.require(beams, "beam_intrinsics", "beam_altitude_angles"),
                                   "beam_intrinsics.beam_altitude_angles");
   m.beam_azimuth_deg = r.numbers(r.require(beams, "beam_intrinsics", "beam_azimuth_angles"),

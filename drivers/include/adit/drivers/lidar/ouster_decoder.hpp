@@ -56,6 +56,8 @@ class OusterDecoder final : public LidarDecoder {
   // For ScanAssemblerConfig::sequence_modulus.
   std::uint64_t sequence_modulus() const { return std::uint64_t{65536} * packets_per_frame_; }
   std::uint32_t packets_per_frame() const { return packets_per_frame_; }
+  // Time between lidar packets (0 when the frame rate is unknown).
+  std::int64_t packet_period_ns() const { return packet_period_ns_; }
 
   // One pixel's precomputed ray: point = range_mm * d + o, in metres.
   // Public only so the profile-templated loop in the .cpp can name it.
@@ -70,6 +72,7 @@ class OusterDecoder final : public LidarDecoder {
   int width_;
   int height_;
   std::uint32_t packets_per_frame_;
+  std::int64_t packet_period_ns_;
   std::vector<Ray> rays_;  // [column * H + row]
   std::vector<float> column_azimuth_deg_;
   std::vector<std::uint16_t> rings_;

@@ -37,6 +37,7 @@ struct OusterMetadata {
   std::string prod_sn;
   std::string firmware;   // build_rev, e.g. "v2.3.0"
   std::string lidar_mode; // "1024x10"
+  int frame_rate_hz = 0;  // from lidar_mode: 5, 10 or 20
 
   std::vector<double> beam_altitude_deg;  // one per row (pixel of a column)
   std::vector<double> beam_azimuth_deg;
