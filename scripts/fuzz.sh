@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs every libFuzzer target in BUILD_DIR/bin for SECONDS each, seeded from
-# tests/fuzz/<target>.seeds (one path or glob per line, relative to the project
-# root; lines starting with shared/ are read from ../shared/data and skipped
-# when it is absent). Crashes are kept in fuzz-artifacts/ and fail the run.
+# tests/fuzz/<target>.seeds: one path or glob per line, relative to the project
+# root; "shared/..." is read from ../shared/data (skipped when absent); a
+# "pcap:" prefix cuts a capture into one seed per UDP payload (seeds_from_pcap).
+# Crashes are kept in fuzz-artifacts/ and fail the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${1:?usage: scripts/fuzz.sh BUILD_DIR [SECONDS]}
@@ -23,10 +24,13 @@ for target in "${targets[@]}"; do
   if [ -f "$seeds_file" ]; then
     while IFS= read -r pattern; do
       [ -z "$pattern" ] || [ "${pattern#\#}" != "$pattern" ] && continue
-      case "$pattern" in
-        shared/*) pattern="$shared/${pattern#shared/}" ;;
-      esac
-      for seed in $pattern; do [ -f "$seed" ] && cp "$seed" "$corpus/"; done
+      split=false
+      case "$pattern" in pcap:*) split=true; pattern=${pattern#pcap:} ;; esac
+      case "$pattern" in shared/*) pattern="$shared/${pattern#shared/}" ;; esac
+      for seed in $pattern; do
+        [ -f "$seed" ] || continue
+        if $split; then "$build_dir/bin/seeds_from_pcap" "$corpus" "$seed" >/dev/null; else cp "$seed" "$corpus/"; fi
+      done
     done < "$seeds_file"
   fi
   echo "fuzz: $name for ${seconds}s with $(ls "$corpus" | wc -l) seeds"

@@ -21,6 +21,11 @@ struct LidarPoint {
   std::uint16_t ring = 0;        // beam index, 0 = the lowest elevation
   std::uint8_t return_index = 0; // 0 first/strongest, 1 second/last (dual modes)
   std::uint8_t reserved = 0;
+  // Raw per-pixel values of formats that have them (Ouster), 0 otherwise:
+  // with intensity (reflectivity) and range_m they keep a sensor's raw fields
+  // through scan assembly. Two u16 round the point to 32 bytes.
+  std::uint16_t signal = 0;      // Ouster signal photons
+  std::uint16_t near_ir = 0;     // Ouster near-infrared (ambient) photons
 };
 
 struct ScanStats {
