@@ -1,0 +1,154 @@
+#include "adit/drivers/lidar/scan_assembler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace adit::drivers {
+namespace {
+// A scan is armed for the next cut once its firings pass this far from the cut
+// azimuth; firings that jitter back across the cut (rot corrections, dual
+// returns) then cannot cut a second time.
+constexpr float kArmFromDeg = 90.0F;
+constexpr float kArmToDeg = 350.0F;
+}  // namespace
+
+ScanAssembler::ScanAssembler(const ScanAssemblerConfig& config) : config_(config) {
+  if (config_.sequence_modulus < 2) config_.sequence_modulus = std::uint64_t{1} << 32;
+  for (LidarScan& scan : scans_) scan.points.reserve(config_.max_points_per_scan);
+}
+
+float ScanAssembler::relative_azimuth(float azimuth_deg) const {
+  float rel = std::fmod(azimuth_deg - config_.cut_azimuth_deg, 360.0F);
+  if (rel < 0.0F) rel += 360.0F;
+  return rel;
+}
+
+ScanAssembler::Verdict ScanAssembler::classify(const DecodedPacket& packet) {
+  LidarScan& scan = scans_[building_];
+  const bool by_sequence = packet.sequence.has_value();
+  const std::uint64_t sequence = by_sequence ? *packet.sequence % config_.sequence_modulus : 0;
+  Verdict verdict = Verdict::in_order;
+  if (have_last_) {
+    std::uint64_t gap = 0;
+    bool resync = false;
+    if (by_sequence) {
+      const std::uint64_t diff = (sequence + config_.sequence_modulus - last_sequence_) % config_.sequence_modulus;
+      if (diff == 0) {
+        verdict = Verdict::duplicate;
+      } else if (diff > config_.sequence_modulus / 2) {
+        verdict = Verdict::late;
+      } else {
+        gap = diff - 1;
+      }
+    } else {
+      const std::int64_t dt = packet.sensor_time_ns - last_time_ns_;
+      if (dt == 0) {
+        verdict = Verdict::duplicate;
+      } else if (dt < 0) {
+        verdict = Verdict::late;
+        // Far in the past is a clock step, not a late packet.
+        if (config_.packet_period_ns > 0 &&
+            static_cast<std::uint64_t>(-dt / config_.packet_period_ns) > kMaxCountedGap) {
+          verdict = Verdict::in_order;
+          resync = true;
+        }
+      } else if (config_.packet_period_ns > 0) {
+        const std::int64_t periods = (dt + config_.packet_period_ns / 2) / config_.packet_period_ns;
+        gap = periods > 1 ? static_cast<std::uint64_t>(periods - 1) : 0;
+      }
+    }
+    if (gap > kMaxCountedGap) {
+      resync = true;
+      gap = 0;
+    }
+    totals_.resyncs += resync ? 1 : 0;
+    scan.stats.missing_packets += static_cast<std::uint32_t>(gap);
+    totals_.missing_packets += gap;
+  }
+  if (verdict == Verdict::duplicate) {
+    ++scan.stats.duplicate_packets;
+    ++totals_.duplicate_packets;
+    return verdict;
+  }
+  if (verdict == Verdict::late) {
+    ++scan.stats.out_of_order_packets;
+    ++totals_.out_of_order_packets;
+    return verdict;
+  }
+  have_last_ = true;
+  last_sequence_ = sequence;
+  last_time_ns_ = packet.sensor_time_ns;
+  return verdict;
+}
+
+LidarScan* ScanAssembler::add(const DecodedPacket& packet, std::int64_t sensor_to_host_ns) {
+  if (packet.status != PacketStatus::ok) return nullptr;
+  if (classify(packet) != Verdict::in_order) return nullptr;
+  ++totals_.packets;
+  sensor_to_host_ns_ = sensor_to_host_ns;
+  LidarScan* finished = nullptr;
+  bool counted_in_building = false;
+  for (const DecodedPoint& point : packet.points) {
+    const LidarScan& scan = scans_[building_];
+    const float rel = relative_azimuth(point.azimuth_deg);
+    if (!scan.points.empty() && finished == nullptr) {
+      const bool crossed = armed_ && rel < kArmFromDeg;
+      const bool overdue = config_.scan_period_ns > 0 &&
+                           point.sensor_time_ns - scan.sensor_start_time_ns > config_.scan_period_ns * 3 / 2;
+      if (crossed || overdue) {
+        finished = finish(crossed);
+        started_at_cut_ = crossed;
+        counted_in_building = false;
+      }
+    }
+    if (rel >= kArmFromDeg && rel < kArmToDeg) armed_ = true;
+    if (!counted_in_building) {
+      ++scans_[building_].stats.packets;
+      counted_in_building = true;
+    }
+    append(point);
+  }
+  if (!counted_in_building) ++scans_[building_].stats.packets;
+  return finished;
+}
+
+void ScanAssembler::append(const DecodedPoint& point) {
+  LidarScan& scan = scans_[building_];
+  if (scan.points.empty()) {
+    scan.sensor_start_time_ns = point.sensor_time_ns;
+    scan.start_time_ns = point.sensor_time_ns + sensor_to_host_ns_;
+  }
+  if (scan.points.size() >= config_.max_points_per_scan) {
+    ++totals_.dropped_points;
+    return;
+  }
+  LidarPoint out = point.point;
+  const std::int64_t offset = point.sensor_time_ns - scan.sensor_start_time_ns;
+  out.time_offset_ns = static_cast<std::uint32_t>(
+      std::clamp<std::int64_t>(offset, 0, std::numeric_limits<std::uint32_t>::max()));
+  scan.points.push_back(out);
+}
+
+LidarScan* ScanAssembler::finish(bool reached_cut) {
+  LidarScan& done = scans_[building_];
+  done.stats.complete = reached_cut && started_at_cut_ && done.stats.missing_packets == 0;
+  ++totals_.scans;
+  totals_.complete_scans += done.stats.complete ? 1 : 0;
+  building_ ^= 1;
+  LidarScan& next = scans_[building_];
+  next.clear();
+  next.points.reserve(config_.max_points_per_scan);  // no-op unless the caller swapped storage in
+  armed_ = false;
+  started_at_cut_ = false;
+  return &done;
+}
+
+LidarScan* ScanAssembler::flush() {
+  if (scans_[building_].points.empty()) return nullptr;
+  LidarScan* done = finish(false);
+  have_last_ = false;
+  return done;
+}
+
+}  // namespace adit::drivers
