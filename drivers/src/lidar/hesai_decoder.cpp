@@ -68,7 +68,6 @@ HesaiDecoder::HesaiDecoder(HesaiModel model, const HesaiAngleCorrection& angles)
     sin_el_.push_back(static_cast<float>(std::sin(el)));
     cos_az_off_.push_back(static_cast<float>(std::cos(az)));
     sin_az_off_.push_back(static_cast<float>(std::sin(az)));
-    az_off_deg_.push_back(angles.azimuth_deg[c]);
   }
   cos_az_.resize(kAzimuthSteps);
   sin_az_.resize(kAzimuthSteps);
@@ -172,6 +171,9 @@ DecodedPacket HesaiDecoder::decode(std::span<const std::uint8_t> p, std::int64_t
     const std::int32_t* firing = firing_ns_[returns - 1][loop].data() + b * lasers;
     const float ca = cos_az_[raw_az];
     const float sa = sin_az_[raw_az];
+    // The encoder azimuth of the firing, not the beam's corrected direction: scans are cut
+    // between firings, as the sensor's own tools do, so per-channel corrections of up to
+    // ~9 deg (QT64) cannot split one firing across two scans.
     const float az_deg = static_cast<float>(raw_az) * 0.01F;
     const std::uint8_t ret = return_index(mode, b % returns, s.reversed_first_last);
     const std::uint8_t* unit = p.data() + at + s.block_prefix_bytes() + 2;
@@ -191,10 +193,7 @@ DecodedPacket HesaiDecoder::decode(std::span<const std::uint8_t> p, std::int64_t
       d.point.time_offset_ns = 0;
       d.point.ring = ring_[c];
       d.point.return_index = ret;
-      float az = az_deg + az_off_deg_[c];
-      if (az < 0.0F) az += 360.0F;
-      if (az >= 360.0F) az -= 360.0F;
-      d.azimuth_deg = az;
+      d.azimuth_deg = az_deg;
       d.sensor_time_ns = packet_ns + firing[c];
     }
   }

@@ -74,7 +74,10 @@ std::int32_t wrap(std::int32_t a) {
   return a < 0 ? a + kSteps : a;
 }
 
-std::int32_t to_steps(float deg) { return static_cast<std::int32_t>(std::lround(deg * 100.0F)); }
+// CSV degrees to the sensor's 0.01 degree steps the way the maker's SDK does it:
+// single-precision product truncated toward zero (8.90 becomes 889). DIFOP
+// packets carry the integers themselves.
+std::int32_t to_steps(float deg) { return static_cast<std::int32_t>(deg * 100.0F); }
 
 std::string lower(std::string_view s) {
   std::string out(s);
@@ -143,8 +146,9 @@ RoboSenseAngles load_robosense_angle_csv(const std::filesystem::path& file) {
   return parse_robosense_angle_csv(text.str(), file.string());
 }
 
-RoboSenseDecoder::RoboSenseDecoder(RoboSenseModel model, const RoboSenseAngles& angles, RoboSenseReturnMode mode)
-    : model_(model), mode_(mode), cos_(kSteps), sin_(kSteps), points_(kBlocks * kChannels) {
+RoboSenseDecoder::RoboSenseDecoder(RoboSenseModel model, const RoboSenseAngles& angles, RoboSenseReturnMode mode,
+                                   RoboSenseAngleSource source)
+    : model_(model), mode_(mode), angle_source_(source), cos_(kSteps), sin_(kSteps), points_(kBlocks * kChannels) {
   if (angles.elevation_deg.size() != 16 || angles.azimuth_deg.size() != 16) {
     throw InputError("calibration", "lasers", "RoboSense 16-laser models need 16 angle rows");
   }
@@ -196,6 +200,11 @@ DecodedPacket RoboSenseDecoder::decode_difop(std::span<const std::uint8_t> p) {
   if (p.size() < kPacketBytes) return out.status = PacketStatus::truncated, out;
   if (p.size() > kPacketBytes) return out.status = PacketStatus::malformed, out;
   ++counters_.difop_packets;
+  // Motor speed (rpm, u16 at byte 8): 6 rpm = 1 degree/s = 100 steps/s.
+  const std::uint16_t rpm = bytes::be16(p, 8);
+  if (rpm >= 60 && rpm <= 1200) {
+    nominal_step_ = static_cast<std::int32_t>(std::lround(rpm * 6.0 * 100.0 * spec_of(model_).sequence_us * 1e-6));
+  }
   const std::uint8_t mode = p[300];
   set_mode(mode == 0x00 ? RoboSenseReturnMode::dual : RoboSenseReturnMode::single);
   auto read_angles = [&](std::size_t at, std::array<std::int32_t, 16>& out_angles) {
@@ -211,7 +220,7 @@ DecodedPacket RoboSenseDecoder::decode_difop(std::span<const std::uint8_t> p) {
   std::array<std::int32_t, 16> horizontal{};
   const bool have_vertical = read_angles(468, vertical);
   const bool all_zero = std::all_of(vertical.begin(), vertical.end(), [](auto v) { return v == 0; });
-  if (have_vertical && !all_zero) {
+  if (have_vertical && !all_zero && angle_source_ == RoboSenseAngleSource::difop_when_present) {
     if (model_ != RoboSenseModel::helios16p || !read_angles(564, horizontal)) horizontal = horizontal_;
     set_angles(vertical, horizontal);
     ++counters_.difop_calibrations_applied;
@@ -251,7 +260,9 @@ DecodedPacket RoboSenseDecoder::decode(std::span<const std::uint8_t> p, std::int
     packet_ns = *seconds * 1'000'000'000LL + millis * 1'000'000LL + micros * 1000LL;
   }
 
-  // Block azimuths and the step to the next block (the last block reuses the previous step).
+  // Block azimuths and the step to the next block; the last block, with no successor in the
+  // packet, takes the step of one firing sequence at the DIFOP's motor speed, or before any
+  // DIFOP the packet's mean step (the encoder's 0.01 degree steps alternate, e.g. 19/20).
   std::array<std::int32_t, kBlocks> azimuth{};
   for (std::size_t b = 0; b < kBlocks; ++b) {
     const std::size_t at = kHeaderBytes + b * kBlockBytes;
@@ -261,7 +272,10 @@ DecodedPacket RoboSenseDecoder::decode(std::span<const std::uint8_t> p, std::int
   }
   std::array<std::int32_t, kBlocks> step{};
   for (std::size_t b = 0; b + 1 < kBlocks; ++b) step[b] = wrap(azimuth[b + 1] - azimuth[b]);
-  step[kBlocks - 1] = step[kBlocks - 2];
+  const std::int32_t span = wrap(azimuth[kBlocks - 1] - azimuth[0]);
+  step[kBlocks - 1] = nominal_step_ > 0 ? nominal_step_
+                                        : (span + static_cast<std::int32_t>(kBlocks - 1) / 2) /
+                                              static_cast<std::int32_t>(kBlocks - 1);
 
   const bool dual = mode_ == RoboSenseReturnMode::dual;
   const float rx = static_cast<float>(s.lens_offset_m);
@@ -269,6 +283,7 @@ DecodedPacket RoboSenseDecoder::decode(std::span<const std::uint8_t> p, std::int
   for (std::size_t b = 0; b < kBlocks; ++b) {
     const std::uint8_t* unit = p.data() + kHeaderBytes + b * kBlockBytes + 4;
     const std::int64_t block_ns = packet_ns + static_cast<std::int64_t>(b) * block_period_ns_;
+    const float block_azimuth_deg = static_cast<float>(azimuth[b]) * 0.01F;
     for (std::size_t c = 0; c < kChannels; ++c, unit += 3) {
       const std::uint16_t raw = static_cast<std::uint16_t>((unit[0] << 8) | unit[1]);
       if (raw == 0 || raw == 0xFFFF) continue;  // no return
@@ -287,7 +302,7 @@ DecodedPacket RoboSenseDecoder::decode(std::span<const std::uint8_t> p, std::int
       d.point.time_offset_ns = 0;
       d.point.ring = ring_[laser];
       d.point.return_index = dual && c >= 16 ? 1 : 0;
-      d.azimuth_deg = static_cast<float>(h) * 0.01F;
+      d.azimuth_deg = block_azimuth_deg;  // the firing's encoder azimuth: scans are cut between blocks
       d.sensor_time_ns = block_ns + firing_ns_[c];
     }
   }
@@ -299,13 +314,13 @@ DecodedPacket RoboSenseDecoder::decode(std::span<const std::uint8_t> p, std::int
 
 std::unique_ptr<LidarDecoder> make_robosense_decoder(std::string_view model,
                                                      const std::filesystem::path& calibration_csv,
-                                                     RoboSenseReturnMode mode) {
+                                                     RoboSenseReturnMode mode, RoboSenseAngleSource source) {
   const auto which = robosense_model_from_name(model);
   if (!which) {
     throw InputError(calibration_csv.string(), "model",
                      fmt::format("'{}' is not a RoboSense model this decoder knows", model));
   }
-  return std::make_unique<RoboSenseDecoder>(*which, load_robosense_angle_csv(calibration_csv), mode);
+  return std::make_unique<RoboSenseDecoder>(*which, load_robosense_angle_csv(calibration_csv), mode, source);
 }
 
 }  // namespace adit::drivers

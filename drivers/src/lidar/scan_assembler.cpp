@@ -6,11 +6,15 @@
 
 namespace adit::drivers {
 namespace {
-// A scan is armed for the next cut once its firings pass this far from the cut
-// azimuth; firings that jitter back across the cut (rot corrections, dual
-// returns) then cannot cut a second time.
-constexpr float kArmFromDeg = 90.0F;
-constexpr float kArmToDeg = 350.0F;
+// A scan is armed for the next cut once its firings reach the far side of the
+// revolution, [kArmFromDeg, kArmToDeg) from the cut; an armed scan is cut by the
+// first firing less than kCrossBelowDeg past the cut. The gap between the two
+// windows is hysteresis: firings that jitter back and forth (per-channel
+// azimuth corrections of up to ~10 deg on Hesai QT and RoboSense, dual
+// returns) can neither re-arm nor cut a second time.
+constexpr float kCrossBelowDeg = 90.0F;
+constexpr float kArmFromDeg = 180.0F;
+constexpr float kArmToDeg = 330.0F;
 }  // namespace
 
 ScanAssembler::ScanAssembler(const ScanAssemblerConfig& config) : config_(config) {
@@ -93,7 +97,7 @@ LidarScan* ScanAssembler::add(const DecodedPacket& packet, std::int64_t sensor_t
     const LidarScan& scan = scans_[building_];
     const float rel = relative_azimuth(point.azimuth_deg);
     if (!scan.points.empty() && finished == nullptr) {
-      const bool crossed = armed_ && rel < kArmFromDeg;
+      const bool crossed = armed_ && rel < kCrossBelowDeg;
       const bool overdue = config_.scan_period_ns > 0 &&
                            point.sensor_time_ns - scan.sensor_start_time_ns > config_.scan_period_ns * 3 / 2;
       if (crossed || overdue) {

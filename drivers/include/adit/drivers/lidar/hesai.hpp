@@ -80,7 +80,7 @@ class HesaiDecoder final : public LidarDecoder {
   const Spec& spec_;
   // Per channel: ring (rank by elevation), sin/cos of elevation and of the azimuth offset.
   std::vector<std::uint16_t> ring_;
-  std::vector<float> cos_el_, sin_el_, cos_az_off_, sin_az_off_, az_off_deg_;
+  std::vector<float> cos_el_, sin_el_, cos_az_off_, sin_az_off_;
   // Per raw azimuth step (0.01 deg): sin/cos, so the hot loop has no trigonometry.
   std::vector<float> cos_az_, sin_az_;
   // Firing offset from the packet time, per [returns-1][loop][block * lasers + channel], ns.

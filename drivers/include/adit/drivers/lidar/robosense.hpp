@@ -22,6 +22,9 @@ namespace adit::drivers {
 
 enum class RoboSenseModel : std::uint8_t { rs16, helios16p };
 enum class RoboSenseReturnMode : std::uint8_t { single, dual };
+// Which angles win when a DIFOP packet arrives: the sensor's (default), or the CSV given
+// (to reproduce a pipeline calibrated from the file; the return mode still follows DIFOP).
+enum class RoboSenseAngleSource : std::uint8_t { difop_when_present, csv_only };
 
 // "RS-16"/"RS16", "Helios16P"/"Helios-16P" (case-insensitive); nullopt otherwise.
 std::optional<RoboSenseModel> robosense_model_from_name(std::string_view name);
@@ -46,7 +49,8 @@ struct RoboSenseCounters {
 class RoboSenseDecoder final : public LidarDecoder {
  public:
   // `angles` from the CSV; DIFOP packets, when they arrive, replace them and the return mode.
-  RoboSenseDecoder(RoboSenseModel model, const RoboSenseAngles& angles, RoboSenseReturnMode mode);
+  RoboSenseDecoder(RoboSenseModel model, const RoboSenseAngles& angles, RoboSenseReturnMode mode,
+                   RoboSenseAngleSource source = RoboSenseAngleSource::difop_when_present);
 
   std::string_view model() const override;
   std::uint16_t default_port() const override { return 6699; }
@@ -65,6 +69,7 @@ class RoboSenseDecoder final : public LidarDecoder {
 
   RoboSenseModel model_;
   RoboSenseReturnMode mode_;
+  RoboSenseAngleSource angle_source_;
   // Angles in the SDK's 0.01 degree integer steps, as the sensor reports them.
   std::array<std::int32_t, 16> vertical_{};
   std::array<std::int32_t, 16> horizontal_{};
@@ -74,13 +79,14 @@ class RoboSenseDecoder final : public LidarDecoder {
   std::array<std::int32_t, 32> firing_ns_{};
   std::array<float, 32> azimuth_fraction_{};
   std::int32_t block_period_ns_ = 0;
+  std::int32_t nominal_step_ = 0;  // azimuth steps per firing sequence at the DIFOP motor speed
   std::vector<float> cos_, sin_;  // per 0.01 degree
   std::vector<DecodedPoint> points_;
   RoboSenseCounters counters_;
 };
 
-std::unique_ptr<LidarDecoder> make_robosense_decoder(std::string_view model,
-                                                     const std::filesystem::path& calibration_csv,
-                                                     RoboSenseReturnMode mode);
+std::unique_ptr<LidarDecoder> make_robosense_decoder(
+    std::string_view model, const std::filesystem::path& calibration_csv, RoboSenseReturnMode mode,
+    RoboSenseAngleSource source = RoboSenseAngleSource::difop_when_present);
 
 }  // namespace adit::drivers
