@@ -10,7 +10,6 @@
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/hesai.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
-#include "adit/drivers/lidar/scan_assembler.hpp"
 #include "lidar_packet_builders.hpp"
 
 namespace adit::drivers {
@@ -313,39 +312,6 @@ TEST(RoboSenseDecoder, BadPacketsComeBackWithAStatusNeverACrash) {
       (void)decoder.decode(noise, 0);
     }
   }
-}
-
-// Regression: per-channel azimuth corrections make firings jitter by several degrees
-// around the block azimuth; the assembler must still cut once per revolution.
-TEST(ScanAssemblerWithJitter, CutsOncePerRevolution) {
-  ScanAssembler assembler(ScanAssemblerConfig{0.0F, 100'000, 0, 0});
-  std::vector<DecodedPoint> points(16);
-  std::size_t scans = 0;
-  std::uint32_t sequence = 0;
-  for (int rev = 0; rev < 3; ++rev) {
-    for (int step = 0; step < 600; ++step, ++sequence) {
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        float az = static_cast<float>(step) * 0.6F + (i % 2 == 0 ? 8.7F : -7.9F);
-        az = std::fmod(az + 360.0F, 360.0F);
-        points[i].azimuth_deg = az;
-        points[i].sensor_time_ns = (rev * 600 + step) * 166'667LL;
-      }
-      DecodedPacket packet;
-      packet.status = PacketStatus::ok;
-      packet.sequence = sequence;
-      packet.sensor_time_ns = points[0].sensor_time_ns;
-      packet.points = points;
-      if (LidarScan* s = assembler.add(packet); s != nullptr) {
-        ++scans;
-        // Cut where the +8.7 deg channels first pass 0, once per revolution.
-        EXPECT_EQ(step, 586);
-        if (rev > 0) {
-          EXPECT_EQ(s->points.size(), 600u * points.size());
-        }
-      }
-    }
-  }
-  EXPECT_EQ(scans, 3u);
 }
 
 }  // namespace

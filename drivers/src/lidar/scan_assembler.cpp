@@ -6,15 +6,14 @@
 
 namespace adit::drivers {
 namespace {
-// A scan is armed for the next cut once its firings reach the far side of the
-// revolution, [kArmFromDeg, kArmToDeg) from the cut; an armed scan is cut by the
-// first firing less than kCrossBelowDeg past the cut. The gap between the two
-// windows is hysteresis: firings that jitter back and forth (per-channel
-// azimuth corrections of up to ~10 deg on Hesai QT and RoboSense, dual
-// returns) can neither re-arm nor cut a second time.
-constexpr float kCrossBelowDeg = 90.0F;
+// A scan is armed for the next cut once its firings reach the far half of the
+// revolution (but not the last few degrees before the cut), and the cut is a
+// firing within the first quarter after the cut azimuth: firings that jitter
+// back across the cut (rot corrections, dual returns) cannot cut twice, and
+// jitter anywhere else cannot cut at all.
 constexpr float kArmFromDeg = 180.0F;
-constexpr float kArmToDeg = 330.0F;
+constexpr float kArmToDeg = 350.0F;
+constexpr float kCutWithinDeg = 90.0F;
 }  // namespace
 
 ScanAssembler::ScanAssembler(const ScanAssemblerConfig& config) : config_(config) {
@@ -97,7 +96,7 @@ LidarScan* ScanAssembler::add(const DecodedPacket& packet, std::int64_t sensor_t
     const LidarScan& scan = scans_[building_];
     const float rel = relative_azimuth(point.azimuth_deg);
     if (!scan.points.empty() && finished == nullptr) {
-      const bool crossed = armed_ && rel < kCrossBelowDeg;
+      const bool crossed = armed_ && rel < kCutWithinDeg;
       const bool overdue = config_.scan_period_ns > 0 &&
                            point.sensor_time_ns - scan.sensor_start_time_ns > config_.scan_period_ns * 3 / 2;
       if (crossed || overdue) {
