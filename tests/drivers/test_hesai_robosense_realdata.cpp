@@ -201,6 +201,39 @@ TEST(HesaiRealdata, PandarQT64MatchesReferenceCloud) {
   check_hesai(dir);
 }
 
+// The firing-time tables against the sensor's own clock: a packet's firings lie
+// within one packet period after its first, and the next packet's first firing
+// follows one period later (XT32 dual: 4 firings x 50 us; QT64 dual: 2 x 166.7 us).
+void check_firing_times(const fs::path& dir, double period_us) {
+  const YAML::Node settings = YAML::LoadFile((dir / "reference-settings.yaml").string());
+  auto decoder = make_hesai_decoder(settings["sensor_model"].as<std::string>(), dir / settings["calibration"].as<std::string>());
+  PcapReader reader(dir / "capture.pcap");
+  UdpDatagram d;
+  std::int64_t previous = 0;
+  std::size_t packets = 0;
+  while (reader.next(d)) {
+    const DecodedPacket out = decoder->decode(d.payload, 0);
+    ASSERT_EQ(out.status, PacketStatus::ok);
+    for (const auto& p : out.points) {
+      ASSERT_GE(p.sensor_time_ns, out.sensor_time_ns);
+      ASSERT_LT(p.sensor_time_ns - out.sensor_time_ns, static_cast<std::int64_t>(period_us * 1000.0));
+    }
+    if (packets > 0) {
+      EXPECT_NEAR(static_cast<double>(out.sensor_time_ns - previous), period_us * 1000.0, 5000.0);
+    }
+    previous = out.sensor_time_ns;
+    ++packets;
+  }
+  EXPECT_GT(packets, 1000u);
+}
+
+TEST(HesaiRealdata, FiringTimesTileTheSensorClock) {
+  ADIT_REQUIRE_SHARED_DATA(xt32, "lidar/hesai-xt32");
+  check_firing_times(xt32, 4 * 50.0);
+  ADIT_REQUIRE_SHARED_DATA(qt64, "lidar/hesai-qt64");
+  check_firing_times(qt64, 2 * 500.0 / 3.0);
+}
+
 // The capture's one DIFOP packet (#543, on the MSOP port; the README says none) reports
 // return-mode byte 0x04 (single, strongest) and an angle calibration. The reference used
 // single-return timing (channels 16-31 a second firing sequence, azimuth interpolated over
