@@ -9,6 +9,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/hesai.hpp"
+#include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
 #include "lidar_packet_builders.hpp"
 
@@ -311,6 +312,35 @@ TEST(RoboSenseDecoder, BadPacketsComeBackWithAStatusNeverACrash) {
       if (i % 2 == 0) std::copy(good.begin(), good.begin() + std::min<std::size_t>(8, noise.size()), noise.begin());
       (void)decoder.decode(noise, 0);
     }
+  }
+}
+
+TEST(LidarRegistry, DetectsEveryHesaiAndRoboSenseModel) {
+  for (const auto& layout : test::hesai_layouts()) {
+    const DetectedLidar found = detect_lidar(test::hesai_packet(layout), 2368);
+    ASSERT_NE(found.family, nullptr) << layout.model;
+    EXPECT_EQ(found.family->name, "hesai");
+    EXPECT_EQ(found.model, layout.model);
+  }
+  for (const bool helios : {false, true}) {
+    const DetectedLidar found = detect_lidar(test::robosense_msop(helios, 0, 20), 6699);
+    ASSERT_NE(found.family, nullptr);
+    EXPECT_EQ(found.family->name, "robosense");
+    EXPECT_EQ(found.model, helios ? "Helios16P" : "RS-16");
+  }
+  const auto* hesai = find_lidar_family("hesai");
+  ASSERT_NE(hesai, nullptr);
+  test::HesaiContent dual;
+  dual.return_mode = 0x39;
+  EXPECT_EQ(hesai->packet_period_ns("PandarXT32", test::hesai_packet(test::hesai_layouts()[1], dual)), 200'000);
+  EXPECT_EQ(hesai->packet_period_ns("PandarXT32", test::hesai_packet(test::hesai_layouts()[1])), 400'000);
+  EXPECT_THROW(hesai->make_decoder("PandarXT32", ""), InputError);
+  EXPECT_THROW(find_lidar_family("robosense")->make_decoder("RS-16", ""), InputError);
+  std::vector<std::uint8_t> velodyne(1206, 0);
+  velodyne[0] = 0xFF, velodyne[1] = 0xEE;
+  const DetectedLidar other = detect_lidar(velodyne, 2368);
+  if (other.family != nullptr) {
+    EXPECT_EQ(other.family->name, "velodyne");
   }
 }
 

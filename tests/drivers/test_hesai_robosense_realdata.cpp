@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "adit/drivers/lidar/hesai.hpp"
+#include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
 #include "adit/drivers/lidar/scan_assembler.hpp"
 #include "adit/drivers/pcap_reader.hpp"
@@ -292,6 +293,22 @@ TEST(RoboSenseRealdata, Helios16PDifopOverridesConfiguredModeAndAngles) {
   EXPECT_EQ(decoder.counters().difop_packets, 1u);
   EXPECT_GT(after_difop, 100u);
   EXPECT_LE(worst_m, 2.0 * 0.0002);  // two 0.01 degree steps, in radians per metre of range
+}
+
+// The registry names each capture's family and model from its first data packet.
+TEST(LidarRegistryRealdata, DetectsHesaiAndRoboSenseCaptures) {
+  ADIT_REQUIRE_SHARED_DATA(lidar, "lidar");
+  const std::pair<const char*, const char*> captures[] = {
+      {"hesai-xt32", "PandarXT32"}, {"hesai-qt64", "PandarQT64"}, {"robosense-helios16p", "Helios16P"}};
+  for (const auto& [folder, model] : captures) {
+    if (!fs::exists(lidar / folder)) continue;
+    PcapReader reader(lidar / folder / "capture.pcap");
+    UdpDatagram d;
+    ASSERT_TRUE(reader.next(d));
+    const DetectedLidar found = detect_lidar(d.payload, d.dst_port);
+    ASSERT_NE(found.family, nullptr) << folder;
+    EXPECT_EQ(found.model, model);
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cctype>
+#include <cmath>
 
 #include "hesai_spec.hpp"
 
@@ -134,6 +135,27 @@ std::optional<HesaiModel> hesai_model_from_name(std::string_view name) {
 }
 
 std::string_view hesai_model_name(HesaiModel model) { return hesai_spec(model).name; }
+
+std::optional<HesaiModel> hesai_model_from_packet(std::span<const std::uint8_t> p) {
+  for (const auto& s : kSpecs) {
+    if (p.size() < s.min_packet_bytes() || p.size() > s.max_packet_bytes()) continue;
+    const bool ours = s.framing == HesaiFraming::preheader12
+                          ? p[0] == 0xEE && p[1] == 0xFF && p[2] == s.protocol_major && p[6] == s.lasers && p[7] == s.blocks
+                      : s.framing == HesaiFraming::header8 ? p[0] == 0xEE && p[1] == 0xFF && p[2] == s.lasers && p[3] == s.blocks
+                                                          : p[0] == 0xFF && p[1] == 0xEE && p[s.block_bytes()] == 0xFF;
+    if (ours) return s.model;
+  }
+  return std::nullopt;
+}
+
+std::int64_t hesai_packet_period_ns(HesaiModel model, std::span<const std::uint8_t> p) {
+  const Spec& s = hesai_spec(model);
+  if (p.size() < s.min_packet_bytes()) return 0;
+  const std::uint8_t mode = p[s.tail_offset() + s.tail_return_mode];
+  const int returns = mode >= 0x33 && mode <= 0x38 ? 1 : mode >= 0x39 && mode <= 0x3C ? 2 : mode == 0x3D ? 3 : 0;
+  if (returns == 0) return 0;
+  return static_cast<std::int64_t>(std::llround(s.blocks / returns * std::abs(s.block_step_ns)));
+}
 std::uint16_t hesai_laser_count(HesaiModel model) { return hesai_spec(model).lasers; }
 
 }  // namespace adit::drivers

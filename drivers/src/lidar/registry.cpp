@@ -8,6 +8,8 @@ std::span<const LidarFamily> lidar_families() {
   // One line per family.
   static const std::array kFamilies{
       velodyne_family(),
+      hesai_family(),
+      robosense_family(),
   };
   return kFamilies;
 }

@@ -97,6 +97,14 @@ std::optional<RoboSenseModel> robosense_model_from_name(std::string_view name) {
 
 std::string_view robosense_model_name(RoboSenseModel model) { return spec_of(model).name; }
 
+std::optional<RoboSenseModel> robosense_model_from_packet(std::span<const std::uint8_t> p) {
+  if (p.size() != kPacketBytes) return std::nullopt;
+  for (const auto model : {RoboSenseModel::rs16, RoboSenseModel::helios16p}) {
+    if (starts_with(p, spec_of(model).magic)) return model;
+  }
+  return std::nullopt;
+}
+
 RoboSenseAngles parse_robosense_angle_csv(std::string_view text, const std::string& source) {
   RoboSenseAngles out;
   std::size_t line_no = 0;

@@ -38,6 +38,10 @@ enum class HesaiModel : std::uint8_t {
 // "PandarXT32", "PandarQT128", "Pandar40P", ... (case-insensitive); nullopt otherwise.
 std::optional<HesaiModel> hesai_model_from_name(std::string_view name);
 std::string_view hesai_model_name(HesaiModel model);
+// The model whose data packet this is (magic, header identity and size), nullopt otherwise.
+std::optional<HesaiModel> hesai_model_from_packet(std::span<const std::uint8_t> payload);
+// Time between data packets of `model` in the return mode the packet's tail states; 0 if unreadable.
+std::int64_t hesai_packet_period_ns(HesaiModel model, std::span<const std::uint8_t> payload);
 std::uint16_t hesai_laser_count(HesaiModel model);
 
 // Per-channel angle corrections from the unit's angle-correction CSV, in

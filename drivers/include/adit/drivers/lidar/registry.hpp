@@ -37,5 +37,7 @@ const LidarFamily* find_lidar_family(std::string_view name);
 
 // Each family's entry, defined beside its decoder.
 LidarFamily velodyne_family();
+LidarFamily hesai_family();
+LidarFamily robosense_family();
 
 }  // namespace adit::drivers

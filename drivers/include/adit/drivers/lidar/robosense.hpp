@@ -29,6 +29,8 @@ enum class RoboSenseAngleSource : std::uint8_t { difop_when_present, csv_only };
 // "RS-16"/"RS16", "Helios16P"/"Helios-16P" (case-insensitive); nullopt otherwise.
 std::optional<RoboSenseModel> robosense_model_from_name(std::string_view name);
 std::string_view robosense_model_name(RoboSenseModel model);
+// The model whose MSOP data packet this is (magic and size), nullopt otherwise (DIFOP included).
+std::optional<RoboSenseModel> robosense_model_from_packet(std::span<const std::uint8_t> payload);
 
 // Per-laser angles in laser order (16 rows), degrees.
 struct RoboSenseAngles {
