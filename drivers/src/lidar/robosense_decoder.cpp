@@ -181,7 +181,11 @@ void RoboSenseDecoder::set_angles(const std::array<std::int32_t, 16>& vertical,
   horizontal_ = horizontal;
   std::array<std::uint16_t, 16> order{};
   std::iota(order.begin(), order.end(), std::uint16_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return vertical_[a] < vertical_[b]; });
+  // Runs on DIFOP arrival in the live path: std::sort with an index tie-break is stable
+  // without std::stable_sort's temporary buffer (a heap allocation).
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) {
+    return vertical_[a] != vertical_[b] ? vertical_[a] < vertical_[b] : a < b;
+  });
   for (std::uint16_t rank = 0; rank < 16; ++rank) ring_[order[rank]] = rank;
 }
 
