@@ -20,8 +20,8 @@
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
 #include "adit/drivers/lidar/scan_assembler.hpp"
+#include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/drivers/pcap_reader.hpp"
-#include "pcd_reader.hpp"
 #include "point_grid.hpp"
 #include "shared_data.hpp"
 
@@ -55,30 +55,29 @@ std::vector<LidarScan> all_scans(const fs::path& capture, std::uint16_t port, Li
 
 struct Reference {
   std::vector<Point3> points;
-  double min_range = 0.0;
-  double max_range = 1e9;
+  // Range as the distance of a point from the origin, on both sides of the comparison
+  // (for RoboSense it differs from the measured range by the lens offset).
+  double min_norm = 0.0;
+  double max_norm = 1e9;
   double min_angle = 0.0;
   double max_angle = 360.0;
 };
 
+double norm(const Point3& p) { return std::sqrt(double{p[0]} * p[0] + double{p[1]} * p[1] + double{p[2]} * p[2]); }
+
 // `hesai_frame`: the reference is in Hesai's frame (y forward, x right); ours is x forward, y left.
 Reference load_reference(const fs::path& pcd, const YAML::Node& settings, bool hesai_frame) {
-  const auto cloud = test::read_pcd(pcd);
+  std::vector<CloudPoint> cloud;
+  read_pcd(pcd, cloud);
   Reference ref;
-  const auto& x = cloud.at("x");
-  const auto& y = cloud.at("y");
-  const auto& z = cloud.at("z");
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const auto fx = static_cast<float>(x[i]), fy = static_cast<float>(y[i]), fz = static_cast<float>(z[i]);
-    ref.points.push_back(hesai_frame ? Point3{fy, -fx, fz} : Point3{fx, fy, fz});
-  }
+  for (const auto& q : cloud) ref.points.push_back(hesai_frame ? Point3{q.y, -q.x, q.z} : Point3{q.x, q.y, q.z});
   if (settings["min_range_m"]) {
-    ref.min_range = settings["min_range_m"].as<double>();
-    ref.max_range = settings["max_range_m"].as<double>();
-  } else {  // no range in the settings: the reference's own distance span
-    const auto& dist = cloud.at("distance");
-    ref.min_range = *std::min_element(dist.begin(), dist.end());
-    ref.max_range = *std::max_element(dist.begin(), dist.end());
+    ref.min_norm = settings["min_range_m"].as<double>();
+    ref.max_norm = settings["max_range_m"].as<double>();
+  } else {  // no range in the settings: the reference's own span
+    ref.min_norm = 1e9;
+    ref.max_norm = 0.0;
+    for (const auto& p : ref.points) ref.min_norm = std::min(ref.min_norm, norm(p)), ref.max_norm = std::max(ref.max_norm, norm(p));
   }
   ref.min_angle = settings["cloud_min_angle_deg"].as<double>();
   ref.max_angle = settings["cloud_max_angle_deg"].as<double>();
@@ -147,7 +146,8 @@ void expect_matches_reference(const fs::path& pcd, const YAML::Node& settings, b
   for (const auto& p : scan.points) {
     double az = std::atan2(-p.y, p.x) * 180.0 / M_PI;  // clockwise from forward, like the sensors
     if (az < 0) az += 360.0;
-    if (p.range_m < ref.min_range || p.range_m > ref.max_range || az < ref.min_angle || az > ref.max_angle ||
+    const double r = norm({p.x, p.y, p.z});
+    if (r < ref.min_norm || r > ref.max_norm || az < ref.min_angle || az > ref.max_angle ||
         degrees_from_cut(p) < cut_band_deg) {
       continue;
     }
