@@ -165,11 +165,13 @@ bool PcapReader::next(UdpDatagram& out) {
     const int rc = pcap_next_ex(impl.handle, &header, &data);
     if (rc == PCAP_ERROR_BREAK) {  // end of file
       impl.reassembler.clear();
+      impl.stats.fragments_dropped = impl.reassembler.dropped_fragments();
       return false;
     }
     if (rc != 1) {  // a truncated or corrupt record: libpcap cannot resynchronise after it
       ++impl.stats.damaged;
       impl.reassembler.clear();
+      impl.stats.fragments_dropped = impl.reassembler.dropped_fragments();
       pcap_close(impl.handle);
       impl.handle = nullptr;
       return false;
@@ -178,14 +180,13 @@ bool PcapReader::next(UdpDatagram& out) {
     const std::int64_t sub = impl.nanoseconds ? header->ts.tv_usec : std::int64_t{header->ts.tv_usec} * 1000;
     const std::int64_t time_ns = std::int64_t{header->ts.tv_sec} * 1'000'000'000 + sub;
     // A frame cut by the snapshot length shows up as damaged through the IP length check.
-    if (impl.parse(time_ns, {data, header->caplen}, out)) return true;
+    const bool got = impl.parse(time_ns, {data, header->caplen}, out);
+    impl.stats.fragments_dropped = impl.reassembler.dropped_fragments();
+    if (got) return true;
   }
 }
 
-const PcapStats& PcapReader::stats() const {
-  impl_->stats.fragments_dropped = impl_->reassembler.dropped_fragments();
-  return impl_->stats;
-}
+const PcapStats& PcapReader::stats() const { return impl_->stats; }
 const std::filesystem::path& PcapReader::file() const { return impl_->file; }
 
 }  // namespace adit::drivers

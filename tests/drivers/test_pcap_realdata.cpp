@@ -3,8 +3,10 @@
 // reassembly is covered by the synthetic captures of test_pcap_reader.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 
+#include "adit/drivers/lidar/scan_directory.hpp"
 #include "adit/drivers/pcap_reader.hpp"
 #include "shared_data.hpp"
 
@@ -49,6 +51,18 @@ TEST(PcapRealdata, OusterPacketsComeBackWhole) {
   EXPECT_EQ(stats.fragments_dropped, 0u);
   // LEGACY profile, 32 beams: 16 columns × (16 + 32·12 + 4) bytes.
   EXPECT_EQ(sizes.at(7502), 16u * (16 + 32 * 12 + 4));
+}
+
+TEST(ScanDirectoryRealdata, ReadsTheHdl64Sequence) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "sequences/hdl64-urban-22");
+  ScanDirectorySource source(dir);
+  EXPECT_EQ(source.size(), 22u);
+  LidarScan scan;
+  ASSERT_TRUE(source.next(scan));
+  EXPECT_GT(scan.points.size(), 100'000u);
+  float farthest = 0.0F;
+  for (const LidarPoint& p : scan.points) farthest = std::max(farthest, p.range_m);
+  EXPECT_LE(farthest, 80.5F);  // the README: range cut at 80 m
 }
 
 }  // namespace

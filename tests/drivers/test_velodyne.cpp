@@ -147,6 +147,26 @@ TEST(VelodyneDecoder, DualReturnKeepsBothEchoesAndMergesIdenticalOnes) {
   EXPECT_EQ(d.points[2].sensor_time_ns - d.points[0].sensor_time_ns, 110'592);
 }
 
+TEST(VelodyneDecoder, TimesFiringsAfterAFieldOfViewGapByTheRotationRate) {
+  VelodyneDecoder decoder(VelodyneModel::vlp16, parse_velodyne_calibration(vlp16_yaml(), "x"));
+  // Blocks 0..5 at 90.0°, 90.2°, ... then the sensor skips to 270.0° (a limited field of view).
+  auto packet = vlp16_packet(9000, 5000, 1000);
+  for (int b = 6; b < 12; ++b) {
+    const int az = 27000 + 20 * (b - 6);
+    packet[b * 100 + 2] = static_cast<std::uint8_t>(az);
+    packet[b * 100 + 3] = static_cast<std::uint8_t>(az >> 8);
+  }
+  const DecodedPacket d = decoder.decode(packet, 0);
+  ASSERT_EQ(d.status, PacketStatus::ok);
+  EXPECT_EQ(decoder.fov_gaps(), 1u);
+  // 0.2° per 110.592 µs: the 179.0° skipped beyond the usual step took 895 group periods.
+  const std::int64_t expected = 6 * 110'592 + (17'900 - 20) * 110'592 / 20;
+  EXPECT_EQ(d.points[6].sensor_time_ns - d.points[0].sensor_time_ns, expected);
+  // Firings before the gap are interpolated with the usual step, not the jump.
+  EXPECT_NEAR(d.points[5].azimuth_deg, 91.0F, 0.01F);
+  EXPECT_NEAR(d.points[6].azimuth_deg, 270.0F, 0.01F);
+}
+
 TEST(VelodyneModels, DetectsModelsAndRates) {
   auto packet = vlp16_packet(0, 0, 0);
   EXPECT_EQ(velodyne_model_from_packet(packet), VelodyneModel::vlp16);

@@ -2,6 +2,8 @@
 
 #include <numeric>
 
+#include "adit/common/log.hpp"
+
 namespace adit::drivers {
 
 std::uint64_t PacketCounters::total() const { return std::accumulate(by_status.begin(), by_status.end(), std::uint64_t{0}); }
@@ -12,12 +14,25 @@ DecodeStream::DecodeStream(LidarDecoder& decoder, ScanAssembler& assembler, Scan
 PacketStatus DecodeStream::push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) {
   const DecodedPacket packet = decoder_.decode(payload, host_time_ns);
   ++counters_.by_status[static_cast<std::size_t>(packet.status)];
-  if (packet.status != PacketStatus::ok) return packet.status;
+  if (packet.status != PacketStatus::ok) {
+    if (packet.status != PacketStatus::auxiliary && host_time_ns - last_bad_log_ns_ >= kBadPacketLogPeriodNs) {
+      last_bad_log_ns_ = host_time_ns;
+      log::warn("{}: skipped {} bad packets so far ({} foreign, {} truncated, {} malformed)", decoder_.model(),
+                bad_packets(), counters_.count(PacketStatus::foreign), counters_.count(PacketStatus::truncated),
+                counters_.count(PacketStatus::malformed));
+    }
+    return packet.status;
+  }
   last_sensor_time_ns_ = packet.sensor_time_ns;
   clock_.add(packet.sensor_time_ns, host_time_ns);
   const std::int64_t sensor_to_host = clock_.to_host(packet.sensor_time_ns) - packet.sensor_time_ns;
   if (LidarScan* scan = assembler_.add(packet, sensor_to_host); scan != nullptr && on_scan_) on_scan_(*scan);
   return packet.status;
+}
+
+std::uint64_t DecodeStream::bad_packets() const {
+  return counters_.count(PacketStatus::foreign) + counters_.count(PacketStatus::truncated) +
+         counters_.count(PacketStatus::malformed);
 }
 
 void DecodeStream::finish() {

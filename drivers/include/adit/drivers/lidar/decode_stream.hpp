@@ -1,7 +1,9 @@
 #pragma once
 // The decode + assemble loop shared by the pcap tools, the live receiver and
 // the tests: feed datagrams in, get scans out, with every packet counted by
-// its status. Nothing here allocates per packet.
+// its status. Nothing here allocates per packet. Bad packets are counted and
+// skipped; a warning with the counts is logged at most once per
+// kBadPacketLogPeriodNs of host time.
 
 #include <array>
 #include <cstdint>
@@ -32,6 +34,9 @@ class DecodeStream {
   void finish();
 
   const PacketCounters& counters() const { return counters_; }
+  std::uint64_t bad_packets() const;
+
+  static constexpr std::int64_t kBadPacketLogPeriodNs = 10'000'000'000;
   const ClockOffsetEstimator& clock() const { return clock_; }
   // Sensor time of the last data packet.
   std::int64_t last_sensor_time_ns() const { return last_sensor_time_ns_; }
@@ -43,6 +48,7 @@ class DecodeStream {
   PacketCounters counters_;
   ClockOffsetEstimator clock_;
   std::int64_t last_sensor_time_ns_ = 0;
+  std::int64_t last_bad_log_ns_ = 0;
 };
 
 // An assembler configuration for a decoder: room for `max_scan_ns` of packets

@@ -35,7 +35,7 @@ std::optional<VelodyneModel> velodyne_model_from_name(std::string_view name);
 // From a data packet's product byte; nullopt when it is not a Velodyne data packet we know.
 std::optional<VelodyneModel> velodyne_model_from_packet(std::span<const std::uint8_t> payload);
 std::optional<VelodyneReturnMode> velodyne_return_mode_from_packet(std::span<const std::uint8_t> payload);
-// Time between data packets (ns, rounded to the nearest) and points per revolution at 10 Hz, for scan assembly.
+// Time between data packets (ns) from the firing timing, for scan assembly's loss counting.
 std::int64_t velodyne_packet_period_ns(VelodyneModel model, VelodyneReturnMode mode);
 std::size_t velodyne_lasers(VelodyneModel model);
 

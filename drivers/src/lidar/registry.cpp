@@ -1,0 +1,31 @@
+#include "adit/drivers/lidar/registry.hpp"
+
+#include <array>
+
+namespace adit::drivers {
+
+std::span<const LidarFamily> lidar_families() {
+  // One line per family.
+  static const std::array kFamilies{
+      velodyne_family(),
+      hesai_family(),
+      robosense_family(),
+  };
+  return kFamilies;
+}
+
+DetectedLidar detect_lidar(std::span<const std::uint8_t> payload, std::uint16_t dst_port) {
+  for (const LidarFamily& family : lidar_families()) {
+    if (std::string model = family.detect(payload, dst_port); !model.empty()) return {&family, std::move(model)};
+  }
+  return {};
+}
+
+const LidarFamily* find_lidar_family(std::string_view name) {
+  for (const LidarFamily& family : lidar_families()) {
+    if (family.name == name) return &family;
+  }
+  return nullptr;
+}
+
+}  // namespace adit::drivers

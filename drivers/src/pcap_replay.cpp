@@ -1,0 +1,36 @@
+#include "adit/drivers/pcap_replay.hpp"
+
+#include <time.h>
+
+#include <cerrno>
+
+namespace adit::drivers {
+namespace {
+std::int64_t monotonic_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
+}
+}  // namespace
+
+PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed) : reader_(file), speed_(speed) {}
+
+bool PacedPcapReader::next(UdpDatagram& out) {
+  if (!reader_.next(out)) return false;
+  if (speed_ <= 0.0) return true;
+  if (!first_capture_ns_) {
+    first_capture_ns_ = out.capture_time_ns;
+    start_monotonic_ns_ = monotonic_ns();
+    return true;
+  }
+  // Captures can step backwards (clock adjustments): never wait for those.
+  const std::int64_t since_first = std::max<std::int64_t>(out.capture_time_ns - *first_capture_ns_, 0);
+  const std::int64_t due = start_monotonic_ns_ + static_cast<std::int64_t>(static_cast<double>(since_first) / speed_);
+  const timespec until{static_cast<time_t>(due / 1'000'000'000), static_cast<long>(due % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr) == EINTR) {
+  }
+  lateness_ns_ = monotonic_ns() - due;
+  return true;
+}
+
+}  // namespace adit::drivers
