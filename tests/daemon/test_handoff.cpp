@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "adit/daemon/handoff.hpp"
+#include "adit/daemon/spsc_ring.hpp"
+
+namespace adit::daemon {
+namespace {
+
+TEST(SpscRing, FifoUntilFullThenRefuses) {
+  SpscRing<std::uint32_t> ring(4);
+  for (std::uint32_t i = 0; i < 4; ++i) EXPECT_TRUE(ring.try_push(i));
+  EXPECT_FALSE(ring.try_push(9));
+  EXPECT_EQ(*ring.try_pop(), 0U);
+  EXPECT_EQ(*ring.steal_oldest(), 1U);
+  EXPECT_EQ(*ring.try_pop(), 2U);
+  EXPECT_EQ(*ring.try_pop(), 3U);
+  EXPECT_FALSE(ring.try_pop().has_value());
+  EXPECT_FALSE(ring.steal_oldest().has_value());
+}
+
+TEST(Handoff, DropOldestKeepsTheNewestAndCountsTheDrops) {
+  Handoff<int> handoff(3, Overflow::drop_oldest, [] { return 0; });
+  for (int i = 1; i <= 5; ++i) {
+    int* item = handoff.acquire();
+    ASSERT_NE(item, nullptr);
+    *item = i;
+    handoff.publish(item);
+  }
+  EXPECT_EQ(handoff.dropped(), 2U);
+  for (int expected : {3, 4, 5}) {
+    int* item = handoff.take();
+    ASSERT_NE(item, nullptr);
+    EXPECT_EQ(*item, expected);
+    handoff.release(item);
+  }
+  EXPECT_EQ(handoff.take(), nullptr);
+}
+
+TEST(Handoff, WaitPolicyRefusesInsteadOfDropping) {
+  Handoff<int> handoff(2, Overflow::wait, [] { return 0; });
+  handoff.publish(handoff.acquire());
+  handoff.publish(handoff.acquire());
+  EXPECT_EQ(handoff.acquire(), nullptr);
+  handoff.release(handoff.take());
+  EXPECT_NE(handoff.acquire(), nullptr);
+  EXPECT_EQ(handoff.dropped(), 0U);
+}
+
+// Two threads, a slow consumer and a small pool: every item the consumer sees
+// is intact (its two halves agree), sequence numbers only increase, and every
+// item is either consumed or counted as dropped.
+TEST(Handoff, ConcurrentDropOldestLosesNothingUncounted) {
+  struct Item {
+    std::uint64_t sequence = 0;
+    std::uint64_t check = 0;
+  };
+  Handoff<Item> handoff(8, Overflow::drop_oldest, [] { return Item{}; });
+  constexpr std::uint64_t kItems = 200'000;
+  std::atomic<bool> done{false};
+  std::uint64_t consumed = 0;
+  std::uint64_t last = 0;
+  bool intact = true;
+  std::thread consumer([&] {
+    while (true) {
+      Item* item = handoff.take();
+      if (item == nullptr) {
+        if (done.load(std::memory_order_acquire) && handoff.depth() == 0) break;
+        std::this_thread::yield();
+        continue;
+      }
+      intact = intact && item->check == ~item->sequence && item->sequence > last;
+      last = item->sequence;
+      ++consumed;
+      handoff.release(item);
+    }
+  });
+  for (std::uint64_t s = 1; s <= kItems; ++s) {
+    Item* item = nullptr;
+    while ((item = handoff.acquire()) == nullptr) std::this_thread::yield();
+    item->sequence = s;
+    item->check = ~s;
+    handoff.publish(item);
+  }
+  done.store(true, std::memory_order_release);
+  consumer.join();
+  EXPECT_TRUE(intact);
+  EXPECT_EQ(consumed + handoff.dropped(), kItems);
+  EXPECT_EQ(last, kItems);  // the newest is never dropped
+}
+
+}  // namespace
+}  // namespace adit::daemon
