@@ -11,7 +11,7 @@ Pose Similarity::apply(const Pose& pose) const {
   return out;
 }
 
-std::optional<Similarity> umeyama(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, bool with_scale) {
+std::optional<Similarity> umeyama_fit(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, bool with_scale) {
   const Eigen::Index n = from.cols();
   if (n < 3 || to.cols() != n) return std::nullopt;
   const Eigen::Vector3d mean_from = from.rowwise().mean();  // mu_x, eq. 34
@@ -69,7 +69,7 @@ std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<
     from.col(static_cast<Eigen::Index>(i)) = est[i].translation();
     to.col(static_cast<Eigen::Index>(i)) = ref[i].translation();
   }
-  return umeyama(from, to, alignment == Alignment::sim3);
+  return umeyama_fit(from, to, alignment == Alignment::sim3);
 }
 
 }  // namespace adit::slam

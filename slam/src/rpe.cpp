@@ -25,7 +25,7 @@ std::vector<IndexPair> all_pairs_by_value(std::span<const double> values, double
     for (auto it : {below, hit}) {
       if (it == hit && it == values.end()) continue;
       if (it == below && below == hit) continue;
-      const double residual = std::abs(*it - target);
+      const double residual = std::abs(*it - values[i] - delta);  // as the linear scan computes it
       if (best == values.size() || residual < best_residual) {
         best = static_cast<std::size_t>(it - values.begin());
         best_residual = residual;

@@ -52,7 +52,7 @@ std::optional<Similarity> fit_on(const Matched& m, const std::vector<std::size_t
     from.col(static_cast<Eigen::Index>(k)) = m.map.col(static_cast<Eigen::Index>(cols[k]));
     to.col(static_cast<Eigen::Index>(k)) = m.truth.col(static_cast<Eigen::Index>(cols[k]));
   }
-  return umeyama(from, to, with_scale);
+  return umeyama_fit(from, to, with_scale);
 }
 
 PointError residual(const Matched& m, std::size_t col, const Similarity& fit, bool control) {

@@ -29,7 +29,7 @@ struct Similarity {
 // s = 1 unless with_scale). nullopt when the points cannot fix a rotation:
 // fewer than 3, or all on one line (rank of the covariance below 2, the
 // condition under Umeyama's eq. 43).
-std::optional<Similarity> umeyama(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, bool with_scale);
+std::optional<Similarity> umeyama_fit(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to, bool with_scale);
 
 enum class Alignment { none, origin, se3, sim3 };
 
@@ -39,7 +39,7 @@ std::string_view alignment_name(Alignment alignment);
 
 // The transform taking `est` onto `ref` (matched pose by pose): identity for
 // none; ref[0] * est[0]^-1 for origin; Umeyama on the positions for se3/sim3.
-// nullopt when se3/sim3 positions are degenerate (see umeyama()).
+// nullopt when se3/sim3 positions are degenerate (see umeyama_fit()).
 std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<const Pose> est,
                                            Alignment alignment);
 
