@@ -8,5 +8,6 @@
 
 namespace adit::tools {
 
+void register_eval_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools
