@@ -106,7 +106,7 @@ void print_report(const TargetsEvalOptions& o, const TargetReport& r) {
 }
 
 void write_plot(const std::string& path, const TargetReport& r) {
-  Plot plot{"Target errors", "target", "error (mm)", {}, {}};
+  Plot plot{"Target errors", "target (* = control)", "distance error (mm)", {}, {}};
   PlotSeries fitted{"after the fit", kColorSecond, SeriesStyle::bars, {}, {}};
   PlotSeries left_out{"left out of the fit", kColorEstimate, SeriesStyle::bars, {}, {}};
   for (std::size_t i = 0; i < r.points.size(); ++i) {

@@ -75,7 +75,7 @@ std::string render_svg(const Plot& plot) {
   xr = bars ? xr : padded(xr);
   yr = padded(yr);
 
-  const double left = 80, right = 20, top = 45, bottom = bars ? 90 : 60;
+  const double left = 80, right = 20, top = 62, bottom = bars ? 90 : 60;
   const double pw = plot.width - left - right, ph = plot.height - top - bottom;
   if (plot.equal_axes) {  // grow the tighter axis so both have the same metres per pixel
     const double scale = std::max(xr.span() / pw, yr.span() / ph);
@@ -155,14 +155,13 @@ std::string render_svg(const Plot& plot) {
   }
   svg += "</g>\n";
 
-  // Legend, top right inside the plot.
-  double ly = top + 18;
-  for (const PlotSeries& s : plot.series) {
-    if (s.label.empty()) continue;
-    const double lx = left + pw - 190;
-    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"10\" fill=\"{}\"/>\n", lx, ly - 9, s.color);
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", lx + 20, ly, escape(s.label));
-    ly += 18;
+  // Legend in one row above the plot, right-aligned, so it never hides data.
+  double lx = left + pw;
+  for (auto it = plot.series.rbegin(); it != plot.series.rend(); ++it) {
+    if (it->label.empty()) continue;
+    lx -= 30.0 + 7.5 * static_cast<double>(it->label.size());
+    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"10\" fill=\"{}\"/>\n", lx, top - 19, it->color);
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", lx + 19, top - 9, escape(it->label));
   }
   svg += "</svg>\n";
   return svg;
