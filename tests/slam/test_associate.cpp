@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include "adit/slam/associate.hpp"
-#include "adit/slam/trajectory_io.hpp"
-#include "shared_data.hpp"
 
 namespace adit::slam {
 namespace {
@@ -41,32 +39,6 @@ TEST(Associate, MaxDifferenceAndOffsetApply) {
 TEST(Associate, EachPoseUsedOnceClosestWins) {
   const std::vector<double> ref{1.0, 5.0, 9.0}, est{0.98, 1.01, 5.0, 9.0};
   EXPECT_EQ(associate(ref, est, 0.05), (std::vector<IndexPair>{{0, 1}, {1, 2}, {2, 3}}));
-}
-
-TEST(AssociateRealData, TumFr1XyzGroundTruthAt100HzAgainstEstimateAt30Hz) {
-  ADIT_REQUIRE_SHARED_DATA(dir, "trajectories/tum-fr1-xyz");
-  const Trajectory gt = read_tum(dir / "freiburg1_xyz-groundtruth.txt");
-  const Trajectory est = read_tum(dir / "freiburg1_xyz-rgbdslam.txt");
-  ASSERT_GT(gt.size(), 2.5 * static_cast<double>(est.size()));  // 100 Hz vs ~30 Hz
-  const double max_diff = 0.01;
-  const Associated a = associate(gt, est, max_diff);
-  // Every estimate pose whose nearest ground-truth stamp is within max_diff is
-  // matched to exactly that pose; no other pose is matched.
-  std::size_t expected = 0;
-  std::size_t k = 0;
-  for (std::size_t j = 0; j < est.size(); ++j) {
-    const std::size_t i = brute_nearest(gt.stamps, est.stamps[j]);
-    if (std::abs(gt.stamps[i] - est.stamps[j]) > max_diff) continue;
-    ++expected;
-    ASSERT_LT(k, a.pairs.size());
-    EXPECT_EQ(a.pairs[k], (IndexPair{i, j}));
-    ++k;
-  }
-  EXPECT_EQ(a.pairs.size(), expected);
-  EXPECT_GT(a.pairs.size(), est.size() * 9 / 10);
-  ASSERT_EQ(a.ref.size(), a.pairs.size());
-  EXPECT_TRUE(a.ref.front().isApprox(gt.poses[a.pairs.front().first]));
-  EXPECT_TRUE(a.est.back().isApprox(est.poses[a.pairs.back().second]));
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 
 #include "adit/common/error.hpp"
 #include "adit/slam/trajectory_io.hpp"
-#include "shared_data.hpp"
 #include "temp_file.hpp"
 
 namespace adit::slam {
@@ -130,18 +129,6 @@ TEST(DetectFormat, KittiAndUnknown) {
   EXPECT_EQ(detect_trajectory_format(kitti.path()), TrajectoryFormat::kitti);
   const TempFile odd("1 2 3\n");
   EXPECT_NE(error_of([&] { detect_trajectory_format(odd.path()); }).find("format"), std::string::npos);
-}
-
-TEST(ReadEurocCsvRealData, V102GroundTruthReads) {
-  ADIT_REQUIRE_SHARED_DATA(dir, "trajectories/euroc-v102");
-  const Trajectory gt = read_euroc_csv(dir / "V102_groundtruth.csv");
-  // One header line, the rest are 200 Hz poses over about 83.5 s.
-  EXPECT_EQ(gt.size(), 16702u);
-  EXPECT_NEAR((gt.stamps.back() - gt.stamps.front()) / static_cast<double>(gt.size() - 1), 0.005, 1e-4);
-  EXPECT_TRUE(gt.poses.front().translation().isApprox(Eigen::Vector3d(0.515356, 1.996773, 0.971104)));
-  for (const Pose& p : gt.poses) ASSERT_NEAR(p.linear().determinant(), 1.0, 1e-9);
-  const Trajectory est = read_tum(dir / "V102.txt");
-  EXPECT_EQ(est.size(), 807u);
 }
 
 }  // namespace

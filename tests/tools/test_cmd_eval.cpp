@@ -1,9 +1,6 @@
 // End-to-end: the `adit eval` binary's exit statuses, JSON and plots.
 
-#include <sys/wait.h>
-
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -11,34 +8,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "shared_data.hpp"
+#include "run_adit.hpp"
 #include "temp_file.hpp"
 
 namespace adit {
 namespace {
 
+using test::adit_eval;
+using test::EvalRun;
+using test::q;
 using test::TempFile;
-using namespace std::string_literals;  // "..."s: g++ 12 -Wrestrict misfires on "literal" + std::string
-
-struct EvalRun {
-  int status = -1;
-  std::string output;  // stdout and stderr together
-};
-
-EvalRun adit_eval(const std::string& args) {
-  const std::string command = "'"s + (test::binary_dir() / "bin" / "adit").string() + "' eval " + args + " 2>&1";
-  EvalRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) run.output.append(buffer, n);
-  const int raw = ::pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
-
-std::string q(const TempFile& f) { return "'"s + f.path().string() + "'"; }
+using namespace std::string_literals;
 
 // A TUM trajectory: an L-shaped drive, 10 Hz, one pose per 0.1 m; `shift` is
 // added to every position and `t0` to every stamp.
@@ -147,21 +127,6 @@ TEST(AditEval, TooFewOrCollinearControlTargetsExit2) {
   const EvalRun malformed = adit_eval("targets --truth "s + q(truth) + " --map " + q(bad));
   EXPECT_EQ(malformed.status, 2) << malformed.output;
   EXPECT_NE(malformed.output.find(bad.path().string() + ":2"), std::string::npos) << malformed.output;
-}
-
-TEST(AditEvalRealData, Kitti00CommandLineMatchesReferenceApeAndRpe) {
-  ADIT_REQUIRE_SHARED_DATA(dir, "trajectories/kitti-00");
-  const EvalRun run = adit_eval("traj --ref '"s + (dir / "KITTI_00_gt.txt").string() + "' --est '" +
-                            (dir / "KITTI_00_ORB.txt").string() + "' --delta 10 --delta-unit m --json");
-  ASSERT_EQ(run.status, 0) << run.output;
-  const auto got = nlohmann::json::parse(run.output);
-  std::ifstream in(dir / "reference-metrics.json");
-  const auto want = nlohmann::json::parse(in)["results"];
-  const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-4 * std::abs(b); };
-  for (const char* stat : {"rmse", "mean", "median", "std", "min", "max", "sse"}) {
-    EXPECT_PRED2(near, got["ape"]["translation_m"][stat].get<double>(), want[0]["stats"][stat].get<double>()) << stat;
-    EXPECT_PRED2(near, got["rpe"]["translation_m"][stat].get<double>(), want[1]["stats"][stat].get<double>()) << stat;
-  }
 }
 
 }  // namespace
