@@ -16,6 +16,10 @@ namespace adit::slam {
 std::vector<Target> read_targets_csv(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string(), "", "cannot open for reading");
+  return read_targets_csv(in, path);
+}
+
+std::vector<Target> read_targets_csv(std::istream& in, const std::filesystem::path& path) {
   std::vector<Target> targets;
   std::unordered_set<std::string> seen;
   std::vector<std::string_view> fields;

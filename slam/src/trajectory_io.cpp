@@ -24,8 +24,7 @@ std::ifstream open(const fs::path& path) {
 
 // Calls `on_line(fields, line_number)` for every data line, split at `separators`.
 template <typename OnLine>
-void for_each_data_line(const fs::path& path, std::string_view separators, OnLine&& on_line) {
-  std::ifstream in = open(path);
+void for_each_data_line(std::istream& in, std::string_view separators, OnLine&& on_line) {
   std::string line;
   std::vector<std::string_view> fields;
   for (std::size_t number = 1; std::getline(in, line); ++number) {
@@ -101,8 +100,13 @@ TrajectoryFormat detect_trajectory_format(const fs::path& path) {
 }
 
 Trajectory read_tum(const fs::path& path) {
+  std::ifstream in = open(path);
+  return read_tum(in, path);
+}
+
+Trajectory read_tum(std::istream& in, const fs::path& path) {
   Trajectory traj;
-  for_each_data_line(path, " \t", [&](const std::vector<std::string_view>& fields, std::size_t line) {
+  for_each_data_line(in, " \t", [&](const std::vector<std::string_view>& fields, std::size_t line) {
     expect_fields(fields, 8, false, "t x y z qx qy qz qw", path, line);
     double v[8];
     parse_numbers(fields, 0, 8, path, line, v);
@@ -113,9 +117,9 @@ Trajectory read_tum(const fs::path& path) {
   return traj;
 }
 
-Trajectory read_kitti(const fs::path& path, const std::optional<fs::path>& times) {
+Trajectory read_kitti(std::istream& in, const fs::path& path) {
   Trajectory traj;
-  for_each_data_line(path, " \t", [&](const std::vector<std::string_view>& fields, std::size_t line) {
+  for_each_data_line(in, " \t", [&](const std::vector<std::string_view>& fields, std::size_t line) {
     expect_fields(fields, 12, false, "row-major 3x4 matrix", path, line);
     double v[12];
     parse_numbers(fields, 0, 12, path, line, v);
@@ -125,11 +129,19 @@ Trajectory read_kitti(const fs::path& path, const std::optional<fs::path>& times
     traj.push_back(static_cast<double>(traj.size()), pose);
   });
   expect_poses(traj, path);
-  traj.timed = times.has_value();
+  traj.timed = false;
+  return traj;
+}
+
+Trajectory read_kitti(const fs::path& path, const std::optional<fs::path>& times) {
+  std::ifstream in = open(path);
+  Trajectory traj = read_kitti(in, path);
   if (!times) return traj;
+  traj.timed = true;
 
   std::size_t count = 0;
-  for_each_data_line(*times, " \t,", [&](const std::vector<std::string_view>& fields, std::size_t line) {
+  std::ifstream times_in = open(*times);
+  for_each_data_line(times_in, " \t,", [&](const std::vector<std::string_view>& fields, std::size_t line) {
     expect_fields(fields, 1, false, "one time in seconds", *times, line);
     double t = 0.0;
     parse_numbers(fields, 0, 1, *times, line, &t);
@@ -148,8 +160,13 @@ Trajectory read_kitti(const fs::path& path, const std::optional<fs::path>& times
 }
 
 Trajectory read_euroc_csv(const fs::path& path) {
+  std::ifstream in = open(path);
+  return read_euroc_csv(in, path);
+}
+
+Trajectory read_euroc_csv(std::istream& in, const fs::path& path) {
   Trajectory traj;
-  for_each_data_line(path, ",", [&](const std::vector<std::string_view>& fields, std::size_t line) {
+  for_each_data_line(in, ",", [&](const std::vector<std::string_view>& fields, std::size_t line) {
     expect_fields(fields, 8, true, "t_ns,px,py,pz,qw,qx,qy,qz", path, line);
     const auto ns = detail::parse_int64(fields[0]);
     if (!ns) throw InputError(at(path, line), "field 1", fmt::format("'{}' is not an integer of ns", fields[0]));

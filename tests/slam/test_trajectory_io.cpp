@@ -62,6 +62,12 @@ TEST(ReadTum, ZeroQuaternionAndEmptyFileAreErrors) {
   EXPECT_NE(error_of([&] { read_tum("/nonexistent/adit.txt"); }).find("cannot open"), std::string::npos);
 }
 
+TEST(ReadTum, FromAStreamErrorsNameTheGivenFile) {
+  std::istringstream in("1.0 1 2 3 0 0 0 1\n0.5 1 2 3 0 0 0 1\n");
+  const std::string e = error_of([&] { read_tum(in, "odometry.tum"); });
+  EXPECT_NE(e.find("odometry.tum:2"), std::string::npos) << e;
+}
+
 TEST(ReadKitti, ReadsMatrixAndOptionalTimes) {
   const TempFile poses("1 0 0 5 0 1 0 6 0 0 1 7\n0 -1 0 1 1 0 0 2 0 0 1 3\n");
   const TempFile times("0.0\n0.1\n");

@@ -3,6 +3,7 @@
 // line. Malformed lines and duplicate ids throw adit::InputError("file:line").
 
 #include <filesystem>
+#include <iosfwd>
 #include <vector>
 
 #include "adit/slam/targets.hpp"
@@ -10,5 +11,7 @@
 namespace adit::slam {
 
 std::vector<Target> read_targets_csv(const std::filesystem::path& path);
+// The same from a stream; `name` is the file named in errors.
+std::vector<Target> read_targets_csv(std::istream& in, const std::filesystem::path& name);
 
 }  // namespace adit::slam

@@ -31,6 +31,11 @@ Trajectory read_kitti(const std::filesystem::path& path,
                       const std::optional<std::filesystem::path>& times = std::nullopt);
 Trajectory read_euroc_csv(const std::filesystem::path& path);
 
+// The same from a stream; `name` is the file named in errors.
+Trajectory read_tum(std::istream& in, const std::filesystem::path& name);
+Trajectory read_kitti(std::istream& in, const std::filesystem::path& name);  // untimed
+Trajectory read_euroc_csv(std::istream& in, const std::filesystem::path& name);
+
 // Dispatches on `format`; `times` applies to KITTI only.
 Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
                            const std::optional<std::filesystem::path>& times = std::nullopt);
