@@ -36,5 +36,13 @@ TEST(SvgPlot, BarsSkipMissingValuesAndHandleFlatData) {
   EXPECT_EQ(render_svg(flat).find("nan"), std::string::npos);
 }
 
+TEST(SvgPlot, TinySpanFarFromZeroStillEnds) {
+  // Survey coordinates (1e9 m) moving by micrometres: ticks are bounded.
+  Plot plot{"t", "x", "y", {}, {}, true};
+  plot.series.push_back({"", "#000", SeriesStyle::line, {1e9, 1e9 + 1e-6}, {2e9, 2e9 + 2e-6}});
+  const std::string svg = render_svg(plot);
+  EXPECT_LT(count(svg, "<line"), 200u);
+}
+
 }  // namespace
 }  // namespace adit::tools

@@ -57,6 +57,19 @@ Range padded(Range r) {
 
 std::string number(double v) { return fmt::format("{:g}", std::abs(v) < 1e-12 ? 0.0 : v); }
 
+// Tick values: multiples of `step` within [lo, hi]. Counted by index, not by
+// adding step to y, which stalls when step is below y's resolution.
+std::vector<double> ticks(double lo, double hi, double step) {
+  std::vector<double> out;
+  const double first = std::ceil(lo / step);
+  for (int k = 0; k < 64; ++k) {
+    const double v = (first + k) * step;
+    if (v > hi) break;
+    out.push_back(v);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string render_svg(const Plot& plot) {
@@ -95,7 +108,7 @@ std::string render_svg(const Plot& plot) {
 
   // Grid and tick labels.
   const double ystep = nice_step(yr.span(), 6);
-  for (double y = std::ceil(yr.lo / ystep) * ystep; y <= yr.hi; y += ystep) {
+  for (const double y : ticks(yr.lo, yr.hi, ystep)) {
     svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#e0e0e0\"/>\n", left,
                        py(y), left + pw, py(y));
     svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{}</text>\n", left - 6, py(y) + 4,
@@ -108,7 +121,7 @@ std::string render_svg(const Plot& plot) {
           px(static_cast<double>(k)) + 4, top + ph + 16, escape(plot.categories[k]));
   } else {
     const double xstep = nice_step(xr.span(), 8);
-    for (double x = std::ceil(xr.lo / xstep) * xstep; x <= xr.hi; x += xstep) {
+    for (const double x : ticks(xr.lo, xr.hi, xstep)) {
       svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#e0e0e0\"/>\n", px(x),
                          top, px(x), top + ph);
       svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{}</text>\n", px(x), top + ph + 18,
