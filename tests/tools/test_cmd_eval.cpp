@@ -20,13 +20,13 @@ using test::q;
 using test::TempFile;
 using namespace std::string_literals;
 
-// A TUM trajectory: an L-shaped drive, 10 Hz, one pose per 0.1 m; `shift` is
-// added to every position and `t0` to every stamp.
-std::string tum_lines(double t0, double shift_x) {
+// A TUM trajectory: an L-shaped drive, 10 Hz, one pose per 0.1 m; positions
+// are scaled by `scale`, then `shift_x` is added; `t0` is added to every stamp.
+std::string tum_lines(double t0, double shift_x, double scale = 1.0) {
   std::ostringstream out;
   for (int i = 0; i < 60; ++i) {
     const double x = i < 30 ? 0.1 * i : 3.0, y = i < 30 ? 0.0 : 0.1 * (i - 30);
-    out << t0 + 0.1 * i << ' ' << x + shift_x << ' ' << y << " 0 0 0 0 1\n";
+    out << t0 + 0.1 * i << ' ' << scale * x + shift_x << ' ' << scale * y << " 0 0 0 0 1\n";
   }
   return out.str();
 }
@@ -43,6 +43,19 @@ TEST(AditEval, TrajJsonGivesApeOfAKnownOffset) {
   const EvalRun aligned = adit_eval("traj --ref "s + q(ref) + " --est " + q(est) + " --json");
   ASSERT_EQ(aligned.status, 0) << aligned.output;
   EXPECT_NEAR(nlohmann::json::parse(aligned.output)["ape"]["translation_m"]["rmse"].get<double>(), 0.0, 1e-6);
+}
+
+TEST(AditEval, RpePairsChosenAlongEstimateOrReference) {
+  // The estimate is 10 % too long. 1.05 m of path is 11 reference steps
+  // (1.1 m, error 0.11 m) but 10 estimate steps (1.0 m of reference, 0.1 m).
+  const TempFile ref(tum_lines(0.0, 0.0)), est(tum_lines(0.0, 0.0, 1.1));
+  const std::string common = "traj --ref "s + q(ref) + " --est " + q(est) + " --align none --delta 1.05 --delta-unit m --json";
+  const EvalRun along_est = adit_eval(common);
+  const EvalRun along_ref = adit_eval(common + " --pairs-on ref");
+  ASSERT_EQ(along_est.status, 0) << along_est.output;
+  ASSERT_EQ(along_ref.status, 0) << along_ref.output;
+  EXPECT_NEAR(nlohmann::json::parse(along_est.output)["rpe"]["translation_m"]["max"].get<double>(), 0.10, 1e-9);
+  EXPECT_NEAR(nlohmann::json::parse(along_ref.output)["rpe"]["translation_m"]["max"].get<double>(), 0.11, 1e-9);
 }
 
 TEST(AditEval, TrajWritesReadableSvgPlots) {

@@ -35,6 +35,9 @@ void add_traj(CLI::App& eval, int& status) {
   cmd->add_option("--delta-unit", o->delta_unit, "RPE step unit: frames, m (path length) or s (default frames)")
       ->check(CLI::IsMember({"frames", "m", "s"}));
   cmd->add_flag("--all-pairs", o->all_pairs, "RPE from every pose instead of consecutive pairs");
+  cmd->add_option("--pairs-on", o->pairs_on,
+                  "Trajectory whose path length and stamps choose the RPE pairs: est (as evo) or ref (default est)")
+      ->check(CLI::IsMember({"est", "ref"}));
   cmd->add_flag("--json", o->json, "Print JSON instead of tables");
   cmd->add_option("--svg", o->svg_prefix,
                   "Write plots PREFIX-plan.svg (trajectories overlaid) and PREFIX-ape.svg (error along the path)");

@@ -21,6 +21,7 @@ struct TrajEvalOptions {
   double delta = 1.0;
   std::string delta_unit = "frames";
   bool all_pairs = false;
+  std::string pairs_on = "est";  // whose path/stamps choose the RPE pairs
   bool json = false;
   std::string svg_prefix;
   std::string save_aligned;

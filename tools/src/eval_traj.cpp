@@ -118,13 +118,16 @@ void run_eval_traj(const TrajEvalOptions& o) {
   for (const Pose& p : a.est) aligned.push_back(fit->apply(p));
 
   const PoseErrors ape = absolute_pose_errors(a.ref, aligned);
-  // Pairs along the (aligned) estimate, as evo chooses them.
-  std::vector<double> est_stamps;
-  for (const auto& [i, j] : a.pairs) est_stamps.push_back(est.trajectory.stamps[j]);
+  // Pairs along the (aligned) estimate by default, as evo chooses them.
+  const bool on_ref = o.pairs_on == "ref";
+  std::vector<double> pair_stamps = a.stamps;
+  if (!on_ref)
+    for (std::size_t k = 0; k < a.pairs.size(); ++k) pair_stamps[k] = est.trajectory.stamps[a.pairs[k].second];
   const RpeSettings rpe_settings{o.delta, *parse_delta_unit(o.delta_unit), o.all_pairs};
-  if (rpe_settings.unit == DeltaUnit::seconds && !est.trajectory.timed)
-    throw InputError(o.est, "delta-unit", "seconds need a timed estimate (KITTI: give --est-times)");
-  const auto pairs = rpe_pairs(path_distances(aligned), est_stamps, rpe_settings);
+  if (rpe_settings.unit == DeltaUnit::seconds && !(on_ref ? ref : est).trajectory.timed)
+    throw InputError(on_ref ? o.ref : o.est, "delta-unit", "seconds need times (KITTI: give --ref-times/--est-times)");
+  const auto pairs = rpe_pairs(path_distances(on_ref ? std::span<const Pose>(a.ref) : std::span<const Pose>(aligned)),
+                               pair_stamps, rpe_settings);
   if (pairs.empty())
     throw InputError("", "delta",
                      fmt::format("delta = {} {} gives no RPE pair on this trajectory; use a smaller delta", o.delta,
@@ -134,7 +137,8 @@ void run_eval_traj(const TrajEvalOptions& o) {
 
   const Stats ape_t = compute_stats(ape.translation), ape_r = compute_stats(ape.rotation_deg);
   const Stats rpe_t = compute_stats(rpe.translation), rpe_r = compute_stats(rpe.rotation_deg);
-  const std::string rpe_label = fmt::format("{} {}, {}", o.delta, o.delta_unit, o.all_pairs ? "all pairs" : "consecutive");
+  const std::string rpe_label = fmt::format("{} {}, {}, chosen along the {}", o.delta, o.delta_unit,
+                                            o.all_pairs ? "all pairs" : "consecutive", on_ref ? "reference" : "estimate");
 
   if (o.json) {
     nlohmann::json j;
@@ -150,6 +154,8 @@ void run_eval_traj(const TrajEvalOptions& o) {
     j["rpe"] = {{"delta", o.delta},
                 {"unit", o.delta_unit},
                 {"all_pairs", o.all_pairs},
+                {"pairs_on", o.pairs_on},
+                {"pairs", pairs.size()},
                 {"translation_m", stats_json(rpe_t)},
                 {"rotation_deg", stats_json(rpe_r)}};
     if (kitti) {
