@@ -87,123 +87,142 @@ nlohmann::json matrix_json(const Eigen::Matrix3d& m) {
   return rows;
 }
 
-}  // namespace
+// Everything `adit eval traj` computed, for printing and plotting.
+struct TrajEvaluation {
+  Loaded ref, est;
+  Associated associated;
+  Similarity fit;
+  std::vector<Pose> aligned;  // associated estimate poses after the fit
+  PoseErrors ape, rpe;
+  std::size_t rpe_pairs = 0;
+  std::optional<KittiDrift> kitti;
+};
 
-void run_eval_traj(const TrajEvalOptions& o) {
-  const Loaded ref = load(o.ref, o.ref_format, o.ref_times);
-  const Loaded est = load(o.est, o.est_format, o.est_times);
+TrajEvaluation evaluate(const TrajEvalOptions& o) {
+  TrajEvaluation e{load(o.ref, o.ref_format, o.ref_times), load(o.est, o.est_format, o.est_times), {}, {}, {}, {}, {}, 0, {}};
+  const Trajectory& ref = e.ref.trajectory;
+  const Trajectory& est = e.est.trajectory;
 
-  const Associated a = associate(ref.trajectory, est.trajectory, o.max_diff, o.offset);
+  e.associated = associate(ref, est, o.max_diff, o.offset);
+  const Associated& a = e.associated;
   if (a.pairs.size() < 2) {
-    if (!(ref.trajectory.timed && est.trajectory.timed) && ref.trajectory.size() != est.trajectory.size())
+    if (!(ref.timed && est.timed) && ref.size() != est.size())
       throw InputError(o.est, "", fmt::format("{} poses against {} in the reference, and without times they can only "
                                               "be matched one to one; give --ref-times/--est-times",
-                                              est.trajectory.size(), ref.trajectory.size()));
+                                              est.size(), ref.size()));
     throw InputError(o.est, "",
                      fmt::format("{} pose(s) associate with the reference within {} s (need 2): reference spans "
                                  "{:.3f}..{:.3f} s, estimate {:.3f}..{:.3f} s; check --max-diff and --offset",
-                                 a.pairs.size(), o.max_diff, ref.trajectory.stamps.front(), ref.trajectory.stamps.back(),
-                                 est.trajectory.stamps.front(), est.trajectory.stamps.back()));
+                                 a.pairs.size(), o.max_diff, ref.stamps.front(), ref.stamps.back(),
+                                 est.stamps.front(), est.stamps.back()));
   }
 
-  const Alignment alignment = *parse_alignment(o.align);
-  const auto fit = align_trajectory(a.ref, a.est, alignment);
+  const auto fit = align_trajectory(a.ref, a.est, *parse_alignment(o.align));
   if (!fit)
     throw InputError(o.est, "align",
                      fmt::format("{} alignment is not determined: fewer than 3 associated positions or all on one line; "
                                  "use --align origin or none",
                                  o.align));
-  std::vector<Pose> aligned;
-  aligned.reserve(a.est.size());
-  for (const Pose& p : a.est) aligned.push_back(fit->apply(p));
+  e.fit = *fit;
+  e.aligned.reserve(a.est.size());
+  for (const Pose& p : a.est) e.aligned.push_back(fit->apply(p));
+  e.ape = absolute_pose_errors(a.ref, e.aligned);
 
-  const PoseErrors ape = absolute_pose_errors(a.ref, aligned);
   // Pairs along the (aligned) estimate by default, as evo chooses them.
   const bool on_ref = o.pairs_on == "ref";
   std::vector<double> pair_stamps = a.stamps;
   if (!on_ref)
-    for (std::size_t k = 0; k < a.pairs.size(); ++k) pair_stamps[k] = est.trajectory.stamps[a.pairs[k].second];
-  const RpeSettings rpe_settings{o.delta, *parse_delta_unit(o.delta_unit), o.all_pairs};
-  if (rpe_settings.unit == DeltaUnit::seconds && !(on_ref ? ref : est).trajectory.timed)
+    for (std::size_t k = 0; k < a.pairs.size(); ++k) pair_stamps[k] = est.stamps[a.pairs[k].second];
+  const RpeSettings settings{o.delta, *parse_delta_unit(o.delta_unit), o.all_pairs};
+  if (settings.unit == DeltaUnit::seconds && !(on_ref ? ref : est).timed)
     throw InputError(on_ref ? o.ref : o.est, "delta-unit", "seconds need times (KITTI: give --ref-times/--est-times)");
-  const auto pairs = rpe_pairs(path_distances(on_ref ? std::span<const Pose>(a.ref) : std::span<const Pose>(aligned)),
-                               pair_stamps, rpe_settings);
+  const std::span<const Pose> along = on_ref ? std::span<const Pose>(a.ref) : std::span<const Pose>(e.aligned);
+  const auto pairs = rpe_pairs(path_distances(along), pair_stamps, settings);
   if (pairs.empty())
     throw InputError("", "delta",
                      fmt::format("delta = {} {} gives no RPE pair on this trajectory; use a smaller delta", o.delta,
                                  o.delta_unit));
-  const PoseErrors rpe = relative_pose_errors(a.ref, aligned, pairs);
-  const auto kitti = kitti_drift(a.ref, aligned);
+  e.rpe = relative_pose_errors(a.ref, e.aligned, pairs);
+  e.rpe_pairs = pairs.size();
+  e.kitti = kitti_drift(a.ref, e.aligned);
+  return e;
+}
 
-  const Stats ape_t = compute_stats(ape.translation), ape_r = compute_stats(ape.rotation_deg);
-  const Stats rpe_t = compute_stats(rpe.translation), rpe_r = compute_stats(rpe.rotation_deg);
-  const std::string rpe_label = fmt::format("{} {}, {}, chosen along the {}", o.delta, o.delta_unit,
-                                            o.all_pairs ? "all pairs" : "consecutive", on_ref ? "reference" : "estimate");
-
-  if (o.json) {
-    nlohmann::json j;
-    j["reference"] = {{"file", o.ref}, {"format", format_name(ref.format)}, {"poses", ref.trajectory.size()}};
-    j["estimate"] = {{"file", o.est}, {"format", format_name(est.format)}, {"poses", est.trajectory.size()}};
-    j["associated_pairs"] = a.pairs.size();
-    j["max_diff_s"] = o.max_diff;
-    j["alignment"] = {{"kind", o.align},
-                      {"rotation", matrix_json(fit->rotation)},
-                      {"translation", {fit->translation.x(), fit->translation.y(), fit->translation.z()}},
-                      {"scale", fit->scale}};
-    j["ape"] = {{"translation_m", stats_json(ape_t)}, {"rotation_deg", stats_json(ape_r)}};
-    j["rpe"] = {{"delta", o.delta},
-                {"unit", o.delta_unit},
-                {"all_pairs", o.all_pairs},
-                {"pairs_on", o.pairs_on},
-                {"pairs", pairs.size()},
-                {"translation_m", stats_json(rpe_t)},
-                {"rotation_deg", stats_json(rpe_r)}};
-    if (kitti) {
-      nlohmann::json lengths = nlohmann::json::array();
-      for (const auto& b : kitti->by_length)
-        lengths.push_back({{"length_m", b.length},
-                           {"segments", b.segments},
-                           {"translation_percent", b.translation_percent},
-                           {"rotation_deg_per_100m", b.rotation_deg_per_100m}});
-      j["kitti"] = {{"segments", kitti->segments},
-                    {"translation_percent", kitti->translation_percent},
-                    {"rotation_deg_per_100m", kitti->rotation_deg_per_100m},
-                    {"by_length", lengths}};
-    } else {
-      j["kitti"] = nullptr;
-    }
-    fmt::print("{}\n", j.dump(2));
-  } else {
-    fmt::print("reference   {} ({}, {} poses)\n", o.ref, format_name(ref.format), ref.trajectory.size());
-    fmt::print("estimate    {} ({}, {} poses)\n", o.est, format_name(est.format), est.trajectory.size());
-    fmt::print("associated  {} pairs (max difference {} s)\n", a.pairs.size(), o.max_diff);
-    fmt::print("alignment   {}: rotation {:.4f} deg, translation ({:.4f}, {:.4f}, {:.4f}) m, scale {:.6f}\n\n", o.align,
-               rad_to_deg(rotation_angle(fit->rotation)), fit->translation.x(), fit->translation.y(),
-               fit->translation.z(), fit->scale);
-    fmt::print("{}", stats_header());
-    fmt::print("{}", stats_row("APE translation (m)", ape_t));
-    fmt::print("{}", stats_row("APE rotation (deg)", ape_r));
-    fmt::print("{}", stats_row("RPE translation (m)", rpe_t));
-    fmt::print("{}", stats_row("RPE rotation (deg)", rpe_r));
-    fmt::print("  RPE pairs: {}\n\n", rpe_label);
-    if (kitti) {
-      fmt::print("KITTI drift over {} segments: {:.4f} % translation, {:.4f} deg/100 m rotation\n", kitti->segments,
-                 kitti->translation_percent, kitti->rotation_deg_per_100m);
-      fmt::print("  {:>8} {:>9} {:>10} {:>14}\n", "length", "segments", "trans %", "rot deg/100m");
-      for (const auto& b : kitti->by_length)
-        if (b.segments > 0)
-          fmt::print("  {:>6.0f} m {:>9} {:>10.4f} {:>14.4f}\n", b.length, b.segments, b.translation_percent,
-                     b.rotation_deg_per_100m);
-    } else {
-      fmt::print("KITTI drift: n/a (the reference path is shorter than 100 m)\n");
-    }
+void print_json(const TrajEvalOptions& o, const TrajEvaluation& e) {
+  nlohmann::json j;
+  j["reference"] = {{"file", o.ref}, {"format", format_name(e.ref.format)}, {"poses", e.ref.trajectory.size()}};
+  j["estimate"] = {{"file", o.est}, {"format", format_name(e.est.format)}, {"poses", e.est.trajectory.size()}};
+  j["associated_pairs"] = e.associated.pairs.size();
+  j["max_diff_s"] = o.max_diff;
+  j["alignment"] = {{"kind", o.align},
+                    {"rotation", matrix_json(e.fit.rotation)},
+                    {"translation", {e.fit.translation.x(), e.fit.translation.y(), e.fit.translation.z()}},
+                    {"scale", e.fit.scale}};
+  j["ape"] = {{"translation_m", stats_json(compute_stats(e.ape.translation))},
+              {"rotation_deg", stats_json(compute_stats(e.ape.rotation_deg))}};
+  j["rpe"] = {{"delta", o.delta},
+              {"unit", o.delta_unit},
+              {"all_pairs", o.all_pairs},
+              {"pairs_on", o.pairs_on},
+              {"pairs", e.rpe_pairs},
+              {"translation_m", stats_json(compute_stats(e.rpe.translation))},
+              {"rotation_deg", stats_json(compute_stats(e.rpe.rotation_deg))}};
+  j["kitti"] = nullptr;
+  if (e.kitti) {
+    nlohmann::json lengths = nlohmann::json::array();
+    for (const auto& b : e.kitti->by_length)
+      lengths.push_back({{"length_m", b.length},
+                         {"segments", b.segments},
+                         {"translation_percent", b.translation_percent},
+                         {"rotation_deg_per_100m", b.rotation_deg_per_100m}});
+    j["kitti"] = {{"segments", e.kitti->segments},
+                  {"translation_percent", e.kitti->translation_percent},
+                  {"rotation_deg_per_100m", e.kitti->rotation_deg_per_100m},
+                  {"by_length", lengths}};
   }
+  fmt::print("{}\n", j.dump(2));
+}
 
-  if (!o.svg_prefix.empty()) write_plots(o.svg_prefix, a, aligned, ape);
+void print_table(const TrajEvalOptions& o, const TrajEvaluation& e) {
+  fmt::print("reference   {} ({}, {} poses)\n", o.ref, format_name(e.ref.format), e.ref.trajectory.size());
+  fmt::print("estimate    {} ({}, {} poses)\n", o.est, format_name(e.est.format), e.est.trajectory.size());
+  fmt::print("associated  {} pairs (max difference {} s)\n", e.associated.pairs.size(), o.max_diff);
+  fmt::print("alignment   {}: rotation {:.4f} deg, translation ({:.4f}, {:.4f}, {:.4f}) m, scale {:.6f}\n\n", o.align,
+             rad_to_deg(rotation_angle(e.fit.rotation)), e.fit.translation.x(), e.fit.translation.y(),
+             e.fit.translation.z(), e.fit.scale);
+  fmt::print("{}", stats_header());
+  fmt::print("{}", stats_row("APE translation (m)", compute_stats(e.ape.translation)));
+  fmt::print("{}", stats_row("APE rotation (deg)", compute_stats(e.ape.rotation_deg)));
+  fmt::print("{}", stats_row("RPE translation (m)", compute_stats(e.rpe.translation)));
+  fmt::print("{}", stats_row("RPE rotation (deg)", compute_stats(e.rpe.rotation_deg)));
+  fmt::print("  RPE pairs: {} {}, {}, chosen along the {}\n\n", o.delta, o.delta_unit,
+             o.all_pairs ? "all pairs" : "consecutive", o.pairs_on == "ref" ? "reference" : "estimate");
+  if (!e.kitti) {
+    fmt::print("KITTI drift: n/a (the reference path is shorter than 100 m)\n");
+    return;
+  }
+  fmt::print("KITTI drift over {} segments: {:.4f} % translation, {:.4f} deg/100 m rotation\n", e.kitti->segments,
+             e.kitti->translation_percent, e.kitti->rotation_deg_per_100m);
+  fmt::print("  {:>8} {:>9} {:>10} {:>14}\n", "length", "segments", "trans %", "rot deg/100m");
+  for (const auto& b : e.kitti->by_length)
+    if (b.segments > 0)
+      fmt::print("  {:>6.0f} m {:>9} {:>10.4f} {:>14.4f}\n", b.length, b.segments, b.translation_percent,
+                 b.rotation_deg_per_100m);
+}
+
+}  // namespace
+
+void run_eval_traj(const TrajEvalOptions& o) {
+  const TrajEvaluation e = evaluate(o);
+  if (o.json)
+    print_json(o, e);
+  else
+    print_table(o, e);
+  if (!o.svg_prefix.empty()) write_plots(o.svg_prefix, e.associated, e.aligned, e.ape);
   if (!o.save_aligned.empty()) {
     Trajectory out;
-    out.stamps = a.stamps;
-    out.poses = aligned;
+    out.stamps = e.associated.stamps;
+    out.poses = e.aligned;
     write_tum(o.save_aligned, out);
   }
 }
