@@ -5,16 +5,11 @@
 // |trans(E_i)| = |t_Q - t_P| and the rotation error the angle of rot(E_i).
 
 #include <span>
-#include <vector>
 
+#include "adit/slam/pose_error.hpp"
 #include "adit/slam/trajectory.hpp"
 
 namespace adit::slam {
-
-struct PoseErrors {
-  std::vector<double> translation;   // metres
-  std::vector<double> rotation_deg;  // degrees
-};
 
 // ref and est have the same length (associated pose by pose).
 PoseErrors absolute_pose_errors(std::span<const Pose> ref, std::span<const Pose> est);

@@ -4,7 +4,6 @@
 #include <span>
 #include <vector>
 
-#include "adit/slam/rpe.hpp"
 #include "adit/slam/trajectory.hpp"
 
 namespace adit::slam {

@@ -2,9 +2,17 @@
 // The two scalar errors of a pose difference E = Q^-1 P (reference Q,
 // estimate P): the length of its translation and the angle of its rotation.
 
+#include <vector>
+
 #include "adit/slam/trajectory.hpp"
 
 namespace adit::slam {
+
+// Per-pose (APE) or per-pair (RPE) errors.
+struct PoseErrors {
+  std::vector<double> translation;   // metres
+  std::vector<double> rotation_deg;  // degrees
+};
 
 // Rotation angle of R in radians, in [0, pi]: atan2(|vee(R - R^T)| / 2, (tr R - 1) / 2),
 // which stays accurate near 0 and pi where acos((tr R - 1) / 2) does not.

@@ -10,10 +10,9 @@
 #include <optional>
 #include <span>
 #include <string_view>
-#include <utility>
 #include <vector>
 
-#include "adit/slam/ape.hpp"
+#include "adit/slam/pose_error.hpp"
 #include "adit/slam/trajectory.hpp"
 
 namespace adit::slam {
@@ -32,8 +31,6 @@ struct RpeSettings {
   bool all_pairs = false;
   double relative_tolerance = 0.1;  // all pairs, metres and seconds: accept |d - delta| <= tol * delta
 };
-
-using IndexPair = std::pair<std::size_t, std::size_t>;
 
 // Pairs along one trajectory: `distances` from path_distances() of its poses,
 // `stamps` its times (seconds). Consecutive pairs, by unit:

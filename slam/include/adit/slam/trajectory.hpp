@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -29,6 +30,9 @@ struct Trajectory {
     poses.push_back(pose);
   }
 };
+
+// Indices of two poses: (i, j) in one trajectory, or matched across two.
+using IndexPair = std::pair<std::size_t, std::size_t>;
 
 // Cumulative path length: out[0] = 0, out[i] = sum_{k<i} |p_{k+1} - p_k|.
 std::vector<double> path_distances(std::span<const Pose> poses);
