@@ -113,6 +113,20 @@ TEST(KittiDrift, OnePercentScaleErrorIsOnePercent) {
   EXPECT_FALSE(kitti_drift(straight(50), straight(50)));
 }
 
+TEST(KittiDrift, ConstantHeadingDriftGivesItsRatePerMetre) {
+  // Positions exact, heading off by c per frame (one frame per metre): a
+  // segment of L m spans L + 1 frames, so its rotation error is c (L + 1).
+  const double c = 1e-4;
+  const std::vector<Pose> ref = straight(1001);
+  std::vector<Pose> est = ref;
+  for (std::size_t i = 0; i < est.size(); ++i)
+    est[i].linear() = Eigen::AngleAxisd(c * static_cast<double>(i), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const auto drift = kitti_drift(ref, est);
+  ASSERT_TRUE(drift);
+  for (const KittiLengthDrift& b : drift->by_length)
+    EXPECT_NEAR(b.rotation_deg_per_100m, 100.0 * rad_to_deg(c * (b.length + 1.0)) / b.length, 1e-9) << b.length;
+}
+
 TEST(EndpointDrift, HandComputed) {
   // Three sides of a 3 x 4 rectangle: path 3 + 4 + 3 = 10 m.
   const std::vector<Pose> poses{at(0, 0, 0), at(3, 0, 0), at(3, 4, 0), at(0, 4, 0)};
