@@ -18,7 +18,7 @@ std::optional<Similarity> umeyama_fit(const Eigen::Matrix3Xd& from, const Eigen:
   const Eigen::Vector3d mean_to = to.rowwise().mean();      // mu_y, eq. 35
   const Eigen::Matrix3Xd x = from.colwise() - mean_from;
   const Eigen::Matrix3Xd y = to.colwise() - mean_to;
-  const double variance_from = x.squaredNorm() / static_cast<double>(n);  // sigma_x^2, eq. 36
+  const double variance_from = x.squaredNorm() / static_cast<double>(n);          // sigma_x^2, eq. 36
   const Eigen::Matrix3d covariance = y * x.transpose() / static_cast<double>(n);  // Sigma_xy, eq. 38
 
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -55,8 +55,7 @@ std::string_view alignment_name(Alignment alignment) {
   return "?";
 }
 
-std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<const Pose> est,
-                                           Alignment alignment) {
+std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<const Pose> est, Alignment alignment) {
   if (alignment == Alignment::none) return Similarity{};
   if (ref.empty() || ref.size() != est.size()) return std::nullopt;
   if (alignment == Alignment::origin) {

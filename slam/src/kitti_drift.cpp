@@ -26,8 +26,8 @@ std::optional<KittiDrift> kitti_drift(std::span<const Pose> ref, std::span<const
     for (std::size_t k = 0; k < kKittiLengths.size(); ++k) {
       const double length = kKittiLengths[k];
       // First frame strictly beyond `length` of path (devkit lastFrameFromSegmentLength).
-      const auto it = std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first), dist.end(),
-                                       dist[first] + length);
+      const auto it =
+          std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first), dist.end(), dist[first] + length);
       if (it == dist.end()) continue;
       const auto last = static_cast<std::size_t>(it - dist.begin());
       const Pose delta_ref = ref[first].inverse() * ref[last];

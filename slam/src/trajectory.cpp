@@ -11,8 +11,7 @@ std::vector<double> path_distances(std::span<const Pose> poses) {
 
 double path_length(std::span<const Pose> poses) {
   double length = 0.0;
-  for (std::size_t i = 1; i < poses.size(); ++i)
-    length += (poses[i].translation() - poses[i - 1].translation()).norm();
+  for (std::size_t i = 1; i < poses.size(); ++i) length += (poses[i].translation() - poses[i - 1].translation()).norm();
   return length;
 }
 

@@ -65,9 +65,9 @@ void check_forward(const Trajectory& traj, double stamp, const fs::path& path, s
 void expect_fields(const std::vector<std::string_view>& fields, std::size_t count, bool at_least,
                    std::string_view layout, const fs::path& path, std::size_t line) {
   if (fields.size() == count || (at_least && fields.size() > count)) return;
-  throw InputError(at(path, line), "",
-                   fmt::format("expected {}{} fields ({}), found {}", at_least ? "at least " : "", count,
-                               layout, fields.size()));
+  throw InputError(
+      at(path, line), "",
+      fmt::format("expected {}{} fields ({}), found {}", at_least ? "at least " : "", count, layout, fields.size()));
 }
 
 void expect_poses(const Trajectory& traj, const fs::path& path) {
@@ -154,8 +154,8 @@ Trajectory read_kitti(const fs::path& path, const std::optional<fs::path>& times
     ++count;
   });
   if (count != traj.size())
-    throw InputError(times->string(), "", fmt::format("has {} times for {} poses in {}", count, traj.size(),
-                                                      path.string()));
+    throw InputError(times->string(), "",
+                     fmt::format("has {} times for {} poses in {}", count, traj.size(), path.string()));
   return traj;
 }
 
@@ -194,8 +194,8 @@ void write_tum(std::ostream& out, const Trajectory& trajectory) {
     const Pose& pose = trajectory.poses[i];
     const Eigen::Quaterniond q(pose.rotation());
     const Eigen::Vector3d& t = pose.translation();
-    out << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", trajectory.stamps[i], t.x(),
-                       t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    out << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", trajectory.stamps[i], t.x(), t.y(),
+                       t.z(), q.x(), q.y(), q.z(), q.w());
   }
 }
 

@@ -62,8 +62,7 @@ TEST(Ape, TranslationAndRotation) {
 
 TEST(RpePairs, FramesConsecutiveAndAll) {
   const std::vector<double> d(7, 0.0), t(7, 0.0);
-  EXPECT_EQ(rpe_pairs(d, t, {2, DeltaUnit::frames, false}),
-            (std::vector<IndexPair>{{0, 2}, {2, 4}, {4, 6}}));
+  EXPECT_EQ(rpe_pairs(d, t, {2, DeltaUnit::frames, false}), (std::vector<IndexPair>{{0, 2}, {2, 4}, {4, 6}}));
   EXPECT_EQ(rpe_pairs(d, t, {5, DeltaUnit::frames, true}), (std::vector<IndexPair>{{0, 5}, {1, 6}}));
 }
 

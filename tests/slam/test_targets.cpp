@@ -42,8 +42,11 @@ TEST(Targets, ScaleErrorUnderRigidAndSimilarityFits) {
 
 TEST(Targets, SimilarityFitRecoversKnownTransform) {
   // Map frame = survey frame turned 30 degrees about z, shifted, scaled by 0.8.
-  const std::vector<Target> truth{{"T1", {100, 200, 10}}, {"T2", {130, 210, 12}}, {"T3", {120, 250, 9}},
-                                  {"T4", {90, 240, 15}}, {"T5", {110, 225, 30}}};
+  const std::vector<Target> truth{{"T1", {100, 200, 10}},
+                                  {"T2", {130, 210, 12}},
+                                  {"T3", {120, 250, 9}},
+                                  {"T4", {90, 240, 15}},
+                                  {"T5", {110, 225, 30}}};
   const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d t(1000, -500, 50);
   const double s = 0.8;

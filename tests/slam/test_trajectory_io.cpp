@@ -90,8 +90,7 @@ TEST(ReadKitti, BadLinesAndTimesAreErrors) {
   EXPECT_NE(error_of([&] { read_kitti(poses.path(), backwards.path()); }).find(backwards.path().string() + ":2"),
             std::string::npos);
   const TempFile too_few("0.0\n");
-  EXPECT_NE(error_of([&] { read_kitti(poses.path(), too_few.path()); }).find("1 times for 2 poses"),
-            std::string::npos);
+  EXPECT_NE(error_of([&] { read_kitti(poses.path(), too_few.path()); }).find("1 times for 2 poses"), std::string::npos);
 }
 
 TEST(ReadEurocCsv, ReadsNanosecondStampsAndWFirstQuaternions) {

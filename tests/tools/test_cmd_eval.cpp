@@ -49,7 +49,8 @@ TEST(AditEval, RpePairsChosenAlongEstimateOrReference) {
   // The estimate is 10 % too long. 1.05 m of path is 11 reference steps
   // (1.1 m, error 0.11 m) but 10 estimate steps (1.0 m of reference, 0.1 m).
   const TempFile ref(tum_lines(0.0, 0.0)), est(tum_lines(0.0, 0.0, 1.1));
-  const std::string common = "traj --ref "s + q(ref) + " --est " + q(est) + " --align none --delta 1.05 --delta-unit m --json";
+  const std::string common =
+      "traj --ref "s + q(ref) + " --est " + q(est) + " --align none --delta 1.05 --delta-unit m --json";
   const EvalRun along_est = adit_eval(common);
   const EvalRun along_ref = adit_eval(common + " --pairs-on ref");
   ASSERT_EQ(along_est.status, 0) << along_est.output;
@@ -117,8 +118,8 @@ TEST(AditEval, TargetsJsonAndPlot) {
   const TempFile truth(kTruth, ".csv");
   const TempFile map("id,x,y,z\nA,0,0,0\nB,10,0,0\nC,0,10,0\nD,10,10,1.05\n", ".csv");
   const std::string svg = truth.path().string() + ".svg";
-  const EvalRun run = adit_eval("targets --truth "s + q(truth) + " --map " + q(map) + " --control A,B,C --json --svg '" +
-                            svg + "'");
+  const EvalRun run =
+      adit_eval("targets --truth "s + q(truth) + " --map " + q(map) + " --control A,B,C --json --svg '" + svg + "'");
   ASSERT_EQ(run.status, 0) << run.output;
   const auto j = nlohmann::json::parse(run.output);
   EXPECT_NEAR(j["absolute"]["points"][3]["dz"].get<double>(), -0.05, 1e-9);

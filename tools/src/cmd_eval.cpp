@@ -30,8 +30,7 @@ void add_traj(CLI::App& eval, int& status) {
   cmd->add_option("--offset", o->offset, "Seconds added to the estimate's stamps before association (default 0)");
   cmd->add_option("--align", o->align, "Alignment of the estimate: none, origin, se3, sim3 (default se3)")
       ->check(CLI::IsMember({"none", "origin", "se3", "sim3"}));
-  cmd->add_option("--delta", o->delta, "RPE step between the poses of a pair (default 1)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--delta", o->delta, "RPE step between the poses of a pair (default 1)")->check(CLI::PositiveNumber);
   cmd->add_option("--delta-unit", o->delta_unit, "RPE step unit: frames, m (path length) or s (default frames)")
       ->check(CLI::IsMember({"frames", "m", "s"}));
   cmd->add_flag("--all-pairs", o->all_pairs, "RPE from every pose instead of consecutive pairs");

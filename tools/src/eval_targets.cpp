@@ -34,8 +34,8 @@ std::vector<std::string> split_ids(const std::string& text) {
 }
 
 nlohmann::json point_json(const PointError& p) {
-  return {{"id", p.id},           {"control", p.control}, {"dx", p.delta.x()},
-          {"dy", p.delta.y()},    {"dz", p.delta.z()},    {"distance", p.distance}};
+  return {{"id", p.id},        {"control", p.control}, {"dx", p.delta.x()},
+          {"dy", p.delta.y()}, {"dz", p.delta.z()},    {"distance", p.distance}};
 }
 
 nlohmann::json report_json(const TargetsEvalOptions& o, const TargetReport& r) {
@@ -57,13 +57,14 @@ nlohmann::json report_json(const TargetsEvalOptions& o, const TargetReport& r) {
     rotation.push_back({r.fit.rotation(row, 0), r.fit.rotation(row, 1), r.fit.rotation(row, 2)});
   nlohmann::json points = nlohmann::json::array();
   for (const PointError& p : r.points) points.push_back(point_json(p));
-  j["absolute"] = {{"fit",
-                    {{"kind", o.scale ? "similarity" : "rigid"},
-                     {"rotation", rotation},
-                     {"translation", {r.fit.translation.x(), r.fit.translation.y(), r.fit.translation.z()}},
-                     {"scale", r.fit.scale}}},
-                   {"points", points},
-                   {"rmse", {{"x", r.rmse_xyz.x()}, {"y", r.rmse_xyz.y()}, {"z", r.rmse_xyz.z()}, {"distance", r.rmse_distance}}}};
+  j["absolute"] = {
+      {"fit",
+       {{"kind", o.scale ? "similarity" : "rigid"},
+        {"rotation", rotation},
+        {"translation", {r.fit.translation.x(), r.fit.translation.y(), r.fit.translation.z()}},
+        {"scale", r.fit.scale}}},
+      {"points", points},
+      {"rmse", {{"x", r.rmse_xyz.x()}, {"y", r.rmse_xyz.y()}, {"z", r.rmse_xyz.z()}, {"distance", r.rmse_distance}}}};
   nlohmann::json loo = nlohmann::json::array();
   for (const LeaveOneOut& l : r.leave_one_out)
     loo.push_back(l.error ? point_json(*l.error) : nlohmann::json{{"id", l.id}, {"distance", nullptr}});
@@ -78,8 +79,8 @@ void print_report(const TargetsEvalOptions& o, const TargetReport& r) {
   fmt::print("{:<10} {:<10} {:>12} {:>12} {:>10} {:>10}\n", "from", "to", "D_true (m)", "D_map (m)", "delta (m)",
              "rate (%)");
   for (const DistanceError& d : r.distances)
-    fmt::print("{:<10} {:<10} {:>12.4f} {:>12.4f} {:>10.4f} {:>10.4f}\n", d.from, d.to, d.true_distance,
-               d.map_distance, d.error, 100.0 * d.rate);
+    fmt::print("{:<10} {:<10} {:>12.4f} {:>12.4f} {:>10.4f} {:>10.4f}\n", d.from, d.to, d.true_distance, d.map_distance,
+               d.error, 100.0 * d.rate);
   fmt::print("{:<46} {:>10.4f} {:>10.4f}\n", "RMSE", r.distance_rmse, 100.0 * r.rate_rmse);
 
   fmt::print("\n(b) residuals true - fitted map after a {} fit on the control targets (*)\n",
@@ -91,8 +92,8 @@ void print_report(const TargetsEvalOptions& o, const TargetReport& r) {
   for (const PointError& p : r.points)
     fmt::print("{:<12} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f}\n", p.id + (p.control ? " *" : ""), p.delta.x(),
                p.delta.y(), p.delta.z(), p.distance);
-  fmt::print("{:<12} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f}\n", "RMSE", r.rmse_xyz.x(), r.rmse_xyz.y(),
-             r.rmse_xyz.z(), r.rmse_distance);
+  fmt::print("{:<12} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f}\n", "RMSE", r.rmse_xyz.x(), r.rmse_xyz.y(), r.rmse_xyz.z(),
+             r.rmse_distance);
 
   fmt::print("\n(c) each target left out of the fit\n");
   fmt::print("{:<12} {:>10} {:>10} {:>10} {:>10}\n", "target", "dX (m)", "dY (m)", "dZ (m)", "dist (m)");

@@ -58,8 +58,7 @@ std::array<int, 2> plan_axes(std::span<const Pose> poses) {
   return smallest == 0 ? std::array{1, 2} : smallest == 1 ? std::array{0, 2} : std::array{0, 1};
 }
 
-void write_plots(const std::string& prefix, const Associated& a, std::span<const Pose> aligned,
-                 const PoseErrors& ape) {
+void write_plots(const std::string& prefix, const Associated& a, std::span<const Pose> aligned, const PoseErrors& ape) {
   const auto [u, v] = plan_axes(a.ref);
   const char* axis = "xyz";
   Plot plan{"Trajectories, plan view", fmt::format("{} (m)", axis[u]), fmt::format("{} (m)", axis[v]), {}, {}, true};
@@ -99,7 +98,8 @@ struct TrajEvaluation {
 };
 
 TrajEvaluation evaluate(const TrajEvalOptions& o) {
-  TrajEvaluation e{load(o.ref, o.ref_format, o.ref_times), load(o.est, o.est_format, o.est_times), {}, {}, {}, {}, {}, 0, {}};
+  TrajEvaluation e{
+      load(o.ref, o.ref_format, o.ref_times), load(o.est, o.est_format, o.est_times), {}, {}, {}, {}, {}, 0, {}};
   const Trajectory& ref = e.ref.trajectory;
   const Trajectory& est = e.est.trajectory;
 
@@ -107,22 +107,24 @@ TrajEvaluation evaluate(const TrajEvalOptions& o) {
   const Associated& a = e.associated;
   if (a.pairs.size() < 2) {
     if (!(ref.timed && est.timed) && ref.size() != est.size())
-      throw InputError(o.est, "", fmt::format("{} poses against {} in the reference, and without times they can only "
-                                              "be matched one to one; give --ref-times/--est-times",
-                                              est.size(), ref.size()));
+      throw InputError(o.est, "",
+                       fmt::format("{} poses against {} in the reference, and without times they can only "
+                                   "be matched one to one; give --ref-times/--est-times",
+                                   est.size(), ref.size()));
     throw InputError(o.est, "",
                      fmt::format("{} pose(s) associate with the reference within {} s (need 2): reference spans "
                                  "{:.3f}..{:.3f} s, estimate {:.3f}..{:.3f} s; check --max-diff and --offset",
-                                 a.pairs.size(), o.max_diff, ref.stamps.front(), ref.stamps.back(),
-                                 est.stamps.front(), est.stamps.back()));
+                                 a.pairs.size(), o.max_diff, ref.stamps.front(), ref.stamps.back(), est.stamps.front(),
+                                 est.stamps.back()));
   }
 
   const auto fit = align_trajectory(a.ref, a.est, *parse_alignment(o.align));
   if (!fit)
-    throw InputError(o.est, "align",
-                     fmt::format("{} alignment is not determined: fewer than 3 associated positions or all on one line; "
-                                 "use --align origin or none",
-                                 o.align));
+    throw InputError(
+        o.est, "align",
+        fmt::format("{} alignment is not determined: fewer than 3 associated positions or all on one line; "
+                    "use --align origin or none",
+                    o.align));
   e.fit = *fit;
   e.aligned.reserve(a.est.size());
   for (const Pose& p : a.est) e.aligned.push_back(fit->apply(p));
@@ -139,9 +141,9 @@ TrajEvaluation evaluate(const TrajEvalOptions& o) {
   const std::span<const Pose> along = on_ref ? std::span<const Pose>(a.ref) : std::span<const Pose>(e.aligned);
   const auto pairs = rpe_pairs(path_distances(along), pair_stamps, settings);
   if (pairs.empty())
-    throw InputError("", "delta",
-                     fmt::format("delta = {} {} gives no RPE pair on this trajectory; use a smaller delta", o.delta,
-                                 o.delta_unit));
+    throw InputError(
+        "", "delta",
+        fmt::format("delta = {} {} gives no RPE pair on this trajectory; use a smaller delta", o.delta, o.delta_unit));
   e.rpe = relative_pose_errors(a.ref, e.aligned, pairs);
   e.rpe_pairs = pairs.size();
   e.kitti = kitti_drift(a.ref, e.aligned);

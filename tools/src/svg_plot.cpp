@@ -111,13 +111,14 @@ std::string render_svg(const Plot& plot) {
   for (const double y : ticks(yr.lo, yr.hi, ystep)) {
     svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#e0e0e0\"/>\n", left,
                        py(y), left + pw, py(y));
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{}</text>\n", left - 6, py(y) + 4,
-                       number(y));
+    svg +=
+        fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{}</text>\n", left - 6, py(y) + 4, number(y));
   }
   if (bars) {
     for (std::size_t k = 0; k < plot.categories.size(); ++k)
       svg += fmt::format(
-          "<text x=\"{0:.1f}\" y=\"{1:.1f}\" text-anchor=\"end\" transform=\"rotate(-45 {0:.1f} {1:.1f})\">{2}</text>\n",
+          "<text x=\"{0:.1f}\" y=\"{1:.1f}\" text-anchor=\"end\" transform=\"rotate(-45 {0:.1f} "
+          "{1:.1f})\">{2}</text>\n",
           px(static_cast<double>(k)) + 4, top + ph + 16, escape(plot.categories[k]));
   } else {
     const double xstep = nice_step(xr.span(), 8);
@@ -135,12 +136,15 @@ std::string render_svg(const Plot& plot) {
                        left + pw, py(0));
   svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{}</text>\n", left + pw / 2,
                      plot.height - 12.0, escape(plot.x_label));
-  svg += fmt::format("<text x=\"18\" y=\"{0:.1f}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {0:.1f})\">{1}</text>\n",
-                     top + ph / 2, escape(plot.y_label));
+  svg += fmt::format(
+      "<text x=\"18\" y=\"{0:.1f}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {0:.1f})\">{1}</text>\n",
+      top + ph / 2, escape(plot.y_label));
 
   // Data, clipped to the plot area.
-  svg += fmt::format("<clipPath id=\"area\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g clip-path=\"url(#area)\">\n",
-                     left, top, pw, ph);
+  svg += fmt::format(
+      "<clipPath id=\"area\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g "
+      "clip-path=\"url(#area)\">\n",
+      left, top, pw, ph);
   std::size_t bar_series = 0;
   const auto bar_count = static_cast<std::size_t>(std::count_if(
       plot.series.begin(), plot.series.end(), [](const PlotSeries& s) { return s.style == SeriesStyle::bars; }));
@@ -148,20 +152,23 @@ std::string render_svg(const Plot& plot) {
     if (s.style == SeriesStyle::line) {
       std::string points;
       for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
-        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) points += fmt::format("{:.1f},{:.1f} ", px(s.x[i]), py(s.y[i]));
-      svg += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linejoin=\"round\" points=\"{}\"/>\n",
-                         s.color, s.stroke_width, points);
+        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))
+          points += fmt::format("{:.1f},{:.1f} ", px(s.x[i]), py(s.y[i]));
+      svg += fmt::format(
+          "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linejoin=\"round\" points=\"{}\"/>\n",
+          s.color, s.stroke_width, points);
     } else if (s.style == SeriesStyle::points) {
       for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
-        svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"{}\"/>\n", px(s.x[i]), py(s.y[i]), s.color);
+        svg +=
+            fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"{}\"/>\n", px(s.x[i]), py(s.y[i]), s.color);
     } else {
       const double group = 0.8 / static_cast<double>(bar_count);
       for (std::size_t k = 0; k < s.y.size(); ++k) {
         if (!std::isfinite(s.y[k])) continue;
         const double x0 = static_cast<double>(k) - 0.4 + group * static_cast<double>(bar_series);
         const double y0 = py(std::max(0.0, s.y[k])), y1 = py(std::min(0.0, s.y[k]));
-        svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\"/>\n", px(x0), y0,
-                           px(x0 + group) - px(x0), y1 - y0, s.color);
+        svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\"/>\n", px(x0),
+                           y0, px(x0 + group) - px(x0), y1 - y0, s.color);
       }
       ++bar_series;
     }
@@ -173,7 +180,8 @@ std::string render_svg(const Plot& plot) {
   for (auto it = plot.series.rbegin(); it != plot.series.rend(); ++it) {
     if (it->label.empty()) continue;
     lx -= 30.0 + 7.5 * static_cast<double>(it->label.size());
-    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"10\" fill=\"{}\"/>\n", lx, top - 19, it->color);
+    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"14\" height=\"10\" fill=\"{}\"/>\n", lx, top - 19,
+                       it->color);
     svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", lx + 19, top - 9, escape(it->label));
   }
   svg += "</svg>\n";

@@ -40,7 +40,6 @@ std::string_view alignment_name(Alignment alignment);
 // The transform taking `est` onto `ref` (matched pose by pose): identity for
 // none; ref[0] * est[0]^-1 for origin; Umeyama on the positions for se3/sim3.
 // nullopt when se3/sim3 positions are degenerate (see umeyama_fit()).
-std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<const Pose> est,
-                                           Alignment alignment);
+std::optional<Similarity> align_trajectory(std::span<const Pose> ref, std::span<const Pose> est, Alignment alignment);
 
 }  // namespace adit::slam

@@ -15,6 +15,7 @@ struct EndpointDrift {
   Eigen::Vector3d true_delta = Eigen::Vector3d::Zero();       // measured end - start
   Eigen::Vector3d estimated_delta = Eigen::Vector3d::Zero();  // p_last - p_first
   Eigen::Vector3d error = Eigen::Vector3d::Zero();            // true - estimated
+
   double drift = 0.0;   // |true - estimated|, metres
   double length = 0.0;  // path length L, metres
   double rate = 0.0;    // drift / L (0 when L = 0)

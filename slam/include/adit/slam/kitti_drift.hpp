@@ -27,8 +27,8 @@ struct KittiLengthDrift {
 
 struct KittiDrift {
   std::size_t segments = 0;
-  double translation_percent = 0.0;     // mean over segments of 100 |trans(E)| / L
-  double rotation_deg_per_100m = 0.0;   // mean over segments of 100 angle(E) / L, degrees
+  double translation_percent = 0.0;    // mean over segments of 100 |trans(E)| / L
+  double rotation_deg_per_100m = 0.0;  // mean over segments of 100 angle(E) / L, degrees
   std::array<KittiLengthDrift, kKittiLengths.size()> by_length{};
 };
 

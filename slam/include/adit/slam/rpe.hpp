@@ -48,7 +48,6 @@ std::vector<IndexPair> rpe_pairs(std::span<const double> distances, std::span<co
 // baseline the benchmark compares against.
 std::vector<IndexPair> rpe_pairs_all_naive(std::span<const double> values, double delta, double tolerance);
 
-PoseErrors relative_pose_errors(std::span<const Pose> ref, std::span<const Pose> est,
-                                std::span<const IndexPair> pairs);
+PoseErrors relative_pose_errors(std::span<const Pose> ref, std::span<const Pose> est, std::span<const IndexPair> pairs);
 
 }  // namespace adit::slam
