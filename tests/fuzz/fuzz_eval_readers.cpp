@@ -1,0 +1,34 @@
+// Fuzzes the text readers `adit eval` trusts with user files: TUM, KITTI,
+// EuRoC CSV and target CSV. Bad input must end in adit::InputError, nothing
+// else (no crash, no other exception, no sanitizer report).
+
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <string>
+
+#include "adit/common/error.hpp"
+#include "adit/slam/targets_io.hpp"
+#include "adit/slam/trajectory_io.hpp"
+
+namespace {
+
+template <typename Read>
+void expect_only_input_errors(const std::string& text, Read&& read) {
+  std::istringstream in(text);
+  try {
+    read(in);
+  } catch (const adit::InputError&) {
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_tum(in, "fuzz.txt"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_kitti(in, "fuzz.txt"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_euroc_csv(in, "fuzz.csv"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_targets_csv(in, "fuzz.csv"); });
+  return 0;
+}

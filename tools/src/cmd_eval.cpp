@@ -1,0 +1,97 @@
+// adit eval traj|endpoint|targets: accuracy numbers from trajectories and
+// total-station targets (docs/EVALUATION.md defines every metric).
+
+#include <memory>
+
+#include "adit/common/error.hpp"
+#include "commands.hpp"
+#include "eval_commands.hpp"
+
+namespace adit::tools {
+namespace {
+
+const std::vector<std::string> kFormats{"auto", "tum", "kitti", "euroc"};
+
+void add_traj(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("traj", "Compare an estimated trajectory with a reference: APE, RPE, KITTI drift");
+  auto o = std::make_shared<TrajEvalOptions>();
+  cmd->add_option("--ref", o->ref, "Reference (ground-truth) trajectory file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--est", o->est, "Estimated trajectory file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--ref-format", o->ref_format, "Reference format: auto, tum, kitti, euroc (default auto)")
+      ->check(CLI::IsMember(kFormats));
+  cmd->add_option("--est-format", o->est_format, "Estimate format: auto, tum, kitti, euroc (default auto)")
+      ->check(CLI::IsMember(kFormats));
+  cmd->add_option("--ref-times", o->ref_times, "Times file (s, one per line) for a KITTI reference")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--est-times", o->est_times, "Times file (s, one per line) for a KITTI estimate")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--max-diff", o->max_diff, "Largest time difference (s) of an associated pair (default 0.01)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--offset", o->offset, "Seconds added to the estimate's stamps before association (default 0)");
+  cmd->add_option("--align", o->align, "Alignment of the estimate: none, origin, se3, sim3 (default se3)")
+      ->check(CLI::IsMember({"none", "origin", "se3", "sim3"}));
+  cmd->add_option("--delta", o->delta, "RPE step between the poses of a pair (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--delta-unit", o->delta_unit, "RPE step unit: frames, m (path length) or s (default frames)")
+      ->check(CLI::IsMember({"frames", "m", "s"}));
+  cmd->add_flag("--all-pairs", o->all_pairs, "RPE from every pose instead of consecutive pairs");
+  cmd->add_option("--pairs-on", o->pairs_on,
+                  "Trajectory whose path length and stamps choose the RPE pairs: est (as evo) or ref (default est)")
+      ->check(CLI::IsMember({"est", "ref"}));
+  cmd->add_flag("--json", o->json, "Print JSON instead of tables");
+  cmd->add_option("--svg", o->svg_prefix,
+                  "Write plots PREFIX-plan.svg (trajectories overlaid) and PREFIX-ape.svg (error along the path)");
+  cmd->add_option("--save-aligned", o->save_aligned, "Write the associated, aligned estimate as a TUM file");
+  cmd->callback([o, &status] {
+    run_eval_traj(*o);
+    status = kExitOk;
+  });
+}
+
+void add_endpoint(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand(
+      "endpoint", "End-to-end drift of a run that returns near its start, against a total-station delta");
+  auto o = std::make_shared<EndpointEvalOptions>();
+  cmd->add_option("--est", o->est, "Estimated trajectory file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--format", o->format, "Trajectory format: auto, tum, kitti, euroc (default auto)")
+      ->check(CLI::IsMember(kFormats));
+  cmd->add_option("--times", o->times, "Times file for a KITTI trajectory")->check(CLI::ExistingFile);
+  cmd->add_option("--true-delta", o->true_delta,
+                  "Start-to-end difference measured by total station, DX,DY,DZ in metres (trajectory frame)")
+      ->required();
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_endpoint(*o);
+    status = kExitOk;
+  });
+}
+
+void add_targets(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("targets", "Check map targets against total-station targets (CSV id,x,y,z)");
+  auto o = std::make_shared<TargetsEvalOptions>();
+  cmd->add_option("--truth", o->truth, "Targets surveyed by total station: CSV id,x,y,z in metres")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--map", o->map, "The same targets picked in the map: CSV id,x,y,z in metres")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--control", o->control, "Comma-separated ids the fit uses (at least 3; default all)");
+  cmd->add_flag("--scale", o->scale, "Fit a similarity (with scale) instead of a rigid transform");
+  cmd->add_flag("--json", o->json, "Print JSON instead of tables");
+  cmd->add_option("--svg", o->svg, "Write a bar chart of the target errors to this SVG file");
+  cmd->callback([o, &status] {
+    run_eval_targets(*o);
+    status = kExitOk;
+  });
+}
+
+}  // namespace
+
+void register_eval_commands(CLI::App& app, int& status) {
+  auto* eval = app.add_subcommand("eval", "Accuracy evaluation: trajectories, end-to-end drift, survey targets");
+  eval->require_subcommand(1);
+  add_traj(*eval, status);
+  add_endpoint(*eval, status);
+  add_targets(*eval, status);
+}
+
+}  // namespace adit::tools

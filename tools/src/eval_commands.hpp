@@ -1,0 +1,55 @@
+#pragma once
+// The three `adit eval` subcommands: their options and what runs them. Each
+// runner prints a table (or JSON with --json) on stdout, writes the plots it
+// was asked for, and throws adit::InputError on bad input (exit status 2).
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "adit/slam/stats.hpp"
+
+namespace adit::tools {
+
+struct TrajEvalOptions {
+  std::string ref, est;
+  std::string ref_format = "auto", est_format = "auto";
+  std::string ref_times, est_times;
+  double max_diff = 0.01;
+  double offset = 0.0;
+  std::string align = "se3";
+  double delta = 1.0;
+  std::string delta_unit = "frames";
+  bool all_pairs = false;
+  std::string pairs_on = "est";  // whose path/stamps choose the RPE pairs
+  bool json = false;
+  std::string svg_prefix;
+  std::string save_aligned;
+};
+
+struct EndpointEvalOptions {
+  std::string est;
+  std::string format = "auto";
+  std::string times;
+  std::string true_delta;
+  bool json = false;
+};
+
+struct TargetsEvalOptions {
+  std::string truth, map;
+  std::string control;
+  bool scale = false;
+  bool json = false;
+  std::string svg;
+};
+
+void run_eval_traj(const TrajEvalOptions& options);
+void run_eval_endpoint(const EndpointEvalOptions& options);
+void run_eval_targets(const TargetsEvalOptions& options);
+
+// Shared by the runners.
+nlohmann::json stats_json(const slam::Stats& stats);
+std::string stats_row(const std::string& name, const slam::Stats& stats);
+std::string stats_header();
+
+}  // namespace adit::tools
