@@ -1,5 +1,5 @@
 // libFuzzer: any bytes into every Hesai model's decoder. Seeds: the captures'
-// payloads (extract with tests/fuzz/seed_from_pcap.sh or pass the .pcap directory).
+// UDP payloads (fuzz_hesai_decoder.seeds).
 #include <cstddef>
 #include <cstdint>
 #include <memory>

@@ -1,6 +1,6 @@
 // PcapReader on arbitrary files: it either refuses the file with
 // adit::InputError or reads it to the end, counting what it skips.
-// Seeds: ../shared/data/lidar/*/*.pcap (cut to their first few kB).
+// Seeds: real captures (fuzz_pcap_reader.seeds).
 #include <sys/mman.h>
 #include <unistd.h>
 

@@ -1,6 +1,6 @@
-// Velodyne decoder + scan assembly on arbitrary payloads. The first byte picks
-// the model and azimuth model; the rest is one packet. Seeds: payloads of the
-// real captures (split with tests/fuzz/seed_velodyne.sh).
+// Velodyne decoder + scan assembly on arbitrary payloads: each input is one
+// packet, decoded by every model and azimuth model. Seeds: the UDP payloads of
+// the real captures (fuzz_velodyne_decoder.seeds).
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -44,14 +44,14 @@ struct Fixture {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static Fixture fixture;
-  if (size == 0) return 0;
-  VelodyneDecoder& decoder = fixture.decoders[data[0] % 8];
-  const std::span<const std::uint8_t> payload(data + 1, size - 1);
-  const DecodedPacket packet = decoder.decode(payload, 1'700'000'000'000'000'000);
-  for (const DecodedPoint& p : packet.points) {
-    // Every decoded value must be finite and the azimuth in range.
-    if (!(p.azimuth_deg >= 0.0F && p.azimuth_deg < 360.0F) || !(p.point.range_m == p.point.range_m)) __builtin_trap();
+  const std::span<const std::uint8_t> payload(data, size);
+  for (VelodyneDecoder& decoder : fixture.decoders) {
+    const DecodedPacket packet = decoder.decode(payload, 1'700'000'000'000'000'000);
+    for (const DecodedPoint& p : packet.points) {
+      // Every decoded value must be finite and the azimuth in range.
+      if (!(p.azimuth_deg >= 0.0F && p.azimuth_deg < 360.0F) || !(p.point.range_m == p.point.range_m)) __builtin_trap();
+    }
+    fixture.assembler.add(packet);
   }
-  fixture.assembler.add(packet);
   return 0;
 }
