@@ -14,6 +14,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/main.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
+#include "adit/drivers/lidar/ouster_digest.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/drivers/pcap_reader.hpp"
@@ -226,15 +227,28 @@ void register_lidar_commands(CLI::App& app, int& status) {
     DecodeOptions options;
     std::string out_dir;
     std::string format = "pcd";
+    bool ouster_digest = false;
   };
   auto decode_command = std::make_shared<DecodeCommand>();
   CLI::App* dec = app.add_subcommand("decode", "Decode a LiDAR capture into one point-cloud file per scan");
   add_decode_options(dec, decode_command->options);
-  dec->add_option("--out", decode_command->out_dir, "Directory for the scan files (created)")->required();
+  dec->add_option("--out", decode_command->out_dir, "Directory for the scan files (created; required unless --ouster-digest)");
   dec->add_option("--format", decode_command->format, "pcd or ply (binary, every point field; default pcd)")
       ->check(CLI::IsMember({"pcd", "ply"}));
+  dec->add_flag("--ouster-digest", decode_command->ouster_digest,
+                "Ouster: print MD5 digests of every decoded field as JSON, in the layout of the Ouster SDK's "
+                "*_digest.json files (needs --calibration METADATA.json)");
   dec->callback([&status, decode_command] {
-    status = decode(decode_command->options, decode_command->out_dir, decode_command->format);
+    const DecodeCommand& c = *decode_command;
+    if (c.ouster_digest) {
+      if (c.options.calibration.empty())
+        throw InputError(c.options.file, "--calibration", "--ouster-digest needs the sensor metadata JSON");
+      fmt::print("{}\n", drivers::ouster_digest_json(c.options.file, c.options.calibration));
+      status = kExitOk;
+      return;
+    }
+    if (c.out_dir.empty()) throw InputError(c.options.file, "--out", "a directory for the scan files is required");
+    status = decode(c.options, c.out_dir, c.format);
   });
 
   struct SendCommand {

@@ -44,6 +44,7 @@ ScanAssemblerConfig assembler_config_for(const LidarDecoder& decoder, std::int64
   ScanAssemblerConfig config;
   config.cut_azimuth_deg = cut_azimuth_deg;
   config.packet_period_ns = packet_period_ns;
+  config.sequence_modulus = decoder.sequence_modulus();
   const std::int64_t packets = packet_period_ns > 0 ? max_scan_ns / packet_period_ns + 2 : 4096;
   config.max_points_per_scan = static_cast<std::size_t>(packets) * decoder.max_points_per_packet();
   return config;

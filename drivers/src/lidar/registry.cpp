@@ -10,6 +10,7 @@ std::span<const LidarFamily> lidar_families() {
       velodyne_family(),
       hesai_family(),
       robosense_family(),
+      ouster_family(),  // last: it recognises packets by port only
   };
   return kFamilies;
 }

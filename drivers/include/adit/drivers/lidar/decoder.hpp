@@ -55,6 +55,8 @@ class LidarDecoder {
   // The UDP destination port of data packets, by default.
   virtual std::uint16_t default_port() const = 0;
   virtual std::size_t max_points_per_packet() const = 0;
+  // Where DecodedPacket::sequence wraps (for the ScanAssembler's loss counting).
+  virtual std::uint64_t sequence_modulus() const { return std::uint64_t{1} << 32; }
   // host_time_ns (CLOCK_REALTIME) resolves sensor clocks that are ambiguous
   // on their own, like Velodyne's microseconds past the top of the hour.
   virtual DecodedPacket decode(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) = 0;

@@ -53,8 +53,8 @@ class OusterDecoder final : public LidarDecoder {
   const OusterImuSample& last_imu() const { return imu_; }
   const OusterDecoderCounters& counters() const { return counters_; }
   const OusterPacketLayout& layout() const { return layout_; }
-  // For ScanAssemblerConfig::sequence_modulus.
-  std::uint64_t sequence_modulus() const { return std::uint64_t{65536} * packets_per_frame_; }
+  // frame_id (16 bits) × packets per frame.
+  std::uint64_t sequence_modulus() const override { return std::uint64_t{65536} * packets_per_frame_; }
   std::uint32_t packets_per_frame() const { return packets_per_frame_; }
   // Time between lidar packets (0 when the frame rate is unknown).
   std::int64_t packet_period_ns() const { return packet_period_ns_; }

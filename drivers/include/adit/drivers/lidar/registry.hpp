@@ -39,5 +39,6 @@ const LidarFamily* find_lidar_family(std::string_view name);
 LidarFamily velodyne_family();
 LidarFamily hesai_family();
 LidarFamily robosense_family();
+LidarFamily ouster_family();
 
 }  // namespace adit::drivers
