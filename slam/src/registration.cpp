@@ -60,8 +60,8 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
       accumulate_plane(ne, qd, n, n.dot(qd - plane->mean.cast<double>()), kappa2);
       continue;
     }
-    const MapNeighbor nb = map.nearest(q);
-    if (!nb.found || nb.distance_sq > max_d2) continue;
+    const MapNeighbor nb = map.nearest(q, static_cast<float>(max_distance_m));
+    if (!nb.found) continue;
     if (!nb.normal.isZero()) {
       // The query's own voxel is not flat (or is empty) but its nearest
       // neighbour's is: point-to-plane through that neighbour.

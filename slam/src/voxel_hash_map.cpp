@@ -82,28 +82,39 @@ void VoxelHashMap::refit_plane(Voxel& voxel) {
                                                                     : Eigen::Vector3f::Zero();
 }
 
-MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query) const {
+MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distance_m) const {
   MapNeighbor best;
-  best.distance_sq = std::numeric_limits<float>::max();
+  best.distance_sq = max_distance_m * max_distance_m;
   const VoxelKey center = key_of(query);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const Voxel* v = find({center.x + dx, center.y + dy, center.z + dz});
-        if (v == nullptr) continue;
-        for (int i = 0; i < v->count; ++i) {
-          const Eigen::Vector3f& p = v->points[static_cast<std::size_t>(i)];
-          const float d = (p - query).squaredNorm();
-          if (d < best.distance_sq) {
-            best.distance_sq = d;
-            best.point = p;
-            best.normal = v->plane.normal;
-            best.found = true;
-          }
-        }
+  // The query's offset inside its voxel, per axis: the squared distance to a
+  // neighbour voxel's box is the sum of the gaps on the axes where it differs.
+  // Neighbours whose box is already farther than the best match are skipped,
+  // the own voxel first, so most queries look at one or a few voxels.
+  const Eigen::Vector3f low = query - Eigen::Vector3f(static_cast<float>(center.x), static_cast<float>(center.y),
+                                                      static_cast<float>(center.z)) * voxel_size_;
+  const Eigen::Vector3f high = Eigen::Vector3f::Constant(voxel_size_) - low;
+  const auto gap2 = [&](int d, int axis) { return d < 0 ? low[axis] * low[axis] : d > 0 ? high[axis] * high[axis] : 0.0F; };
+  const auto search = [&](int dx, int dy, int dz) {
+    if (gap2(dx, 0) + gap2(dy, 1) + gap2(dz, 2) >= best.distance_sq) return;
+    const Voxel* v = find({center.x + dx, center.y + dy, center.z + dz});
+    if (v == nullptr) return;
+    for (int i = 0; i < v->count; ++i) {
+      const Eigen::Vector3f& p = v->points[static_cast<std::size_t>(i)];
+      const float d = (p - query).squaredNorm();
+      if (d < best.distance_sq) {
+        best.distance_sq = d;
+        best.point = p;
+        best.normal = v->plane.normal;
+        best.found = true;
       }
     }
-  }
+  };
+  search(0, 0, 0);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz)
+        if (dx != 0 || dy != 0 || dz != 0) search(dx, dy, dz);
+  if (!best.found) best.distance_sq = 0.0F;
   return best;
 }
 

@@ -29,4 +29,14 @@ const LidarFamily* find_lidar_family(std::string_view name) {
   return nullptr;
 }
 
+const LidarFamily* lidar_family_of_model(std::string_view model) {
+  // Model names are the makers' own, and their prefixes do not overlap.
+  static constexpr std::pair<std::string_view, std::string_view> kPrefixes[] = {
+      {"VLP-", "velodyne"}, {"HDL-", "velodyne"}, {"VLS-", "velodyne"}, {"Pandar", "hesai"},
+      {"RS-", "robosense"}, {"Helios", "robosense"}, {"OS", "ouster"}};
+  for (const auto& [prefix, family] : kPrefixes)
+    if (model.starts_with(prefix)) return find_lidar_family(family);
+  return nullptr;
+}
+
 }  // namespace adit::drivers

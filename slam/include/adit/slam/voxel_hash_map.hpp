@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -50,8 +51,10 @@ class VoxelHashMap {
   // Removes every voxel whose first point is farther than max_distance_m from origin.
   void remove_far(const Eigen::Vector3f& origin, float max_distance_m);
 
-  // The nearest point among the 27 voxels around `query`.
-  MapNeighbor nearest(const Eigen::Vector3f& query) const;
+  // The nearest point among the 27 voxels around `query` closer than
+  // max_distance_m (found == false when there is none).
+  MapNeighbor nearest(const Eigen::Vector3f& query,
+                      float max_distance_m = std::numeric_limits<float>::infinity()) const;
 
   // The plane of the voxel containing `query`, when that voxel is flat: an
   // O(1) correspondence for point-to-plane registration; nullptr otherwise.

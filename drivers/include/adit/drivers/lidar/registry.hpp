@@ -34,6 +34,8 @@ std::span<const LidarFamily> lidar_families();
 // The first family that recognises the packet; family == nullptr when none does.
 DetectedLidar detect_lidar(std::span<const std::uint8_t> payload, std::uint16_t dst_port);
 const LidarFamily* find_lidar_family(std::string_view name);
+// The family of a configured model name (VLP-16, PandarXT32, Helios16P, OS1-64, ...), nullptr when unknown.
+const LidarFamily* lidar_family_of_model(std::string_view model);
 
 // Each family's entry, defined beside its decoder.
 LidarFamily velodyne_family();

@@ -1,0 +1,383 @@
+#include "adit/daemon/pipeline.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/daemon/handoff.hpp"
+#include "adit/daemon/thread_settings.hpp"
+#include "adit/drivers/lidar/decode_stream.hpp"
+#include "adit/drivers/lidar/registry.hpp"
+#include "adit/drivers/lidar/scan_directory.hpp"
+#include "adit/drivers/pcap_replay.hpp"
+#include "adit/drivers/udp.hpp"
+
+namespace adit::daemon {
+namespace {
+
+constexpr std::size_t kMaxDatagram = 65'536;
+constexpr std::size_t kPacketSlots = 512;   // ~0.4 s of the busiest sensor (Ouster, 1280 packets/s)
+constexpr std::size_t kScanSlots = 4;
+constexpr std::size_t kPoseSlots = 8;
+constexpr std::size_t kTimingCapacity = 1 << 20;  // scans kept for statistics (29 h at 10 Hz)
+
+struct Packet {
+  std::int64_t host_time_ns = 0;     // capture or kernel time (the sensor clock's reference)
+  std::int64_t received_mono_ns = 0; // when the receiver handed it on (latency)
+  std::uint32_t size = 0;
+  std::array<std::uint8_t, kMaxDatagram> data{};
+};
+
+struct ScanSlot {
+  drivers::LidarScan scan;
+  std::int64_t last_packet_mono_ns = 0;
+};
+
+struct PoseSlot {
+  slam::OdometryResult result;
+  std::int64_t last_packet_mono_ns = 0;
+  std::int64_t pose_mono_ns = 0;
+};
+
+// The sensor's pose in the body frame, from the configuration.
+Eigen::Isometry3f extrinsic_of(const config::Transform& t) {
+  constexpr float kDeg = static_cast<float>(M_PI / 180.0);
+  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
+  T.linear() = (Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[2]) * kDeg, Eigen::Vector3f::UnitZ()) *
+                Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[1]) * kDeg, Eigen::Vector3f::UnitY()) *
+                Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[0]) * kDeg, Eigen::Vector3f::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t.xyz_m[0], t.xyz_m[1], t.xyz_m[2]).cast<float>();
+  return T;
+}
+
+void wait_a_little() { std::this_thread::sleep_for(std::chrono::microseconds(200)); }
+
+}  // namespace
+
+struct Pipeline::Impl {
+  Impl(const config::Config& c, const PipelineOptions& o)
+      : config(c),
+        options(o),
+        overflow(c.lidar.source == config::LidarSource::udp ? Overflow::drop_oldest : Overflow::wait),
+        packets(kPacketSlots, overflow, [] { return Packet{}; }),
+        extrinsic(extrinsic_of(c.lidar.extrinsics)) {
+    options.odometry.min_range_m = static_cast<float>(c.lidar.min_range_m);
+    options.odometry.max_range_m = static_cast<float>(c.lidar.max_range_m);
+    const double speed = options.replay_speed >= 0.0 ? options.replay_speed : c.lidar.replay_speed;
+
+    if (c.lidar.source == config::LidarSource::scan_dir) {
+      scan_directory.emplace(c.lidar.scan_dir);
+    } else {
+      if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);
+      const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
+      if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
+      try {
+        decoder = family->make_decoder(c.lidar.model, c.lidar.calibration);
+      } catch (const InputError& e) {
+        // The family speaks of its own inputs; name the configuration key.
+        throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
+      }
+      data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
+      if (c.lidar.source == config::LidarSource::udp) {
+        drivers::UdpReceiverConfig udp_config;
+        udp_config.bind_address = c.lidar.address;
+        udp_config.port = data_port;
+        udp_config.interface = c.lidar.interface;
+        udp_config.multicast_group = c.lidar.multicast_group;
+        udp_config.receive_buffer_bytes = c.lidar.receive_buffer_bytes;
+        udp.emplace(udp_config);
+      }
+      // The packet period is learnt from the first packet by the family; 0 = by sequence only.
+      assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
+      stream.emplace(*decoder, *assembler, [this](drivers::LidarScan& scan) { hand_on(scan); });
+    }
+    const std::size_t max_points =
+        assembler ? assembler->config().max_points_per_scan : options.odometry.max_scan_points;
+    options.odometry.max_scan_points = std::max(options.odometry.max_scan_points, max_points);
+    scans.emplace(kScanSlots, overflow, [max_points] {
+      ScanSlot slot;
+      slot.scan.points.reserve(max_points);
+      return slot;
+    });
+    odometry.emplace(options.odometry);
+    body_points.reserve(options.odometry.max_scan_points);
+    body_times.reserve(options.odometry.max_scan_points);
+    timings.odometry_ms.reserve(kTimingCapacity);
+    timings.latency_ms.reserve(kTimingCapacity);
+    if (!options.trajectory_file.empty()) {
+      std::filesystem::create_directories(options.trajectory_file.parent_path());
+      trajectory.reset(std::fopen(options.trajectory_file.c_str(), "w"));
+      if (!trajectory) throw InputError(options.trajectory_file.string(), "", "cannot write the trajectory");
+    }
+  }
+
+  // Assembly thread: a finished scan goes to odometry (swapped, not copied).
+  void hand_on(drivers::LidarScan& scan) {
+    stats.scans.fetch_add(1, std::memory_order_relaxed);
+    if (!scan.stats.complete) stats.incomplete_scans.fetch_add(1, std::memory_order_relaxed);
+    ScanSlot* slot = nullptr;
+    while ((slot = scans->acquire()) == nullptr && !stop.load(std::memory_order_relaxed)) {
+      assembly_beat.beat();
+      wait_a_little();
+    }
+    if (slot == nullptr) return;
+    std::swap(slot->scan, scan);
+    slot->last_packet_mono_ns = current_packet_mono_ns;
+    scans->publish(slot);
+  }
+
+  void receiver_loop() {
+    settle_thread("adit-receiver", config.threads.receiver);
+    if (scan_directory) return scan_directory_loop();
+    const auto push = [this](std::span<const std::uint8_t> payload, std::int64_t time_ns) {
+      Packet* packet = nullptr;
+      while ((packet = packets.acquire()) == nullptr) {  // replay: wait for assembly
+        if (stop.load(std::memory_order_relaxed)) return;
+        receiver_beat.beat();
+        wait_a_little();
+      }
+      packet->host_time_ns = time_ns;
+      packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
+      std::memcpy(packet->data.data(), payload.data(), packet->size);
+      packet->received_mono_ns = monotonic_ns();
+      packets.publish(packet);
+    };
+    if (pcap) {
+      drivers::UdpDatagram d;
+      while (!stop.load(std::memory_order_relaxed) && pcap->next(d)) {
+        receiver_beat.beat();
+        stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+        if (d.dst_port != data_port) {
+          stats.foreign_datagrams.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
+        push(d.payload, d.capture_time_ns);
+      }
+    } else {
+      while (!stop.load(std::memory_order_relaxed)) {
+        receiver_beat.beat();
+        for (const drivers::ReceivedDatagram& d : udp->receive(100)) {
+          stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+          push(d.payload, d.kernel_time_ns);
+        }
+      }
+    }
+    source_done.store(true, std::memory_order_release);
+    receiver_beat.finished.store(true);
+  }
+
+  void scan_directory_loop() {
+    drivers::LidarScan scan;
+    scan.points.reserve(options.odometry.max_scan_points);
+    while (!stop.load(std::memory_order_relaxed) && scan_directory->next(scan)) {
+      receiver_beat.beat();
+      current_packet_mono_ns = monotonic_ns();
+      hand_on(scan);
+    }
+    source_done.store(true, std::memory_order_release);
+    assembly_done.store(true, std::memory_order_release);
+    receiver_beat.finished.store(true);
+    assembly_beat.finished.store(true);
+  }
+
+  void assembly_loop() {
+    settle_thread("adit-assembly", config.threads.receiver);
+    if (scan_directory) return;
+    while (!stop.load(std::memory_order_relaxed)) {
+      assembly_beat.beat();
+      Packet* packet = packets.take();
+      if (packet == nullptr) {
+        if (source_done.load(std::memory_order_acquire) && packets.depth() == 0) break;
+        wait_a_little();
+        continue;
+      }
+      current_packet_mono_ns = packet->received_mono_ns;
+      stream->push(std::span<const std::uint8_t>(packet->data.data(), packet->size), packet->host_time_ns);
+      packets.release(packet);
+    }
+    if (!stop.load()) stream->finish();
+    stats.bad_packets.store(stream->bad_packets());
+    stats.dropped_packets.store(packets.dropped());
+    assembly_done.store(true, std::memory_order_release);
+    assembly_beat.finished.store(true);
+  }
+
+  void odometry_loop() {
+    settle_thread("adit-odometry", config.threads.odometry);
+    while (!stop.load(std::memory_order_relaxed)) {
+      odometry_beat.beat();
+      ScanSlot* slot = scans->take();
+      if (slot == nullptr) {
+        if (assembly_done.load(std::memory_order_acquire) && scans->depth() == 0) break;
+        wait_a_little();
+        continue;
+      }
+      // Sensor frame → body frame, and firing offsets in seconds.
+      body_points.clear();
+      body_times.clear();
+      for (const drivers::LidarPoint& p : slot->scan.points) {
+        body_points.push_back(extrinsic * Eigen::Vector3f(p.x, p.y, p.z));
+        body_times.push_back(1e-9F * static_cast<float>(p.time_offset_ns));
+      }
+      const std::int64_t t0 = monotonic_ns();
+      const slam::OdometryResult result = odometry->process({slot->scan.start_time_ns, body_points, body_times});
+      const std::int64_t t1 = monotonic_ns();
+      if (timings.odometry_ms.size() < kTimingCapacity) timings.odometry_ms.push_back(1e-6 * static_cast<double>(t1 - t0));
+      if (first_stamp_ns == 0) first_stamp_ns = slot->scan.start_time_ns;
+      last_stamp_ns = slot->scan.start_time_ns;
+
+      PoseSlot* out = nullptr;
+      while ((out = poses->acquire()) == nullptr && !stop.load(std::memory_order_relaxed)) {
+        odometry_beat.beat();
+        wait_a_little();
+      }
+      if (out != nullptr) {
+        out->result = result;
+        out->last_packet_mono_ns = slot->last_packet_mono_ns;
+        out->pose_mono_ns = monotonic_ns();
+        poses->publish(out);
+      }
+      scans->release(slot);
+    }
+    stats.dropped_scans.store(scans->dropped());
+    odometry_done.store(true, std::memory_order_release);
+    odometry_beat.finished.store(true);
+  }
+
+  void output_loop() {
+    settle_thread("adit-output", config.threads.publisher);
+    while (!stop.load(std::memory_order_relaxed)) {
+      output_beat.beat();
+      PoseSlot* slot = poses->take();
+      if (slot == nullptr) {
+        if (odometry_done.load(std::memory_order_acquire) && poses->depth() == 0) break;
+        wait_a_little();
+        continue;
+      }
+      const slam::OdometryResult& r = slot->result;
+      stats.poses.fetch_add(1, std::memory_order_relaxed);
+      if (!r.valid) stats.invalid_poses.fetch_add(1, std::memory_order_relaxed);
+      if (r.status == slam::OdometryStatus::degenerate) stats.degenerate_poses.fetch_add(1, std::memory_order_relaxed);
+      if (timings.latency_ms.size() < kTimingCapacity)
+        timings.latency_ms.push_back(1e-6 * static_cast<double>(slot->pose_mono_ns - slot->last_packet_mono_ns));
+      if (trajectory && r.valid) {
+        const Eigen::Quaterniond q(r.pose.linear());
+        const Eigen::Vector3d& t = r.pose.translation();
+        fmt::print(trajectory.get(), "{:.9f} {:.6f} {:.6f} {:.6f} {:.9f} {:.9f} {:.9f} {:.9f}\n",
+                   1e-9 * static_cast<double>(r.stamp_ns), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+      }
+      poses->release(slot);
+    }
+    if (trajectory) std::fflush(trajectory.get());
+    output_beat.finished.store(true);
+  }
+
+  void settle_thread(std::string_view name, const config::ThreadSettings& settings) {
+    auto w = apply_thread_settings(name, settings);
+    const std::lock_guard lock(warnings_mutex);  // once per thread at start, never on the hot path
+    warnings.insert(warnings.end(), w.begin(), w.end());
+  }
+
+  config::Config config;
+  PipelineOptions options;
+  Overflow overflow;
+  std::unique_ptr<drivers::LidarDecoder> decoder;
+  std::uint16_t data_port = 0;
+  std::optional<drivers::PacedPcapReader> pcap;
+  std::optional<drivers::UdpReceiver> udp;
+  std::optional<drivers::ScanDirectorySource> scan_directory;
+  std::optional<drivers::ScanAssembler> assembler;
+  std::optional<drivers::DecodeStream> stream;
+  Handoff<Packet> packets;
+  std::optional<Handoff<ScanSlot>> scans;
+  std::optional<Handoff<PoseSlot>> poses{std::in_place, kPoseSlots, Overflow::wait, [] { return PoseSlot{}; }};
+  std::optional<slam::Odometry> odometry;
+  Eigen::Isometry3f extrinsic;
+  std::vector<Eigen::Vector3f> body_points;
+  std::vector<float> body_times;
+  std::int64_t current_packet_mono_ns = 0;  // assembly thread only
+  std::int64_t first_stamp_ns = 0;          // odometry thread only
+  std::int64_t last_stamp_ns = 0;
+  struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, FileCloser> trajectory;
+
+  PipelineStats stats;
+  PipelineTimings timings;
+  Heartbeat receiver_beat{"receiver"};
+  Heartbeat assembly_beat{"assembly"};
+  Heartbeat odometry_beat{"odometry"};
+  Heartbeat output_beat{"output"};
+  std::atomic<bool> stop{false};
+  std::atomic<bool> source_done{false};
+  std::atomic<bool> assembly_done{false};
+  std::atomic<bool> odometry_done{false};
+  std::mutex warnings_mutex;
+  std::vector<std::string> warnings;
+  std::vector<std::thread> threads;
+  std::int64_t started_ns = 0;
+};
+
+Pipeline::Pipeline(const config::Config& config, const PipelineOptions& options)
+    : impl_(std::make_unique<Impl>(config, options)) {}
+
+Pipeline::~Pipeline() {
+  request_stop();
+  join();
+}
+
+void Pipeline::start() {
+  Impl& i = *impl_;
+  if (i.config.threads.lock_memory) {
+    auto w = lock_memory();
+    i.warnings.insert(i.warnings.end(), w.begin(), w.end());
+  }
+  i.started_ns = monotonic_ns();
+  i.threads.emplace_back([&i] { i.output_loop(); });
+  i.threads.emplace_back([&i] { i.odometry_loop(); });
+  i.threads.emplace_back([&i] { i.assembly_loop(); });
+  i.threads.emplace_back([&i] { i.receiver_loop(); });
+}
+
+void Pipeline::request_stop() { impl_->stop.store(true, std::memory_order_release); }
+
+void Pipeline::join() {
+  Impl& i = *impl_;
+  for (std::thread& t : i.threads)
+    if (t.joinable()) t.join();
+  if (!i.threads.empty()) {
+    i.timings.duration_s = 1e-9 * static_cast<double>(monotonic_ns() - i.started_ns);
+    i.timings.sensor_span_s = 1e-9 * static_cast<double>(i.last_stamp_ns - i.first_stamp_ns);
+    i.threads.clear();
+  }
+}
+
+bool Pipeline::drained() const { return impl_->output_beat.finished.load(std::memory_order_acquire); }
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1) + 0.5);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+const PipelineStats& Pipeline::stats() const { return impl_->stats; }
+const PipelineTimings& Pipeline::timings() const { return impl_->timings; }
+std::vector<const Heartbeat*> Pipeline::heartbeats() const {
+  return {&impl_->receiver_beat, &impl_->assembly_beat, &impl_->odometry_beat, &impl_->output_beat};
+}
+std::vector<std::string> Pipeline::warnings() const {
+  const std::lock_guard lock(impl_->warnings_mutex);
+  return impl_->warnings;
+}
+
+}  // namespace adit::daemon
