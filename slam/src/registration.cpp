@@ -163,8 +163,11 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
     delta.tail<3>() = degeneracy.rotation_projector * delta.tail<3>();
     result.pose = exp_se3(delta) * result.pose;
     result.iterations = iteration;
-    if (delta.norm() < config.convergence_norm) {
-      if (kappa <= config.min_kernel_scale_m) break;
+    // Wider kernels only steer: move on once they settle roughly; the final
+    // kernel decides, to the full tolerance.
+    const bool last_level = kappa <= config.min_kernel_scale_m;
+    if (delta.norm() < (last_level ? 1.0 : 10.0) * config.convergence_norm) {
+      if (last_level) break;
       kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
     }
   }

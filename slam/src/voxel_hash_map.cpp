@@ -13,7 +13,8 @@ VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels)
       inverse_voxel_size_(1.0F / voxel_size_m),
       mask_(std::bit_ceil(std::max<std::size_t>(capacity_voxels, 16)) - 1),
       max_voxels_((mask_ + 1) * 3 / 4),
-      slots_(mask_ + 1) {
+      slots_(mask_ + 1),
+      voxels_(mask_ + 1) {
   doomed_.reserve(slots_.size());
 }
 
@@ -21,49 +22,45 @@ std::size_t VoxelHashMap::home_of(const VoxelKey& key) const { return voxel_hash
 
 std::size_t VoxelHashMap::index_of(const VoxelKey& key) const {
   for (std::size_t i = home_of(key);; i = (i + 1) & mask_) {
-    const Voxel& v = slots_[i];
-    if (v.count == 0 || v.key == key) return i;
+    const Slot& s = slots_[i];
+    if (s.count == 0 || s.key == key) return i;
   }
 }
 
-const VoxelHashMap::Voxel* VoxelHashMap::find(const VoxelKey& key) const {
-  const Voxel& v = slots_[index_of(key)];
-  return v.count > 0 ? &v : nullptr;
+std::size_t VoxelHashMap::find(const VoxelKey& key) const {
+  const std::size_t i = index_of(key);
+  return slots_[i].count > 0 ? i : kNone;
 }
 
-VoxelHashMap::Voxel* VoxelHashMap::find_or_insert(const VoxelKey& key) {
-  for (std::size_t i = home_of(key);; i = (i + 1) & mask_) {
-    Voxel& v = slots_[i];
-    if (v.count > 0) {
-      if (v.key == key) return &v;
-      continue;
-    }
-    if (voxel_count_ >= max_voxels_) return nullptr;
-    v.key = key;
-    v.plane = {};
-    ++voxel_count_;
-    return &v;  // count stays 0 until the caller stores a point
-  }
+std::size_t VoxelHashMap::find_or_insert(const VoxelKey& key) {
+  const std::size_t i = index_of(key);
+  if (slots_[i].count > 0) return i;
+  if (voxel_count_ >= max_voxels_) return kNone;
+  slots_[i].key = key;  // count stays 0 until the caller stores a point
+  voxels_[i].plane = {};
+  ++voxel_count_;
+  return i;
 }
 
 void VoxelHashMap::add(std::span<const Eigen::Vector3f> points) {
   for (const Eigen::Vector3f& p : points) {
-    Voxel* v = find_or_insert(key_of(p));
-    if (v == nullptr || v->count >= kMaxPointsPerVoxel) {
+    const std::size_t i = find_or_insert(key_of(p));
+    if (i == kNone || slots_[i].count >= kMaxPointsPerVoxel) {
       ++dropped_points_;
       continue;
     }
-    v->points[static_cast<std::size_t>(v->count++)] = p;
-    if (v->count >= kMinPointsForPlane) refit_plane(*v);
+    voxels_[i].points[static_cast<std::size_t>(slots_[i].count++)] = p;
+    if (slots_[i].count >= kMinPointsForPlane) refit_plane(i);
   }
 }
 
 // The plane of a voxel's points: the covariance's eigenvector of the smallest
 // eigenvalue. Accepted only when the points are clearly flat (smallest
 // eigenvalue well below the middle one), else the normal stays zero and the
-// registration falls back to point-to-point for this voxel.
-void VoxelHashMap::refit_plane(Voxel& voxel) {
-  const int n = voxel.count;
+// registration looks for a plane in a neighbouring voxel.
+void VoxelHashMap::refit_plane(std::size_t index) {
+  const int n = slots_[index].count;
+  Voxel& voxel = voxels_[index];
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
   for (int i = 0; i < n; ++i) mean += voxel.points[static_cast<std::size_t>(i)];
   mean /= static_cast<float>(n);
@@ -96,15 +93,16 @@ MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distan
   const auto gap2 = [&](int d, int axis) { return d < 0 ? low[axis] * low[axis] : d > 0 ? high[axis] * high[axis] : 0.0F; };
   const auto search = [&](int dx, int dy, int dz) {
     if (gap2(dx, 0) + gap2(dy, 1) + gap2(dz, 2) >= best.distance_sq) return;
-    const Voxel* v = find({center.x + dx, center.y + dy, center.z + dz});
-    if (v == nullptr) return;
-    for (int i = 0; i < v->count; ++i) {
-      const Eigen::Vector3f& p = v->points[static_cast<std::size_t>(i)];
+    const std::size_t s = find({center.x + dx, center.y + dy, center.z + dz});
+    if (s == kNone) return;
+    const Voxel& v = voxels_[s];
+    for (int i = 0; i < slots_[s].count; ++i) {
+      const Eigen::Vector3f& p = v.points[static_cast<std::size_t>(i)];
       const float d = (p - query).squaredNorm();
       if (d < best.distance_sq) {
         best.distance_sq = d;
         best.point = p;
-        best.normal = v->plane.normal;
+        best.normal = v.plane.normal;
         best.found = true;
       }
     }
@@ -119,16 +117,17 @@ MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distan
 }
 
 const VoxelPlane* VoxelHashMap::plane_at(const Eigen::Vector3f& query) const {
-  const Voxel* v = find(key_of(query));
-  return v != nullptr && v->count >= kMinPointsForPlane && !v->plane.normal.isZero() ? &v->plane : nullptr;
+  const std::size_t s = find(key_of(query));
+  return s != kNone && slots_[s].count >= kMinPointsForPlane && !voxels_[s].plane.normal.isZero() ? &voxels_[s].plane
+                                                                                                   : nullptr;
 }
 
 void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {
   const float max_sq = max_distance_m * max_distance_m;
   // Collect keys, not slot indices: each erase shifts later slots back.
   doomed_.clear();
-  for (const Voxel& v : slots_)
-    if (v.count > 0 && (v.points[0] - origin).squaredNorm() > max_sq) doomed_.push_back(v.key);
+  for (std::size_t s = 0; s < slots_.size(); ++s)
+    if (slots_[s].count > 0 && (voxels_[s].points[0] - origin).squaredNorm() > max_sq) doomed_.push_back(slots_[s].key);
   for (const VoxelKey& key : doomed_) erase_at(index_of(key));
 }
 
@@ -142,6 +141,7 @@ void VoxelHashMap::erase_at(std::size_t index) {
     const bool home_between = hole <= j ? (hole < home && home <= j) : (hole < home || home <= j);
     if (!home_between) {
       slots_[hole] = slots_[j];
+      voxels_[hole] = voxels_[j];
       hole = j;
     }
   }
@@ -150,14 +150,14 @@ void VoxelHashMap::erase_at(std::size_t index) {
 }
 
 void VoxelHashMap::clear() {
-  for (Voxel& v : slots_) v.count = 0;
+  for (Slot& s : slots_) s.count = 0;
   voxel_count_ = 0;
   dropped_points_ = 0;
 }
 
 std::size_t VoxelHashMap::point_count() const {
   std::size_t n = 0;
-  for (const Voxel& v : slots_) n += static_cast<std::size_t>(v.count);
+  for (const Slot& s : slots_) n += static_cast<std::size_t>(s.count);
   return n;
 }
 

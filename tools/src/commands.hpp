@@ -9,6 +9,7 @@
 namespace adit::tools {
 
 void register_config_commands(CLI::App& app, int& status);
+void register_bench_commands(CLI::App& app, int& status);
 
 void register_lidar_commands(CLI::App& app, int& status);
 void register_eval_commands(CLI::App& app, int& status);

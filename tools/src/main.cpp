@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
     int status = adit::kExitOk;
     adit::tools::register_config_commands(app, status);
+    adit::tools::register_bench_commands(app, status);
     adit::tools::register_lidar_commands(app, status);
     adit::tools::register_eval_commands(app, status);
     try {

@@ -70,27 +70,32 @@ class VoxelHashMap {
 
   template <typename F>
   void for_each_point(F&& f) const {
-    for (const Voxel& v : slots_)
-      if (v.count > 0)
-        for (int i = 0; i < v.count; ++i) f(v.points[static_cast<std::size_t>(i)]);
+    for (std::size_t s = 0; s < slots_.size(); ++s)
+      for (int i = 0; i < slots_[s].count; ++i) f(voxels_[s].points[static_cast<std::size_t>(i)]);
   }
 
   VoxelKey key_of(const Eigen::Vector3f& p) const { return voxel_key(p, inverse_voxel_size_); }
 
  private:
-  struct Voxel {
+  // Probing touches only the compact slots (4 per cache line); a voxel's
+  // points and plane, at the same index, are read only on a hit.
+  struct Slot {
     VoxelKey key;
     std::int32_t count = 0;  // 0 = empty slot
-    VoxelPlane plane;        // normal is zero while the points are not clearly flat
+  };
+  struct Voxel {
+    VoxelPlane plane;  // normal is zero while the points are not clearly flat
     std::array<Eigen::Vector3f, kMaxPointsPerVoxel> points;
   };
 
   std::size_t home_of(const VoxelKey& key) const;
   std::size_t index_of(const VoxelKey& key) const;  // its slot, or the empty slot ending its probe run
-  const Voxel* find(const VoxelKey& key) const;
-  Voxel* find_or_insert(const VoxelKey& key);
+  // The slot index holding `key`, or kNone.
+  std::size_t find(const VoxelKey& key) const;
+  std::size_t find_or_insert(const VoxelKey& key);
   void erase_at(std::size_t index);
-  static void refit_plane(Voxel& voxel);
+  void refit_plane(std::size_t index);
+  static constexpr std::size_t kNone = ~std::size_t{0};
 
   float voxel_size_;
   float inverse_voxel_size_;
@@ -98,7 +103,8 @@ class VoxelHashMap {
   std::size_t max_voxels_;
   std::size_t voxel_count_ = 0;
   std::uint64_t dropped_points_ = 0;
-  std::vector<Voxel> slots_;
+  std::vector<Slot> slots_;
+  std::vector<Voxel> voxels_;
   std::vector<VoxelKey> doomed_;  // remove_far's scratch, reserved to capacity
 };
 

@@ -1,0 +1,186 @@
+// adit bench odometry: per-scan odometry time (median, p99), speed as a
+// multiple of real time, memory, drift against ground truth when given, and a
+// baseline (PCL GICP) on the same scans in the same run, with the ratio.
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/slam/associate.hpp"
+#include "adit/slam/kitti_drift.hpp"
+#include "adit/slam/odometry.hpp"
+#include "adit/slam/trajectory.hpp"
+#include "adit/slam/trajectory_io.hpp"
+#include "bench_baseline.hpp"
+#include "bench_scans.hpp"
+#include "commands.hpp"
+
+namespace adit::tools {
+namespace {
+
+struct BenchOptions {
+  BenchInput input;
+  std::string truth;
+  std::string out;
+  std::string baseline = "gicp";
+  double scan_period_s = 0.0;  // 0 = from the scans' stamps
+  float max_range_m = 100.0F;
+  float map_voxel_m = 0.5F;
+};
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+double resident_mb() {
+  std::ifstream statm("/proc/self/statm");
+  long size = 0;
+  long resident = 0;
+  statm >> size >> resident;
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+double peak_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+template <typename F>
+double time_ms(F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Drift of `est` against the reference, the KITTI way over 100–800 m segments,
+// or, for shorter paths, the end-to-end error over the path length.
+void print_drift(const std::string& label, const slam::Trajectory& truth, const slam::Trajectory& est) {
+  const slam::Associated a = slam::associate(truth, est, 0.02);
+  if (a.pairs.size() < 2) {
+    fmt::print("{}: no poses associated with the ground truth within 20 ms\n", label);
+    return;
+  }
+  if (const auto kitti = slam::kitti_drift(a.ref, a.est)) {
+    fmt::print("{}: drift {:.3f} % and {:.4f} deg/100 m (KITTI, {} segments of 100-800 m)\n", label,
+               kitti->translation_percent, kitti->rotation_deg_per_100m, kitti->segments);
+    return;
+  }
+  const double length = slam::path_length(a.ref);
+  const Eigen::Isometry3d ref_delta = a.ref.front().inverse() * a.ref.back();
+  const Eigen::Isometry3d est_delta = a.est.front().inverse() * a.est.back();
+  const double error = (ref_delta.inverse() * est_delta).translation().norm();
+  fmt::print("{}: end-to-end error {:.3f} m over {:.1f} m of path = {:.3f} % (path shorter than 100 m)\n", label, error,
+             length, length > 0 ? 100.0 * error / length : 0.0);
+}
+
+int bench_odometry(const BenchOptions& o) {
+  const std::vector<BenchScan> scans = load_bench_scans(o.input);
+  if (scans.size() < 2) throw InputError(o.input.scans_dir + o.input.pcap, "", "fewer than 2 scans to benchmark");
+  std::vector<double> gaps;
+  for (std::size_t i = 1; i < scans.size(); ++i) gaps.push_back(1e-9 * static_cast<double>(scans[i].stamp_ns - scans[i - 1].stamp_ns));
+  const double period_s = o.scan_period_s > 0.0 ? o.scan_period_s : quantile(gaps, 0.5);
+  std::vector<double> sizes;
+  for (const auto& s : scans) sizes.push_back(static_cast<double>(s.points.size()));
+  fmt::print("scans: {} with {:.0f} points each (median), one every {:.1f} ms\n", scans.size(), quantile(sizes, 0.5),
+             1e3 * period_s);
+
+  slam::OdometryConfig config;
+  config.max_range_m = o.max_range_m;
+  config.map_voxel_m = o.map_voxel_m;
+  config.registration_voxel_m = 1.5F * o.map_voxel_m;
+  config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
+  const double rss_before = resident_mb();
+  slam::Odometry odometry(config);
+  slam::Trajectory estimate;
+  std::vector<double> ms;
+  std::size_t degenerate = 0;
+  std::size_t invalid = 0;
+  std::vector<double> iterations;
+  std::vector<double> used_points;
+  for (const BenchScan& scan : scans) {
+    slam::OdometryResult r;
+    ms.push_back(time_ms([&] { r = odometry.process({scan.stamp_ns, scan.points, scan.times_s}); }));
+    degenerate += r.status == slam::OdometryStatus::degenerate ? 1 : 0;
+    invalid += r.valid ? 0 : 1;
+    iterations.push_back(r.registration.iterations);
+    used_points.push_back(static_cast<double>(r.registration_points));
+    estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
+  }
+  const double median = quantile(ms, 0.5);
+  fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
+             "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
+             "  registration: {:.0f} points, {:.0f} iterations per scan (medians)\n",
+             median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
+             peak_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5));
+  if (!o.out.empty()) {
+    std::ofstream out(o.out);
+    slam::write_tum(out, estimate);
+  }
+
+  std::optional<slam::Trajectory> truth;
+  if (!o.truth.empty()) {
+    truth = slam::read_tum(o.truth);
+    print_drift("adit odometry", *truth, estimate);
+  }
+
+  if (o.baseline == "gicp") {
+    auto baseline = make_pcl_gicp_baseline(o.map_voxel_m, o.max_range_m);
+    if (!baseline) {
+      fmt::print("baseline: this build has no PCL (install libpcl-dev and reconfigure)\n");
+      return kExitOk;
+    }
+    slam::Trajectory baseline_estimate;
+    std::vector<double> baseline_ms;
+    for (const BenchScan& scan : scans) {
+      Eigen::Isometry3d pose;
+      baseline_ms.push_back(time_ms([&] { pose = baseline->process(scan.points); }));
+      baseline_estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), pose);
+    }
+    const double baseline_median = quantile(baseline_ms, 0.5);
+    fmt::print("baseline PCL GICP (scan-to-scan, voxel {:.2f} m): median {:.2f} ms, p99 {:.2f} ms per scan; "
+               "adit is {:.1f}x faster (median)\n",
+               o.map_voxel_m, baseline_median, quantile(baseline_ms, 0.99), baseline_median / median);
+    if (truth) print_drift("baseline PCL GICP", *truth, baseline_estimate);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_bench_commands(CLI::App& app, int& status) {
+  CLI::App* bench = app.add_subcommand("bench", "Measure speed and accuracy");
+  bench->require_subcommand(1);
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* odometry = bench->add_subcommand(
+      "odometry", "Odometry time per scan (median, p99), × real time, memory, drift, and a PCL GICP baseline");
+  auto* scans = odometry->add_option("--scans", o->input.scans_dir, "Directory of PCD or KITTI .bin scans");
+  auto* pcap = odometry->add_option("--pcap", o->input.pcap, "Capture to decode (with --model and --calibration)");
+  scans->excludes(pcap);
+  odometry->add_option("--model", o->input.model, "LiDAR model of the capture (VLP-16, PandarXT32, ...)");
+  odometry->add_option("--calibration", o->input.calibration, "Calibration or metadata file of the capture");
+  odometry->add_option("--max-scans", o->input.max_scans, "Use at most this many scans (0 = all)");
+  odometry->add_option("--truth", o->truth, "Ground-truth trajectory (TUM) for drift");
+  odometry->add_option("--out", o->out, "Write adit's trajectory (TUM) here");
+  odometry->add_option("--baseline", o->baseline, "gicp (PCL Generalized-ICP, scan to scan) or none")
+      ->check(CLI::IsMember({"gicp", "none"}));
+  odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
+  odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
+  odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");
+  odometry->callback([o, &status] {
+    if (o->input.scans_dir.empty() && o->input.pcap.empty())
+      throw InputError("", "--scans/--pcap", "give a scan directory or a capture");
+    status = bench_odometry(*o);
+  });
+}
+
+}  // namespace adit::tools
