@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
            "Log level: trace, debug, info, warn, error, off (default info)")
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
     int status = adit::kExitOk;
+    adit::tools::register_config_commands(app, status);
     adit::tools::register_can_commands(app, status);
     adit::tools::register_calibrate_wheels_commands(app, status);
     try {

@@ -1,0 +1,149 @@
+#pragma once
+// The payload configuration: every setting a program reads from YAML.
+//
+// The default values written here are the only defaults in the project; the
+// schema (schema.hpp) names the keys, their checks and which are required.
+// Relative paths are resolved against the configuration file's folder.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "adit/common/log.hpp"
+
+namespace adit::config {
+
+// A rigid transform, e.g. the sensor's pose in the body frame (x forward,
+// y left, z up), rotation as roll-pitch-yaw in degrees (applied Z·Y·X).
+struct Transform {
+  std::array<double, 3> xyz_m{0.0, 0.0, 0.0};
+  std::array<double, 3> rpy_deg{0.0, 0.0, 0.0};
+};
+
+struct PayloadSection {
+  std::string id;                          // required: names this payload on the network
+  std::string state_dir = "/var/lib/aditd";  // sessions, maps and recordings
+};
+
+struct LogSection {
+  log::Level level = log::Level::info;
+};
+
+enum class LidarSource { udp, pcap, scan_dir };
+enum class ReturnMode { strongest, last, dual };
+
+struct LidarSection {
+  std::string model;                     // required, e.g. VLP-16, PandarXT32, OS1-64
+  LidarSource source = LidarSource::udp;
+  std::string pcap;                      // source: pcap (required then)
+  std::string scan_dir;                  // source: scan_dir (required then)
+  double replay_speed = 1.0;             // pcap/scan_dir: × recorded rate; 0 = as fast as possible
+  std::string calibration;               // Velodyne YAML, Hesai/RoboSense CSV, Ouster metadata JSON
+  std::string address = "0.0.0.0";       // udp: local address to bind
+  int port = 0;                          // udp: 0 = the model's default data port
+  std::string interface;                 // udp: bind to this interface (empty = any)
+  std::string multicast_group;           // udp: join this group (empty = unicast)
+  int receive_buffer_bytes = 16 << 20;   // udp: SO_RCVBUF
+  ReturnMode return_mode = ReturnMode::strongest;
+  double scan_cut_azimuth_deg = 0.0;
+  double min_range_m = 0.3;
+  double max_range_m = 120.0;
+  Transform extrinsics;                  // sensor in body frame
+};
+
+enum class CanSource { socketcan, candump };
+enum class ByteOrder { intel, motorola };
+enum class ValueType { unsigned_int, signed_int, ieee_float };
+
+// A signal written inline, for payloads without a DBC (same fields as DBC SG_).
+struct CanSignal {
+  std::string name;          // required
+  std::uint32_t id = 0;      // required: CAN identifier
+  bool extended = false;     // 29-bit identifier
+  int start_bit = 0;         // DBC convention for the byte order
+  int length = 16;
+  ByteOrder byte_order = ByteOrder::intel;
+  ValueType value_type = ValueType::unsigned_int;  // ieee_float: length 32 or 64
+  double factor = 1.0;
+  double offset = 0.0;
+  std::string unit;
+};
+
+struct CanSection {
+  bool enabled = false;
+  CanSource source = CanSource::socketcan;
+  std::string interface = "can0";        // socketcan
+  std::string log;                       // candump: -L log to replay (required then)
+  std::string dbc;                       // a DBC file with the signals (or inline signals)
+  std::string preset;                    // "", canopen_tpdo, odrive
+  int node_id = 1;                       // presets: CANopen / ODrive node
+  bool record = false;                   // write the bus to the session folder
+  std::vector<CanSignal> signals;
+};
+
+enum class DriveModel { differential, skid_steer };
+enum class WheelQuantity { speed, angular_speed, counts };
+
+struct WheelOdometrySection {
+  bool enabled = false;
+  DriveModel model = DriveModel::differential;
+  std::string left_signal;               // required when enabled: DBC "MESSAGE.SIGNAL" or inline name
+  std::string right_signal;              // required when enabled
+  WheelQuantity quantity = WheelQuantity::speed;  // m/s, rad/s, or encoder counts
+  double left_radius_m = 0.1;
+  double right_radius_m = 0.1;
+  double track_width_m = 0.5;
+  int counts_per_revolution = 4096;      // quantity: counts
+  int counter_bits = 32;                 // quantity: counts (wrap-around)
+  double time_offset_s = 0.0;            // encoder clock minus LiDAR clock
+};
+
+// A GPIO line: by offset on the chip, or by its name (one of them).
+struct GpioLine {
+  int offset = -1;
+  std::string name;
+  bool active_low = false;
+};
+
+struct GpioSection {
+  bool enabled = false;
+  std::string chip = "gpiochip0";
+  GpioLine button;
+  GpioLine status_led;
+  GpioLine lidar_power;
+  int debounce_ms = 30;
+};
+
+struct LcmSection {
+  std::string url = "udpm://239.255.76.67:7667?ttl=1";
+};
+
+enum class SchedPolicy { other, fifo };
+
+struct ThreadSettings {
+  SchedPolicy policy = SchedPolicy::other;
+  int priority = 0;   // SCHED_FIFO priority, 1..99
+  int cpu = -1;       // pin to this CPU; -1 = any
+};
+
+struct ThreadsSection {
+  bool lock_memory = true;
+  ThreadSettings receiver;
+  ThreadSettings odometry;
+  ThreadSettings mapping;
+  ThreadSettings publisher;
+};
+
+struct Config {
+  PayloadSection payload;
+  LogSection log;
+  LidarSection lidar;
+  CanSection can;
+  WheelOdometrySection wheel_odometry;
+  GpioSection gpio;
+  LcmSection lcm;
+  ThreadsSection threads;
+};
+
+}  // namespace adit::config

@@ -1,0 +1,197 @@
+#pragma once
+// The configuration schema, written once: for each section, which keys exist,
+// which are required and what values they accept. The same description drives
+// the YAML reader (validation, with file/line/key errors) and the writer
+// (`adit config show`), so keys, checks and defaults cannot drift apart.
+//
+// A visitor V provides:
+//   v.required(key, value, check...)  a key that must be present
+//   v.optional(key, value, check...)  a key that keeps its default when absent
+//   v.section(key, sub)               a nested mapping, described by describe(v, sub)
+//   v.list(key, items)                a sequence of mappings
+// Checks: Range{lo, hi} for numbers, OneOf for strings, Names<E> for enums.
+
+#include <array>
+#include <span>
+#include <string_view>
+#include <utility>
+
+#include "adit/config/config.hpp"
+
+namespace adit::config {
+
+template <typename T>
+struct Range {
+  T lo;
+  T hi;
+};
+
+struct OneOf {
+  std::span<const std::string_view> allowed;
+};
+
+template <typename E>
+struct Names {
+  std::span<const std::pair<std::string_view, E>> table;
+};
+
+// The LiDAR models the drivers decode. Ouster names follow "OS<range>-<beams>".
+inline constexpr std::array<std::string_view, 22> kLidarModels{
+    "VLP-16",     "VLP-32C",     "HDL-32E",      "VLS-128",     "RS-16",     "Helios-16P",
+    "PandarXT16", "PandarXT32",  "PandarXT32M",  "PandarQT64",  "PandarQT128", "Pandar40P",
+    "Pandar64",   "OS0-32",      "OS0-64",       "OS0-128",     "OS1-32",    "OS1-64",
+    "OS1-128",    "OS2-32",      "OS2-64",       "OS2-128"};
+
+inline constexpr std::array<std::string_view, 3> kCanPresets{"", "canopen_tpdo", "odrive"};
+
+inline constexpr std::array<std::pair<std::string_view, log::Level>, 6> kLogLevels{{
+    {"trace", log::Level::trace}, {"debug", log::Level::debug}, {"info", log::Level::info},
+    {"warn", log::Level::warn},   {"error", log::Level::error}, {"off", log::Level::off}}};
+inline constexpr std::array<std::pair<std::string_view, LidarSource>, 3> kLidarSources{{
+    {"udp", LidarSource::udp}, {"pcap", LidarSource::pcap}, {"scan_dir", LidarSource::scan_dir}}};
+inline constexpr std::array<std::pair<std::string_view, ReturnMode>, 3> kReturnModes{{
+    {"strongest", ReturnMode::strongest}, {"last", ReturnMode::last}, {"dual", ReturnMode::dual}}};
+inline constexpr std::array<std::pair<std::string_view, CanSource>, 2> kCanSources{{
+    {"socketcan", CanSource::socketcan}, {"candump", CanSource::candump}}};
+inline constexpr std::array<std::pair<std::string_view, ByteOrder>, 2> kByteOrders{{
+    {"intel", ByteOrder::intel}, {"motorola", ByteOrder::motorola}}};
+inline constexpr std::array<std::pair<std::string_view, ValueType>, 3> kValueTypes{{
+    {"unsigned", ValueType::unsigned_int}, {"signed", ValueType::signed_int}, {"ieee_float", ValueType::ieee_float}}};
+inline constexpr std::array<std::pair<std::string_view, DriveModel>, 2> kDriveModels{{
+    {"differential", DriveModel::differential}, {"skid_steer", DriveModel::skid_steer}}};
+inline constexpr std::array<std::pair<std::string_view, WheelQuantity>, 3> kWheelQuantities{{
+    {"speed", WheelQuantity::speed}, {"angular_speed", WheelQuantity::angular_speed},
+    {"counts", WheelQuantity::counts}}};
+inline constexpr std::array<std::pair<std::string_view, SchedPolicy>, 2> kSchedPolicies{{
+    {"other", SchedPolicy::other}, {"fifo", SchedPolicy::fifo}}};
+
+template <typename V>
+void describe(V& v, Transform& t) {
+  v.optional("xyz_m", t.xyz_m, Range<double>{-100.0, 100.0});
+  v.optional("rpy_deg", t.rpy_deg, Range<double>{-360.0, 360.0});
+}
+
+template <typename V>
+void describe(V& v, PayloadSection& s) {
+  v.required("id", s.id);
+  v.optional("state_dir", s.state_dir);
+}
+
+template <typename V>
+void describe(V& v, LogSection& s) {
+  v.optional("level", s.level, Names<log::Level>{kLogLevels});
+}
+
+template <typename V>
+void describe(V& v, LidarSection& s) {
+  v.required("model", s.model, OneOf{kLidarModels});
+  v.optional("source", s.source, Names<LidarSource>{kLidarSources});
+  v.optional("pcap", s.pcap);
+  v.optional("scan_dir", s.scan_dir);
+  v.optional("replay_speed", s.replay_speed, Range<double>{0.0, 1000.0});
+  v.optional("calibration", s.calibration);
+  v.optional("address", s.address);
+  v.optional("port", s.port, Range<int>{0, 65535});
+  v.optional("interface", s.interface);
+  v.optional("multicast_group", s.multicast_group);
+  v.optional("receive_buffer_bytes", s.receive_buffer_bytes, Range<int>{65536, 1 << 30});
+  v.optional("return_mode", s.return_mode, Names<ReturnMode>{kReturnModes});
+  v.optional("scan_cut_azimuth_deg", s.scan_cut_azimuth_deg, Range<double>{0.0, 360.0});
+  v.optional("min_range_m", s.min_range_m, Range<double>{0.0, 10.0});
+  v.optional("max_range_m", s.max_range_m, Range<double>{1.0, 2000.0});
+  v.section("extrinsics", s.extrinsics);
+}
+
+template <typename V>
+void describe(V& v, CanSignal& s) {
+  v.required("name", s.name);
+  v.required("id", s.id, Range<std::uint32_t>{0, 0x1FFFFFFF});
+  v.optional("extended", s.extended);
+  v.required("start_bit", s.start_bit, Range<int>{0, 511});
+  v.required("length", s.length, Range<int>{1, 64});
+  v.optional("byte_order", s.byte_order, Names<ByteOrder>{kByteOrders});
+  v.optional("value_type", s.value_type, Names<ValueType>{kValueTypes});
+  v.optional("factor", s.factor);
+  v.optional("offset", s.offset);
+  v.optional("unit", s.unit);
+}
+
+template <typename V>
+void describe(V& v, CanSection& s) {
+  v.optional("enabled", s.enabled);
+  v.optional("source", s.source, Names<CanSource>{kCanSources});
+  v.optional("interface", s.interface);
+  v.optional("log", s.log);
+  v.optional("dbc", s.dbc);
+  v.optional("preset", s.preset, OneOf{kCanPresets});
+  v.optional("node_id", s.node_id, Range<int>{0, 127});
+  v.optional("record", s.record);
+  v.list("signals", s.signals);
+}
+
+template <typename V>
+void describe(V& v, WheelOdometrySection& s) {
+  v.optional("enabled", s.enabled);
+  v.optional("model", s.model, Names<DriveModel>{kDriveModels});
+  v.optional("left_signal", s.left_signal);
+  v.optional("right_signal", s.right_signal);
+  v.optional("quantity", s.quantity, Names<WheelQuantity>{kWheelQuantities});
+  v.optional("left_radius_m", s.left_radius_m, Range<double>{0.005, 5.0});
+  v.optional("right_radius_m", s.right_radius_m, Range<double>{0.005, 5.0});
+  v.optional("track_width_m", s.track_width_m, Range<double>{0.05, 10.0});
+  v.optional("counts_per_revolution", s.counts_per_revolution, Range<int>{1, 1 << 24});
+  v.optional("counter_bits", s.counter_bits, Range<int>{8, 64});
+  v.optional("time_offset_s", s.time_offset_s, Range<double>{-10.0, 10.0});
+}
+
+template <typename V>
+void describe(V& v, GpioLine& s) {
+  v.optional("offset", s.offset, Range<int>{-1, 1023});
+  v.optional("name", s.name);
+  v.optional("active_low", s.active_low);
+}
+
+template <typename V>
+void describe(V& v, GpioSection& s) {
+  v.optional("enabled", s.enabled);
+  v.optional("chip", s.chip);
+  v.section("button", s.button);
+  v.section("status_led", s.status_led);
+  v.section("lidar_power", s.lidar_power);
+  v.optional("debounce_ms", s.debounce_ms, Range<int>{0, 1000});
+}
+
+template <typename V>
+void describe(V& v, LcmSection& s) {
+  v.optional("url", s.url);
+}
+
+template <typename V>
+void describe(V& v, ThreadSettings& s) {
+  v.optional("policy", s.policy, Names<SchedPolicy>{kSchedPolicies});
+  v.optional("priority", s.priority, Range<int>{0, 99});
+  v.optional("cpu", s.cpu, Range<int>{-1, 1023});
+}
+
+template <typename V>
+void describe(V& v, ThreadsSection& s) {
+  v.optional("lock_memory", s.lock_memory);
+  v.section("receiver", s.receiver);
+  v.section("odometry", s.odometry);
+  v.section("mapping", s.mapping);
+  v.section("publisher", s.publisher);
+}
+
+template <typename V>
+void describe(V& v, Config& c) {
+  v.section("payload", c.payload);
+  v.section("log", c.log);
+  v.section("lidar", c.lidar);
+  v.section("can", c.can);
+  v.section("wheel_odometry", c.wheel_odometry);
+  v.section("gpio", c.gpio);
+  v.section("lcm", c.lcm);
+  v.section("threads", c.threads);
+}
+
+}  // namespace adit::config

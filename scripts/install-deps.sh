@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Installs exactly the Debian 12 packages adit needs to build and test.
+# Idempotent: when everything is present it changes nothing and needs no network.
+# Runs apt-get update once, only when something is missing.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkg-config ccache git
+  # clang and its sanitizer/libFuzzer runtimes: fuzz targets (CI runs them briefly)
+  clang libclang-rt-14-dev
+  # libraries
+  libeigen3-dev          # geometry and linear algebra
+  libyaml-cpp-dev        # payload configuration
+  libspdlog-dev libfmt-dev  # logging, formatting
+  libcli11-dev           # command-line options of aditd and adit
+  nlohmann-json3-dev     # Ouster metadata, JSON output
+  libpcap-dev            # pcap replay
+  libgpiod-dev           # GPIO (libgpiod v1 C++ API)
+  libsystemd-dev         # sd_notify
+  libzstd-dev            # map tile compression
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+if ! command -v apt-get >/dev/null 2>&1 || ! command -v dpkg-query >/dev/null 2>&1; then
+  echo "install-deps: apt-get/dpkg not found: this script is for Debian 12 (bookworm)" >&2
+  exit 1
+fi
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages are installed"
+  exit 0
+fi
+
+sudo=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    sudo=(sudo)
+  else
+    echo "install-deps: missing ${missing[*]}; run this script as root to install them" >&2
+    exit 1
+  fi
+fi
+
+echo "install-deps: installing ${missing[*]}"
+"${sudo[@]}" apt-get update
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,203 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "adit/common/error.hpp"
+#include "adit/config/load.hpp"
+#include "shared_data.hpp"
+
+namespace adit::config {
+namespace {
+
+constexpr const char* kMinimal =
+    "payload:\n"
+    "  id: test\n"
+    "lidar:\n"
+    "  model: VLP-16\n";
+
+Config parse(const std::string& yaml) { return parse_config(yaml, "test.yaml", "/base"); }
+
+// Parses `yaml`, expects an InputError, and returns it for inspection.
+InputError parse_error(const std::string& yaml) {
+  try {
+    parse(yaml);
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for:\n" << yaml;
+  return InputError("", "", "");
+}
+
+TEST(ConfigLoader, MinimalConfigTakesEveryDefaultFromTheStructs) {
+  const Config c = parse(kMinimal);
+  const Config defaults;
+  EXPECT_EQ(c.payload.id, "test");
+  EXPECT_EQ(c.lidar.model, "VLP-16");
+  EXPECT_EQ(c.lidar.source, defaults.lidar.source);
+  EXPECT_EQ(c.lidar.receive_buffer_bytes, defaults.lidar.receive_buffer_bytes);
+  EXPECT_EQ(c.lcm.url, defaults.lcm.url);
+  EXPECT_EQ(c.log.level, defaults.log.level);
+  EXPECT_EQ(c.payload.state_dir, defaults.payload.state_dir);  // absolute: not re-based
+}
+
+TEST(ConfigLoader, UnknownKeyNamesFileLineKeyAndSuggestsTheClosestKey) {
+  const InputError e = parse_error(std::string(kMinimal) + "  prot: 2368\n");
+  EXPECT_EQ(e.where(), "test.yaml:5");
+  EXPECT_EQ(e.key(), "lidar.prot");
+  EXPECT_EQ(e.reason(), "unknown key (did you mean 'port'?)");
+}
+
+TEST(ConfigLoader, UnknownSectionIsRejected) {
+  const InputError e = parse_error(std::string(kMinimal) + "lidra:\n  port: 1\n");
+  EXPECT_EQ(e.where(), "test.yaml:5");
+  EXPECT_EQ(e.key(), "lidra");
+  EXPECT_EQ(e.reason(), "unknown key (did you mean 'lidar'?)");
+}
+
+TEST(ConfigLoader, WrongTypeNamesFileLineAndKey) {
+  const InputError e = parse_error(std::string(kMinimal) + "  port: abc\n");
+  EXPECT_EQ(e.where(), "test.yaml:5");
+  EXPECT_EQ(e.key(), "lidar.port");
+  EXPECT_EQ(e.reason(), "expected an integer, got 'abc'");
+}
+
+TEST(ConfigLoader, ListWhereAScalarBelongsIsAWrongType) {
+  const InputError e = parse_error(std::string(kMinimal) + "  address: [1, 2]\n");
+  EXPECT_EQ(e.key(), "lidar.address");
+  EXPECT_EQ(e.reason(), "expected a string, got a list");
+}
+
+TEST(ConfigLoader, OutOfRangeValueIsRejectedWithTheRange) {
+  const InputError e = parse_error(std::string(kMinimal) + "  port: 70000\n");
+  EXPECT_EQ(e.where(), "test.yaml:5");
+  EXPECT_EQ(e.reason(), "expected a value in [0, 65535], got 70000");
+}
+
+TEST(ConfigLoader, NonFiniteNumbersAreRejected) {
+  const InputError e = parse_error(std::string(kMinimal) + "  max_range_m: nan\n");
+  EXPECT_EQ(e.key(), "lidar.max_range_m");
+  EXPECT_EQ(e.reason(), "expected a number, got 'nan'");
+}
+
+TEST(ConfigLoader, MissingRequiredKeyNamesTheEnclosingSectionsLine) {
+  const InputError e = parse_error("payload:\n  id: x\nlidar:\n  port: 2368\n");
+  EXPECT_EQ(e.where(), "test.yaml:4");
+  EXPECT_EQ(e.key(), "lidar.model");
+  EXPECT_EQ(e.reason(), "required key is missing");
+}
+
+TEST(ConfigLoader, MissingRequiredSectionIsReported) {
+  const InputError e = parse_error("lidar:\n  model: VLP-16\n");
+  EXPECT_EQ(e.key(), "payload.id");
+  EXPECT_EQ(e.reason(), "required key is missing");
+}
+
+TEST(ConfigLoader, UnknownModelListsTheSupportedOnes) {
+  const InputError e = parse_error("payload:\n  id: x\nlidar:\n  model: VLP-17\n");
+  EXPECT_EQ(e.where(), "test.yaml:4");
+  EXPECT_NE(e.reason().find("expected one of: VLP-16, VLP-32C"), std::string::npos) << e.reason();
+}
+
+TEST(ConfigLoader, EnumsAcceptOnlyTheirNames) {
+  EXPECT_EQ(parse(std::string(kMinimal) + "  return_mode: dual\n").lidar.return_mode, ReturnMode::dual);
+  const InputError e = parse_error(std::string(kMinimal) + "  return_mode: both\n");
+  EXPECT_EQ(e.reason(), "expected one of: strongest, last, dual; got 'both'");
+}
+
+TEST(ConfigLoader, BooleansAreStrictTrueOrFalse) {
+  EXPECT_TRUE(parse(std::string(kMinimal) + "can:\n  enabled: true\n").can.enabled);
+  const InputError e = parse_error(std::string(kMinimal) + "can:\n  enabled: yes\n");
+  EXPECT_EQ(e.key(), "can.enabled");
+  EXPECT_EQ(e.reason(), "expected true or false, got 'yes'");
+}
+
+TEST(ConfigLoader, DuplicateKeysAreRejected) {
+  const InputError e = parse_error(std::string(kMinimal) + "  port: 1\n  port: 2\n");
+  EXPECT_EQ(e.where(), "test.yaml:6");
+  EXPECT_EQ(e.reason(), "key is given twice");
+}
+
+TEST(ConfigLoader, SectionThatIsNotAMappingIsRejected) {
+  const InputError e = parse_error(std::string(kMinimal) + "gpio: 5\n");
+  EXPECT_EQ(e.key(), "gpio");
+  EXPECT_EQ(e.reason(), "expected a mapping of keys");
+}
+
+TEST(ConfigLoader, InvalidYamlReportsTheLine) {
+  const InputError e = parse_error("payload:\n  id: [unclosed\n");
+  EXPECT_EQ(e.where().rfind("test.yaml:", 0), 0U);
+  EXPECT_NE(e.reason().find("not valid YAML"), std::string::npos);
+}
+
+TEST(ConfigLoader, HexadecimalIntegersAreAcceptedForCanIds) {
+  const Config c = parse(std::string(kMinimal) +
+                         "can:\n  signals:\n    - name: a\n      id: 0x1AB\n      start_bit: 0\n      length: 8\n");
+  ASSERT_EQ(c.can.signals.size(), 1U);
+  EXPECT_EQ(c.can.signals[0].id, 0x1ABU);
+}
+
+TEST(ConfigLoader, ListElementsAreCheckedWithTheirIndex) {
+  const InputError e = parse_error(std::string(kMinimal) +
+                                   "can:\n  signals:\n    - name: a\n      id: 1\n      length: 8\n");
+  EXPECT_EQ(e.key(), "can.signals[0].start_bit");
+  EXPECT_EQ(e.reason(), "required key is missing");
+}
+
+TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
+  const InputError pcap = parse_error(std::string(kMinimal) + "  source: pcap\n");
+  EXPECT_EQ(pcap.where(), "test.yaml:5");  // the line of lidar.source
+  EXPECT_EQ(pcap.key(), "lidar.pcap");
+  EXPECT_EQ(pcap.reason(), "required when lidar.source is pcap");
+
+  const InputError wheels = parse_error(std::string(kMinimal) + "wheel_odometry:\n  enabled: true\n");
+  EXPECT_EQ(wheels.key(), "wheel_odometry.enabled");
+  EXPECT_EQ(wheels.reason(), "needs can.enabled: true");
+
+  const InputError fifo = parse_error(std::string(kMinimal) + "threads:\n  odometry:\n    policy: fifo\n");
+  EXPECT_EQ(fifo.key(), "threads.odometry.priority");
+}
+
+TEST(ConfigLoader, GpioLinesNeedExactlyOneOfOffsetOrName) {
+  const std::string base = std::string(kMinimal) + "gpio:\n  enabled: true\n  button:\n    offset: 3\n"
+                                                   "  status_led:\n    name: LED\n";
+  const InputError e = parse_error(base + "  lidar_power:\n    offset: 4\n    name: PWR\n");
+  EXPECT_EQ(e.key(), "gpio.lidar_power.offset");
+  EXPECT_NO_THROW(parse(base + "  lidar_power:\n    offset: 4\n"));
+}
+
+TEST(ConfigLoader, RelativePathsAreResolvedAgainstTheConfigFolder) {
+  const Config c = parse(std::string(kMinimal) + "  source: pcap\n  pcap: ../sessions/a.pcap\n");
+  EXPECT_EQ(c.lidar.pcap, "/sessions/a.pcap");
+}
+
+TEST(ConfigLoader, EffectiveYamlReadsBackToTheSameConfiguration) {
+  const std::filesystem::path file = test::source_dir() / "firmware-config/templates/vlp16-diffdrive-robot.yaml";
+  const Config original = load_config(file);
+  const std::string yaml = to_yaml(original);
+  const Config again = parse_config(yaml, "effective.yaml", "/");
+  EXPECT_EQ(to_yaml(again), yaml);
+  EXPECT_EQ(again.can.signals.size(), 2U);
+  EXPECT_EQ(again.threads.odometry.priority, 70);
+}
+
+TEST(ConfigLoader, MissingFileIsAnInputErrorNamingIt) {
+  try {
+    load_config("/nonexistent/payload.yaml");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "/nonexistent/payload.yaml");
+  }
+}
+
+TEST(ShippedConfigs, EveryFileInFirmwareConfigIsValid) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::source_dir() / "firmware-config")) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++count;
+    EXPECT_NO_THROW(load_config(entry.path())) << entry.path();
+  }
+  EXPECT_GE(count, 2);
+}
+
+}  // namespace
+}  // namespace adit::config
