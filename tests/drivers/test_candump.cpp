@@ -68,6 +68,7 @@ TEST(Candump, RejectsMalformedLinesWithAReason) {
   EXPECT_EQ(can::parse_candump_line("(46408.) can0 0AA#00", f), can::LineError::timestamp);
   EXPECT_EQ(can::parse_candump_line("(1.0)", f), can::LineError::interface);
   EXPECT_EQ(can::parse_candump_line("(1.0) averyveryverylongname 0AA#00", f), can::LineError::interface);
+  EXPECT_EQ(can::parse_candump_line(std::string_view("(1.0) c\0n 0AA#00", 16), f), can::LineError::interface);
   EXPECT_EQ(can::parse_candump_line("(1.0) can0 0A#00", f), can::LineError::identifier);
   EXPECT_EQ(can::parse_candump_line("(1.0) can0 800#00", f), can::LineError::identifier);
   EXPECT_EQ(can::parse_candump_line("(1.0) can0 0AG#00", f), can::LineError::identifier);

@@ -92,7 +92,11 @@ LineError parse_candump_line(std::string_view s, Frame& out) {
   while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
   const std::size_t name_end = s.find_first_of(" \t");
   if (name_end == 0 || name_end == std::string_view::npos) return LineError::interface;
-  if (!out.set_interface_name(s.substr(0, name_end))) return LineError::interface;
+  const std::string_view name = s.substr(0, name_end);
+  // Interface names are printable (Linux dev_valid_name also forbids '/' and ':').
+  for (const char c : name)
+    if (c <= ' ' || c > '~' || c == '/' || c == ':') return LineError::interface;
+  if (!out.set_interface_name(name)) return LineError::interface;
   s.remove_prefix(name_end);
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
 
