@@ -175,3 +175,24 @@ TEST(Units, ConvertsKnownUnitsAndPassesOthersThrough) {
   EXPECT_FALSE(can::si_conversion("furlong").known);
   EXPECT_EQ(can::si_conversion("furlong").si_unit, "furlong");
 }
+
+TEST(InlineSignals, GroupByIdWithAMinimumLength) {
+  std::vector<can::MessageSpec> messages;
+  can::add_inline_signal(messages, 0x201, false, signal("left", 0, 16, can::ByteOrder::intel, true));
+  can::add_inline_signal(messages, 0x201, false, signal("right", 16, 16, can::ByteOrder::intel, true));
+  can::add_inline_signal(messages, 0x18FF0001, true, signal("odo", 7, 32, can::ByteOrder::motorola, false));
+  ASSERT_EQ(messages.size(), 2U);
+  EXPECT_EQ(messages[0].length, 4U);
+  EXPECT_FALSE(messages[0].exact_length);
+  EXPECT_EQ(messages[1].length, 4U);
+  EXPECT_THROW(can::add_inline_signal(messages, 0x800, false, signal("x", 0, 8, can::ByteOrder::intel, false)),
+               std::invalid_argument);
+  EXPECT_THROW(can::add_inline_signal(messages, 1, false, signal("x", 510, 8, can::ByteOrder::intel, false)),
+               std::invalid_argument);
+  can::SignalDecoder decoder(messages);
+  std::vector<double> v(decoder.slot_count());
+  EXPECT_EQ(decoder.decode(frame(0x201, {0xFF, 0xFF, 0x02, 0x00, 0xAA, 0xBB}), v).status, can::DecodeStatus::decoded);
+  EXPECT_EQ(v[decoder.slot("left")], -1);
+  EXPECT_EQ(v[decoder.slot("right")], 2);
+  EXPECT_EQ(decoder.decode(frame(0x201, {0xFF, 0xFF, 0x02}), v).status, can::DecodeStatus::wrong_length);
+}

@@ -31,7 +31,7 @@ SignalDecoder::SignalDecoder(std::span<const MessageSpec> messages, std::span<co
     : standard_index_(2048, -1) {
   std::vector<bool> used(wanted.size(), false);
   for (const MessageSpec& m : messages) {
-    Message out{m.id, m.extended, static_cast<std::uint8_t>(std::min(m.length, 64U)),
+    Message out{m.id, m.extended, static_cast<std::uint8_t>(std::min(m.length, 64U)), m.exact_length,
                 static_cast<std::uint32_t>(signals_.size()), 0, -1};
     // A wanted multiplexed signal needs its selector decoded too.
     bool wants_multiplexed = false;
@@ -130,7 +130,7 @@ DecodeResult SignalDecoder::decode(const Frame& frame, std::span<double> values)
     ++stats_.unknown_id;
     return {DecodeStatus::unknown_id, 0, 0};
   }
-  if (frame.length != m->length) {
+  if (frame.length < m->length || (m->exact && frame.length != m->length)) {
     ++stats_.wrong_length;
     return {DecodeStatus::wrong_length, m->first, m->count};
   }

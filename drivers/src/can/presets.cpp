@@ -1,5 +1,8 @@
 #include "adit/drivers/can/presets.hpp"
 
+#include "adit/drivers/can/frame.hpp"
+
+#include <algorithm>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -33,6 +36,39 @@ MessageSpec canopen_tpdo_position_velocity(unsigned node_id, unsigned pdo, const
   m.signals.push_back(little_endian(prefix + "position", 0, 32, true, ValueType::integer, "counts"));
   m.signals.push_back(little_endian(prefix + "velocity", 32, 32, true, ValueType::integer, velocity_unit));
   return m;
+}
+
+void add_inline_signal(std::vector<MessageSpec>& messages, std::uint32_t id, bool extended, SignalSpec s) {
+  if (id > (extended ? 0x1FFFFFFFU : 0x7FFU))
+    throw std::invalid_argument(fmt::format("signal {}: id {:#x} out of range", s.name, id));
+  if (s.length < 1 || s.length > 64)
+    throw std::invalid_argument(fmt::format("signal {}: length {} not in 1..64", s.name, s.length));
+  if ((s.type == ValueType::float32 && s.length != 32) || (s.type == ValueType::float64 && s.length != 64))
+    throw std::invalid_argument(fmt::format("signal {}: a float needs 32 or 64 bits", s.name));
+  unsigned last = 0;
+  if (s.byte_order == ByteOrder::intel) {
+    last = (s.start_bit + s.length - 1) / 8;
+  } else {
+    last = ((s.start_bit / 8) * 8 + 7 - s.start_bit % 8 + s.length - 1) / 8;
+  }
+  if (last >= 64) throw std::invalid_argument(fmt::format("signal {}: does not fit 64 bytes", s.name));
+  auto it = std::find_if(messages.begin(), messages.end(),
+                         [&](const MessageSpec& m) { return m.id == id && m.extended == extended; });
+  if (it == messages.end()) {
+    MessageSpec m;
+    m.id = id;
+    m.extended = extended;
+    m.name = fmt::format("{}{:X}", extended ? "ID_X" : "ID_", id);
+    m.length = 0;
+    m.exact_length = false;
+    messages.push_back(std::move(m));
+    it = messages.end() - 1;
+  }
+  // FD frames come in DLC steps; round the minimum up to one.
+  unsigned need = last + 1;
+  while (!is_valid_fd_length(need)) ++need;
+  it->length = std::max(it->length, need);
+  it->signals.push_back(std::move(s));
 }
 
 MessageSpec odrive_encoder_estimates(unsigned node_id, const std::string& prefix) {

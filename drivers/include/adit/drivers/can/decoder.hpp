@@ -24,7 +24,7 @@ struct DecodedSignal {
 enum class DecodeStatus : std::uint8_t {
   decoded,       // the slots [first, first + count) were written
   unknown_id,    // no selected signal in this message: ignored, counted
-  wrong_length,  // known id, payload length differs from the message's: counted, not decoded
+  wrong_length,  // known id, payload length differs from the message's (or is below an inline minimum): counted, not decoded
   not_data,      // error or remote frame
 };
 
@@ -78,6 +78,7 @@ class SignalDecoder {
     std::uint32_t id = 0;
     bool extended = false;
     std::uint8_t length = 0;
+    bool exact = true;  // else `length` is a minimum
     std::uint32_t first = 0;
     std::uint32_t count = 0;
     int selector = -1;  // index into layouts_ of the multiplexer signal, if any

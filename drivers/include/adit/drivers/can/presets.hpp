@@ -1,5 +1,6 @@
 #pragma once
-// Message definitions for two common wheel-encoder interfaces, so a config
+// Message definitions for two common wheel-encoder interfaces (and
+// add_inline_signal, declared in signal.hpp, for signals written in the config), so a config
 // can say "canopen node 3" instead of spelling out bit layouts.
 
 #include <cstdint>

@@ -47,7 +47,13 @@ struct MessageSpec {
   bool extended = false;  // 29-bit identifier
   std::string name;
   unsigned length = 8;  // expected payload length (DLC); frames of other lengths are counted, not decoded
+  bool exact_length = true;  // false: `length` is a minimum (inline signals), longer frames decode too
   std::vector<SignalSpec> signals;
 };
+
+// Signals written inline in the config carry their own id; this groups them
+// into messages whose minimum length covers every signal. Throws
+// std::invalid_argument naming the signal when it cannot fit a CAN FD frame.
+void add_inline_signal(std::vector<MessageSpec>& messages, std::uint32_t id, bool extended, SignalSpec signal);
 
 }  // namespace adit::drivers::can
