@@ -23,14 +23,19 @@ Eigen::Vector2d position_at(std::span<const PlanarPosition> ref, double t) {
 // Cumulative wheel travel (trapezoid rule) at each sample, interpolated between.
 class WheelTravel {
  public:
-  explicit WheelTravel(std::span<const WheelSpeedSample> w) : t_(w.size()), left_(w.size()), right_(w.size()) {
-    for (std::size_t i = 0; i < w.size(); ++i) {
-      t_[i] = w[i].t;
-      if (i == 0) continue;
-      const double dt = w[i].t - w[i - 1].t;
-      left_[i] = left_[i - 1] + 0.5 * (w[i].left + w[i - 1].left) * dt;
-      right_[i] = right_[i - 1] + 0.5 * (w[i].right + w[i - 1].right) * dt;
+  // Samples whose time does not increase, or that are not finite, are skipped.
+  explicit WheelTravel(std::span<const WheelSpeedSample> w) {
+    const WheelSpeedSample* last = nullptr;
+    for (const WheelSpeedSample& s : w) {
+      if (!std::isfinite(s.t) || !std::isfinite(s.left) || !std::isfinite(s.right)) continue;
+      if (last != nullptr && !(s.t > last->t)) continue;
+      const double dt = last != nullptr ? s.t - last->t : 0.0;
+      t_.push_back(s.t);
+      left_.push_back(last != nullptr ? left_.back() + 0.5 * (s.left + last->left) * dt : 0.0);
+      right_.push_back(last != nullptr ? right_.back() + 0.5 * (s.right + last->right) * dt : 0.0);
+      last = &s;
     }
+    if (t_.size() < 2) throw std::invalid_argument("calibration needs at least two wheel samples with increasing times");
   }
   // (left, right) travelled since the first sample, at encoder time t.
   std::pair<double, double> at(double t) const {
@@ -120,6 +125,9 @@ std::vector<Pose2> dead_reckon(std::span<const WheelSpeedSample> wheels, double 
 CalibrationResult calibrate_wheels(std::span<const WheelSpeedSample> wheels, std::span<const PlanarPosition> reference,
                                    const CalibrationOptions& o) {
   if (wheels.size() < 2 || reference.size() < 2) throw std::invalid_argument("calibration needs wheel and reference samples");
+  if (!(o.window > 0) || !(o.heading_span > 0) || !(o.sigma_distance > 0) || !(o.sigma_heading > 0) ||
+      !(o.max_time_offset >= 0) || !(o.nominal.effective_track() > 0))
+    throw std::invalid_argument("calibration options: window, heading span, sigmas and track must be positive");
   const WheelTravel travel(wheels);
   const double margin = o.max_time_offset + o.heading_span;
   const double t_begin = std::max(reference.front().t, wheels.front().t) + margin;

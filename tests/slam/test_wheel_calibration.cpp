@@ -76,3 +76,17 @@ TEST(WheelCalibration, TooLittleOverlapIsAnError) {
   const std::vector<slam::PlanarPosition> reference{{100, 0, 0}, {101, 1, 0}};
   EXPECT_THROW(slam::calibrate_wheels(wheels, reference, {}), std::invalid_argument);
 }
+
+TEST(WheelCalibration, SkipsSamplesWhoseTimeGoesBackAndRejectsBadOptions) {
+  Simulated s = simulate(1.0, 1.0, 1.6, 0.0);
+  // Duplicate and out-of-order samples with nonsense speeds must be ignored.
+  s.wheels.insert(s.wheels.begin() + 500, {s.wheels[499].t, 99.0, -99.0});
+  s.wheels.insert(s.wheels.begin() + 900, {s.wheels[100].t, 99.0, -99.0});
+  slam::CalibrationOptions o;
+  o.nominal.track_width = 1.6;
+  const slam::CalibrationResult r = slam::calibrate_wheels(s.wheels, s.reference, o);
+  EXPECT_NEAR(r.left_scale, 1.0, 2e-3);
+  EXPECT_NEAR(r.effective_track, 1.6, 0.01);
+  o.window = 0.0;
+  EXPECT_THROW(slam::calibrate_wheels(s.wheels, s.reference, o), std::invalid_argument);
+}

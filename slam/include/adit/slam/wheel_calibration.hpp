@@ -82,6 +82,8 @@ CalibrationResult calibrate_wheels(std::span<const WheelSpeedSample> wheels, std
 
 // Wheel dead reckoning from `start` over reference times [t0, t1] (encoder
 // samples shifted by time_offset), returning the poses at each sample.
+// Samples whose time does not increase are skipped; throws
+// std::invalid_argument when fewer than two remain.
 std::vector<Pose2> dead_reckon(std::span<const WheelSpeedSample> wheels, double left_scale, double right_scale,
                                double effective_track, double time_offset, const Pose2& start, double t0, double t1);
 

@@ -38,7 +38,6 @@ struct Frame {
     interface[n] = '\0';
     return n == name.size();
   }
-  std::uint8_t payload(std::size_t i) const { return data[i]; }
 };
 
 // Equal in everything that is carried, payload compared up to `length`.
