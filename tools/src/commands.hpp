@@ -13,5 +13,7 @@ void register_bench_commands(CLI::App& app, int& status);
 
 void register_lidar_commands(CLI::App& app, int& status);
 void register_eval_commands(CLI::App& app, int& status);
+void register_can_commands(CLI::App& app, int& status);
+void register_calibrate_wheels_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
     adit::tools::register_bench_commands(app, status);
     adit::tools::register_lidar_commands(app, status);
     adit::tools::register_eval_commands(app, status);
+    adit::tools::register_can_commands(app, status);
+    adit::tools::register_calibrate_wheels_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {
