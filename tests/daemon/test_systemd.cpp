@@ -1,0 +1,93 @@
+// aditd under a systemd-like supervisor: the test binds a NOTIFY_SOCKET and
+// sets WATCHDOG_USEC as systemd does, runs aditd on a real capture, and reads
+// the sd_notify(3) datagrams: READY=1 once, WATCHDOG=1 while the workers are
+// alive, STATUS= lines, STOPPING=1 at the end. Also checks the unit file.
+
+#include <gtest/gtest.h>
+
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <thread>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "run_program.hpp"
+#include "shared_data.hpp"
+
+namespace adit::test {
+namespace {
+
+TEST(Systemd, AditdNotifiesReadyWatchdogStatusAndStopping) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-hdl32e");
+  const std::string socket_path = (binary_dir() / fmt::format("notify-{}.sock", getpid())).string();
+  ::unlink(socket_path.c_str());
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", socket_path.c_str());
+  ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
+
+  const std::string config = (binary_dir() / "systemd-test.yaml").string();
+  std::ofstream(config) << fmt::format(
+      "payload:\n  id: test\n  state_dir: {}\nlidar:\n  model: HDL-32E\n  source: pcap\n  pcap: {}\n"
+      "  calibration: {}\n  replay_speed: 0.25\nthreads:\n  lock_memory: false\n",
+      (binary_dir() / "systemd-test-state").string(), (dir / "capture.pcap").string(), (dir / "HDL32.yaml").string());
+  // Read as systemd does, while aditd runs: a full datagram queue would block its sd_notify.
+  std::vector<std::string> messages;
+  std::atomic<bool> done{false};
+  std::thread reader([&] {
+    std::array<char, 4096> buffer{};
+    while (true) {
+      const ssize_t n = ::recv(fd, buffer.data(), buffer.size(), 0);
+      if (n > 0) {
+        messages.emplace_back(buffer.data(), static_cast<std::size_t>(n));
+      } else if (done.load()) {
+        break;
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+  });
+  ::setenv("NOTIFY_SOCKET", socket_path.c_str(), 1);
+  ::setenv("WATCHDOG_USEC", "400000", 1);  // aditd checks and pets every 200 ms
+  const ProgramResult r = run_program({(binary_dir() / "bin/aditd").string(), "--config", config});
+  ::unsetenv("NOTIFY_SOCKET");
+  ::unsetenv("WATCHDOG_USEC");
+  done = true;
+  reader.join();
+  ::close(fd);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  ASSERT_FALSE(messages.empty());
+  ::unlink(socket_path.c_str());
+
+  const auto count = [&](const std::string& prefix) {
+    return std::count_if(messages.begin(), messages.end(), [&](const std::string& m) { return m.rfind(prefix, 0) == 0; });
+  };
+  EXPECT_EQ(count("READY=1"), 1);
+  EXPECT_GE(count("WATCHDOG=1"), 5);  // the 0.5 s capture replayed at 0.25x: about 2 s, a pet every 0.2 s
+  EXPECT_GE(count("STATUS=scans"), 5);
+  EXPECT_EQ(count("STOPPING=1"), 1);
+  EXPECT_EQ(messages.back(), "STOPPING=1");
+}
+
+TEST(Systemd, UnitIsTypeNotifyWithWatchdogRestartLimitsAndStateDirectory) {
+  std::ifstream unit(source_dir() / "systemd/aditd.service");
+  ASSERT_TRUE(unit.good());
+  std::stringstream text;
+  text << unit.rdbuf();
+  for (const char* line : {"Type=notify", "WatchdogSec=", "Restart=on-failure", "LimitRTPRIO=", "LimitMEMLOCK=infinity",
+                           "StateDirectory=aditd", "--check-config"})
+    EXPECT_NE(text.str().find(line), std::string::npos) << line;
+  // These two would break real time and GPIO (see FIELD-NOTES): they must not be set.
+  EXPECT_EQ(text.str().find("\nRestrictRealtime=yes"), std::string::npos);
+  EXPECT_EQ(text.str().find("\nPrivateDevices=yes"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace adit::test
