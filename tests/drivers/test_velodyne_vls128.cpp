@@ -166,7 +166,9 @@ TEST(VelodyneVls128Dual, IgnoresPaddingAndRejectsMisplacedBanks) {
   const DecodedPacket padded = decoder.decode(vls128_dual_packet(100, 5'000, e, 0xFF), 0);
   ASSERT_EQ(padded.status, PacketStatus::ok);
   ASSERT_EQ(padded.points.size(), expected.size());
-  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(padded.points[i].point.range_m, expected[i].point.range_m);
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(padded.points[i].point.range_m, expected[i].point.range_m);
+  }
 
   auto bank_order = vls128_dual_packet(100, 5'000, e);
   bank_order[1 * 100 + 1] = 0xDD;  // the single-return order FFEE, FFDD, ... instead of pairs

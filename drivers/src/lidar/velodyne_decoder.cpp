@@ -252,7 +252,8 @@ int VelodyneDecoder::reference_azimuth(const std::array<int, kBlocks>& azimuth, 
 int VelodyneDecoder::advance_from_previous_packet(std::uint32_t us_past_hour, int azimuth) {
   constexpr std::int64_t kHourUs = 3'600'000'000;
   if (previous_group_) {
-    const std::int64_t dt_ns = (us_past_hour - static_cast<std::int64_t>(previous_group_->first) + kHourUs) % kHourUs * 1000;
+    const std::int64_t dt_us = us_past_hour - static_cast<std::int64_t>(previous_group_->first);
+    const std::int64_t dt_ns = (dt_us + kHourUs) % kHourUs * 1000;  // across the hour too
     const int moved = (azimuth - previous_group_->second + kAzimuthSteps) % kAzimuthSteps;
     // Only from a recent packet (a few lost at most), and not across a field-of-view gap.
     if (dt_ns > 0 && dt_ns <= 8 * static_cast<std::int64_t>(group_ns_)) {

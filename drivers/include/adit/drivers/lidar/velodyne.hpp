@@ -84,7 +84,9 @@ enum class VelodyneAzimuthModel : std::uint8_t {
   // azimuth advanced by the share of the rotation to the next firing group
   // elapsed at the firing (its time from the firing-timing table); the last
   // group of a packet reuses the previous advance; both blocks of a dual pair
-  // share their azimuth. The rotational correction is applied exactly.
+  // share their azimuth. A VLS-128 dual packet holds a single group: its
+  // advance is measured from the previous packet. The rotational correction is
+  // applied exactly.
   manual,
   // Reproduces the ROS velodyne_pointcloud / Autoware nebula decoders, to
   // compare against clouds they produced: the last block (dual: the last pair)
