@@ -49,6 +49,23 @@ constexpr std::array<ModelSpec, 4> kModels{{
 
 const ModelSpec& spec(VelodyneModel model) { return kModels[static_cast<std::size_t>(model)]; }
 
+// How a packet's blocks hold firing groups in one return mode.
+struct BlockLayout {
+  std::size_t blocks;  // blocks carrying data, from the first
+  std::size_t step;    // blocks per firing group
+  std::size_t pair;    // blocks per bank: 2 in dual mode (last, strongest), else 1
+};
+
+// Dual mode doubles every block of a group into a (last, strongest) pair. A
+// firing sequence may not span two packets (VLS-128 manual §9.3.1.1), so a
+// VLS-128 dual packet holds one sequence in 8 blocks (FFEE, FFEE, FFDD, FFDD,
+// FFCC, FFCC, FFBB, FFBB) and its last 4 blocks are padding.
+BlockLayout block_layout(const ModelSpec& m, bool dual) {
+  const std::size_t pair = dual ? 2 : 1;
+  const std::size_t step = pair * m.blocks_per_group;
+  return {VelodyneDecoder::kBlocks / step * step, step, pair};
+}
+
 // When channel `c` of block `g` (of its group) fires, after the group start, and which laser it is.
 std::pair<std::uint16_t, std::uint32_t> slot_timing(VelodyneModel model, std::size_t g, std::size_t c) {
   switch (model) {
@@ -115,9 +132,8 @@ std::optional<VelodyneReturnMode> velodyne_return_mode_from_packet(std::span<con
 
 std::int64_t velodyne_packet_period_ns(VelodyneModel model, VelodyneReturnMode mode) {
   const ModelSpec& m = spec(model);
-  const std::int64_t groups = static_cast<std::int64_t>(VelodyneDecoder::kBlocks / m.blocks_per_group);
-  const std::int64_t period = groups * m.group_ns;
-  return mode == VelodyneReturnMode::dual ? period / 2 : period;
+  const BlockLayout layout = block_layout(m, mode == VelodyneReturnMode::dual);
+  return static_cast<std::int64_t>(layout.blocks / layout.step) * m.group_ns;
 }
 
 std::size_t velodyne_lasers(VelodyneModel model) { return spec(model).lasers; }
@@ -233,6 +249,22 @@ int VelodyneDecoder::reference_azimuth(const std::array<int, kBlocks>& azimuth, 
   }
 }
 
+int VelodyneDecoder::advance_from_previous_packet(std::uint32_t us_past_hour, int azimuth) {
+  constexpr std::int64_t kHourUs = 3'600'000'000;
+  if (previous_group_) {
+    const std::int64_t dt_us = us_past_hour - static_cast<std::int64_t>(previous_group_->first);
+    const std::int64_t dt_ns = (dt_us + kHourUs) % kHourUs * 1000;  // across the hour too
+    const int moved = (azimuth - previous_group_->second + kAzimuthSteps) % kAzimuthSteps;
+    // Only from a recent packet (a few lost at most), and not across a field-of-view gap.
+    if (dt_ns > 0 && dt_ns <= 8 * static_cast<std::int64_t>(group_ns_)) {
+      const long advance = std::lround(static_cast<double>(moved) * group_ns_ / static_cast<double>(dt_ns));
+      if (advance <= kGapCentideg) carried_advance_ = static_cast<int>(advance);
+    }
+  }
+  previous_group_ = std::pair{us_past_hour, azimuth};
+  return carried_advance_;
+}
+
 DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) {
   DecodedPacket out;
   const std::uint8_t* p = payload.data();
@@ -244,16 +276,14 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
     return out;
   }
   const bool dual = mode_byte == 0x39;
-  if (dual && blocks_per_group_ != 1) {  // VLS-128 dual-return layout is not supported
-    out.status = PacketStatus::malformed;
-    return out;
-  }
-  // Validate every block before decoding any: a damaged packet yields no points.
+  const BlockLayout layout = block_layout(spec(model_), dual);
+  // Validate every data block before decoding any: a damaged packet yields no points.
   std::array<int, kBlocks> azimuth{};
-  for (std::size_t b = 0; b < kBlocks; ++b) {
+  for (std::size_t b = 0; b < layout.blocks; ++b) {
     const std::uint8_t* block = p + b * kBlockSize;
     const std::uint16_t flag = static_cast<std::uint16_t>(block[0] << 8 | block[1]);
-    const std::uint16_t want = blocks_per_group_ == 1 ? 0xFFEE : static_cast<std::uint16_t>(0xFFEE - 0x11 * (b % 4));
+    const std::size_t bank = (b % layout.step) / layout.pair;  // VLS-128 banks: FFEE, FFDD, FFCC, FFBB
+    const std::uint16_t want = static_cast<std::uint16_t>(0xFFEE - 0x11 * bank);
     azimuth[b] = le16(block + 2);
     if (flag != want || azimuth[b] >= kAzimuthSteps) {
       out.status = b == 0 && flag != want ? PacketStatus::foreign : PacketStatus::malformed;
@@ -269,12 +299,12 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
 
   const std::int64_t packet_ns = clock_.resolve(us_past_hour, host_time_ns);
   out.sensor_time_ns = packet_ns;
-  // Blocks of one firing group: 1 (or 2 in dual mode, last then strongest) or the VLS-128's 4 banks.
-  const std::size_t step = dual ? 2 : blocks_per_group_;
+  // Blocks of one firing group: 1 or the VLS-128's 4 banks, doubled in dual mode.
+  const std::size_t step = layout.step;
   const float min_range = config_.min_range_m;
   const float max_range = config_.max_range_m;
   const bool reference_mode = config_.azimuth_model == VelodyneAzimuthModel::reference_decoders;
-  const std::size_t groups = kBlocks / step;
+  const std::size_t groups = layout.blocks / step;
   // The azimuth advance from each firing group to the next, for interpolating
   // the firings in between. Sensors with a restricted field of view skip the
   // rest of the turn inside a packet: an advance far beyond the usual one is
@@ -297,12 +327,14 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
     }
   }
   const double usual = regular_count > 0 ? static_cast<double>(regular_sum) / regular_count : 0.0;
+  // A packet of one group (VLS-128 dual) has no next group inside it: the advance comes from the previous packet.
+  const int lone_group_advance = groups == 1 ? advance_from_previous_packet(us_past_hour, azimuth[0]) : 0;
   std::array<std::int64_t, kBlocks> group_time{};
   std::int64_t gap_ns = 0;
   for (std::size_t k = 0; k < groups; ++k) {
     group_time[k] = packet_ns + static_cast<std::int64_t>(k) * group_ns_ + gap_ns;
     if (k + 1 == groups) {
-      advance[k] = k > 0 ? advance[k - 1] : 0;  // the last group: the previous advance
+      advance[k] = k > 0 ? advance[k - 1] : lone_group_advance;  // the last group: the previous advance
     } else if (usual > 0.0 && advance[k] > gap_above) {
       gap_ns += std::llround((advance[k] - usual) * group_ns_ / usual);
       advance[k] = static_cast<int>(std::lround(usual));
@@ -310,7 +342,7 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
     }
   }
   std::size_t n = 0;
-  for (std::size_t b = 0; b < kBlocks; ++b) {
+  for (std::size_t b = 0; b < layout.blocks; ++b) {
     const std::size_t group = b / step;
     const int azimuth_diff = advance[group];
     const std::uint8_t* block = p + b * kBlockSize + 4;
@@ -318,7 +350,7 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
     const std::uint8_t* partner = nullptr;
     if (dual) partner = b % 2 == 0 ? block + kBlockSize : block - kBlockSize;
     const bool last_block = dual && b % 2 == 0;
-    const Slot* slots = slots_.data() + (dual ? 0 : (b % blocks_per_group_) * kChannels);
+    const Slot* slots = slots_.data() + (b % step) / layout.pair * kChannels;  // the block's bank
     const std::int64_t group_ns = group_time[group];
     for (std::size_t c = 0; c < kChannels; ++c) {
       const std::uint8_t* m = block + 3 * c;

@@ -11,6 +11,8 @@
 // Sources: VLP-16 User Manual rev. E §9 (packet format, "Firing timing",
 // "Precision azimuth calculation"); VLP-32C User Manual rev. B §9;
 // HDL-32E User Manual §9 and appendix; VLS-128 User Manual (63-9480) §9.
+// VLS-128 dual return: one firing sequence per packet, blocks 0-7 = banks
+// FFEE, FFDD, FFCC, FFBB each as a (last, strongest) pair, blocks 8-11 padding.
 
 #include <array>
 #include <cstdint>
@@ -18,6 +20,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "adit/drivers/lidar/decoder.hpp"
@@ -81,7 +84,9 @@ enum class VelodyneAzimuthModel : std::uint8_t {
   // azimuth advanced by the share of the rotation to the next firing group
   // elapsed at the firing (its time from the firing-timing table); the last
   // group of a packet reuses the previous advance; both blocks of a dual pair
-  // share their azimuth. The rotational correction is applied exactly.
+  // share their azimuth. A VLS-128 dual packet holds a single group: its
+  // advance is measured from the previous packet. The rotational correction is
+  // applied exactly.
   manual,
   // Reproduces the ROS velodyne_pointcloud / Autoware nebula decoders, to
   // compare against clouds they produced: the last block (dual: the last pair)
@@ -141,6 +146,10 @@ class VelodyneDecoder final : public LidarDecoder {
   // with `rot_applied` set when the rotational correction is already in it.
   int reference_azimuth(const std::array<int, 12>& azimuth, std::size_t b, std::size_t c, bool dual, const Laser& laser,
                         bool& rot_applied) const;
+  // For packets holding one firing group (VLS-128 dual): the azimuth advance per
+  // group (0.01°) measured from the previous such packet; the last good one
+  // when that packet is too old or the step is a gap; 0 before any.
+  int advance_from_previous_packet(std::uint32_t us_past_hour, int azimuth);
 
   VelodyneModel model_;
   VelodyneCalibration calibration_;
@@ -157,6 +166,8 @@ class VelodyneDecoder final : public LidarDecoder {
   TopOfHourClock clock_;
   std::uint64_t model_mismatches_ = 0;
   std::uint64_t fov_gaps_ = 0;
+  std::optional<std::pair<std::uint32_t, int>> previous_group_;  // µs past the hour, azimuth
+  int carried_advance_ = 0;
 };
 
 }  // namespace adit::drivers
