@@ -12,4 +12,9 @@ void register_config_commands(CLI::App& app, int& status);
 
 void register_lidar_commands(CLI::App& app, int& status);
 
+// status, watch, start, stop, sessions, ping (the tablet protocol)
+void register_client_commands(CLI::App& app, int& status);
+
+void register_download_commands(CLI::App& app, int& status);
+
 }  // namespace adit::tools
