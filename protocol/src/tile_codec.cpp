@@ -3,6 +3,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -72,16 +73,21 @@ std::vector<std::uint8_t> encode_tile(TileKey key, std::span<const MapPoint> poi
   const double ox = key.x * params.tile_size_m;
   const double oy = key.y * params.tile_size_m;
   const double oz = key.z * params.tile_size_m;
+  // Points are sorted by their quantised (x, y, z): the order inside a tile
+  // carries no meaning, and sorted columns compress several times better
+  // than the arbitrary order of a voxel hash map (bench_tile_stream).
+  std::vector<std::array<std::uint16_t, 4>> quantised(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const MapPoint& p = points[i];
+    quantised[i] = {quantise(p.x, ox, params.quantum_m), quantise(p.y, oy, params.quantum_m),
+                    quantise(p.z, oz, params.quantum_m), quantise(p.intensity, 0.0, 1.0)};
+  }
+  std::sort(quantised.begin(), quantised.end());
   // Columns compress better than interleaved records: neighbouring values of
   // one axis share their high bytes.
   std::vector<std::uint16_t> columns(4 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const MapPoint& p = points[i];
-    columns[i] = quantise(p.x, ox, params.quantum_m);
-    columns[n + i] = quantise(p.y, oy, params.quantum_m);
-    columns[2 * n + i] = quantise(p.z, oz, params.quantum_m);
-    columns[3 * n + i] = quantise(p.intensity, 0.0, 1.0);
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < 4; ++c) columns[c * n + i] = quantised[i][c];
   const std::size_t raw_size = columns.size() * sizeof(std::uint16_t);
   std::vector<std::uint8_t> blob(kTileHeaderBytes + ZSTD_compressBound(raw_size));
   std::memcpy(blob.data(), "ADT1", 4);

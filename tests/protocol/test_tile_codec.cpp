@@ -1,7 +1,9 @@
 // Tile ids, quantisation, compression and chunking.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <random>
 
 #include "adit/protocol/channels.hpp"
@@ -38,6 +40,15 @@ TEST(TileId, PointsFallIntoTheFloorOfTheirCoordinates) {
   EXPECT_EQ(tile_of(std::nan(""), 1e30, -1e30, 20.0).y, kTileCoordinateLimit - 1);
 }
 
+// Points in a canonical order (the codec sorts them; order carries no meaning).
+std::vector<MapPoint> sorted_by_mm(std::vector<MapPoint> points) {
+  const auto mm = [](const MapPoint& p) {
+    return std::make_tuple(std::lround(p.x * 1000), std::lround(p.y * 1000), std::lround(p.z * 1000), p.intensity);
+  };
+  std::sort(points.begin(), points.end(), [&](const MapPoint& a, const MapPoint& b) { return mm(a) < mm(b); });
+  return points;
+}
+
 TEST(TileCodec, RoundTripIsWithinHalfAQuantum) {
   const TileParams params;
   const TileKey key{3, -2, 0};
@@ -46,15 +57,25 @@ TEST(TileCodec, RoundTripIsWithinHalfAQuantum) {
   std::vector<MapPoint> back;
   ASSERT_EQ(decode_tile(blob, key, back), "");
   ASSERT_EQ(back.size(), points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    EXPECT_NEAR(back[i].x, points[i].x, 0.5 * params.quantum_m + 1e-6);
-    EXPECT_NEAR(back[i].y, points[i].y, 0.5 * params.quantum_m + 1e-6);
-    EXPECT_NEAR(back[i].z, points[i].z, 0.5 * params.quantum_m + 1e-6);
-    EXPECT_EQ(back[i].intensity, points[i].intensity);
+  const auto a = sorted_by_mm(points);
+  const auto b = sorted_by_mm(back);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(b[i].x, a[i].x, 0.5 * params.quantum_m + 1e-6);
+    EXPECT_NEAR(b[i].y, a[i].y, 0.5 * params.quantum_m + 1e-6);
+    EXPECT_NEAR(b[i].z, a[i].z, 0.5 * params.quantum_m + 1e-6);
+    EXPECT_EQ(b[i].intensity, a[i].intensity);
   }
   // 8 bytes per point before compression; random points barely compress, but
   // the header and frame overhead must stay small.
   EXPECT_LT(blob.size(), points.size() * kBytesPerQuantisedPoint + 200);
+}
+
+TEST(TileCodec, TheEncodingDoesNotDependOnThePointOrder) {
+  const TileKey key{0, 0, 0};
+  auto points = random_points(key, 20.0, 2000, 4);
+  const auto blob = encode_tile(key, points, {});
+  std::reverse(points.begin(), points.end());
+  EXPECT_EQ(encode_tile(key, points, {}), blob);
 }
 
 TEST(TileCodec, RejectsParametersThatDoNotFitUint16) {

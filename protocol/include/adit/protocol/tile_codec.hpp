@@ -8,7 +8,7 @@
 //   char[4] "ADT1", u16 format (1), u16 flags (0), u32 n_points,
 //   f32 tile_size_m, f32 quantum_m, then a zstd frame (with its content
 //   checksum) holding
-//   u16 qx[n], u16 qy[n], u16 qz[n], u16 intensity[n].
+//   u16 qx[n], u16 qy[n], u16 qz[n], u16 intensity[n], sorted by (qx, qy, qz).
 // A point is  origin + q * quantum, origin = tile coordinate * tile_size.
 
 #include <cstddef>
