@@ -360,6 +360,15 @@ TEST(LcmEndpoint, BadCommandsAreRejectedOrIgnoredAndTheStateStays) {
   EXPECT_EQ(h.endpoint->state(), SessionState::mapping);
 }
 
+TEST(LcmEndpoint, DownloadOfASessionTheDaemonDoesNotHoldSaysSo) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  const auto r = h.adit({"download", "--session", "s9", "--format", "ply", "--out", "/nonexistent/x.ply"}, 2);
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("download failed: session 's9' is not held by this daemon (it holds 's1')"), std::string::npos)
+      << r.err;
+}
+
 TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {
   const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 50000 + ::getpid() % 10000);
   const auto adit = (test::binary_dir() / "bin" / "adit").string();
