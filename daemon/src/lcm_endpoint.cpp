@@ -156,7 +156,14 @@ struct LcmEndpoint::Impl {
       ack.accepted = false;
       ack.reason = r.reason;
     } else {
-      execute(r.verb, r.command, ack);
+      // A hook that throws must not take the endpoint thread down: the
+      // command is answered as failed and the state stays as it was.
+      try {
+        execute(r.verb, r.command, ack);
+      } catch (const std::exception& e) {
+        ack.accepted = false;
+        ack.reason = fmt::format("{} failed: {}", protocol::verb_name(r.verb), e.what());
+      }
     }
     (ack.accepted ? counters.commands_executed : counters.commands_rejected)++;
     ack.state = static_cast<std::int8_t>(machine.state());
@@ -202,13 +209,16 @@ struct LcmEndpoint::Impl {
     }
   }
 
+  // The hooks run before the machine moves, so a hook that throws leaves the
+  // state unchanged.
   void apply_transition(protocol::SessionEvent event, command_ack_t& ack) {
-    const protocol::Transition t = machine.apply(event);
+    const protocol::Transition t = protocol::next_state(machine.state(), event);
     ack.accepted = t.accepted;
     ack.reason = t.reason;
     if (!t.accepted) return;
     if (event == protocol::SessionEvent::start) {
-      session_id = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
+      std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
+      session_id = std::move(started);
       store = TileStore(options.tiles);
       dirty.clear();
       outgoing.clear();
@@ -218,6 +228,7 @@ struct LcmEndpoint::Impl {
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
       hooks.stop();
     }
+    machine.apply(event);
     published_state = machine.state();
   }
 
@@ -228,9 +239,14 @@ struct LcmEndpoint::Impl {
       pending.swap(events);
     }
     for (const protocol::SessionEvent event : pending) {
-      command_ack_t ignored;
-      apply_transition(event, ignored);
-      if (!ignored.accepted) log::warn("session: {} ({})", ignored.reason, protocol::state_name(machine.state()));
+      command_ack_t result;
+      try {
+        apply_transition(event, result);
+      } catch (const std::exception& e) {
+        result.accepted = false;
+        result.reason = e.what();
+      }
+      if (!result.accepted) log::warn("session: {} ({})", result.reason, protocol::state_name(machine.state()));
     }
   }
 

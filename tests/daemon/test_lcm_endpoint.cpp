@@ -360,6 +360,21 @@ TEST(LcmEndpoint, BadCommandsAreRejectedOrIgnoredAndTheStateStays) {
   EXPECT_EQ(h.endpoint->state(), SessionState::mapping);
 }
 
+TEST(LcmEndpoint, AFailingStartHookIsRejectedAndLeavesTheStateIdle) {
+  EndpointOptions o;
+  o.lcm_url = unique_url();
+  o.payload_id = fmt::format("fail-{}", ::getpid());
+  SessionHooks hooks;
+  hooks.start = []() -> std::string { throw std::runtime_error("disk full"); };
+  LcmEndpoint endpoint(o, hooks);
+  const auto adit = (test::binary_dir() / "bin" / "adit").string();
+  const auto r =
+      test::run_program({adit, "start", "--payload", o.payload_id, "--lcm-url", o.lcm_url, "--timeout", "3"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("START rejected: START failed: disk full (state IDLE)"), std::string::npos) << r.err;
+  EXPECT_EQ(endpoint.state(), SessionState::idle);
+}
+
 TEST(LcmEndpoint, DownloadOfASessionTheDaemonDoesNotHoldSaysSo) {
   Harness h;
   ASSERT_EQ(h.adit({"start"}).exit_status, 0);
