@@ -21,6 +21,7 @@
 #include "adit/daemon/tile_store.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
 #include "adit/protocol/command_gate.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_chunk_t.hpp"
@@ -367,8 +368,7 @@ struct LcmEndpoint::Impl {
 
   void on_tile_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
     tile_request_t r;
-    if (r.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size) ||
-        r.payload_id != options.payload_id) {
+    if (!protocol::checked_decode(rbuf->data, rbuf->data_size, r) || r.payload_id != options.payload_id) {
       ++counters.tile_requests_malformed;
       return;
     }

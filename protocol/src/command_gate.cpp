@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "adit/protocol/checked_decode.hpp"
+
 namespace adit::protocol {
 
 std::optional<Verb> parse_verb(std::string_view text) {
@@ -29,8 +31,7 @@ CommandGate::CommandGate(std::string payload_id, std::size_t window)
 
 GateResult CommandGate::inspect(const void* data, std::size_t size) {
   GateResult result;
-  if (size > static_cast<std::size_t>(INT32_MAX) ||
-      result.command.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) {
+  if (!checked_decode(data, size, result.command)) {
     ++counts_.malformed;
     result.reason = fmt::format("{} bytes that are not an adit.command_t", size);
     return result;

@@ -7,13 +7,14 @@
 #include <span>
 #include <vector>
 
+#include "adit/protocol/checked_decode.hpp"
 #include "adit/protocol/tile_assembler.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/tile_chunk_t.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   adit::tile_chunk_t chunk;
-  if (size < (1u << 20) && chunk.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size)) {
+  if (adit::protocol::checked_decode(data, size, chunk)) {
     adit::protocol::TileAssembler assembler;
     assembler.note_index(chunk.tile_id, chunk.version, chunk.n_chunks);
     assembler.add_chunk(chunk);

@@ -11,6 +11,7 @@
 #include "adit/command_t.hpp"
 #include "adit/common/error.hpp"
 #include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
 #include "adit/tile_chunk_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
@@ -32,8 +33,7 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 template <typename Message>
 std::optional<Message> decode(const lcm::ReceiveBuffer* rbuf) {
   Message m;
-  if (m.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size))
-    return std::nullopt;
+  if (!protocol::checked_decode(rbuf->data, rbuf->data_size, m)) return std::nullopt;
   return m;
 }
 
