@@ -10,7 +10,6 @@
 #include <set>
 #include <stdexcept>
 #include <thread>
-#include <tuple>
 
 #include <fmt/format.h>
 
@@ -303,9 +302,15 @@ struct LcmEndpoint::Impl {
     const auto now = Clock::now();
     if (dirty.empty() || now - last_tile_broadcast < std::chrono::duration<double>(options.tile_period_s)) return;
     last_tile_broadcast = now;
-    for (const std::int64_t id : dirty) queue_tile(*store.find(id), -1);
+    // The index of just the changed tiles: a full one costs 20 bytes per tile
+    // every second; clients ask for it once (want_index).
+    std::vector<const EncodedTile*> changed;
+    for (const std::int64_t id : dirty) {
+      changed.push_back(store.find(id));
+      queue_tile(*changed.back(), -1);
+    }
     dirty.clear();
-    send_index();
+    send_index_parts(changed, false, "");
   }
 
   void queue_tile(const EncodedTile& tile, std::int32_t only_chunk) {
@@ -319,17 +324,17 @@ struct LcmEndpoint::Impl {
   void send_index() {
     std::vector<const EncodedTile*> all;
     for (const auto& [id, tile] : store.tiles()) all.push_back(&tile);
-    send_index_parts(all, "");
+    send_index_parts(all, true, "");
   }
 
-  void send_index_parts(const std::vector<const EncodedTile*>& all, const std::string& error) {
+  void send_index_parts(const std::vector<const EncodedTile*>& all, bool full, const std::string& error) {
     const std::int32_t n_parts =
         static_cast<std::int32_t>(std::max<std::size_t>(1, (all.size() + kIndexEntriesPerPart - 1) / kIndexEntriesPerPart));
     std::array<float, 3> lo{0, 0, 0};
     std::array<float, 3> hi{0, 0, 0};
     bool first = true;
-    for (const EncodedTile* t : all) {
-      const protocol::TileKey k = protocol::tile_key(t->id);
+    for (const auto& [id, tile] : store.tiles()) {  // bounds of the whole map
+      const protocol::TileKey k = protocol::tile_key(id);
       const std::array<double, 3> a{k.x * options.tiles.tile_size_m, k.y * options.tiles.tile_size_m,
                                     k.z * options.tiles.tile_size_m};
       for (int i = 0; i < 3; ++i) {
@@ -347,6 +352,7 @@ struct LcmEndpoint::Impl {
       m.session_id = session_id;
       m.error = error;
       m.tile_size_m = static_cast<float>(options.tiles.tile_size_m);
+      m.full = full;
       m.part = part;
       m.n_parts = n_parts;
       const std::size_t begin = static_cast<std::size_t>(part) * kIndexEntriesPerPart;
@@ -375,7 +381,7 @@ struct LcmEndpoint::Impl {
     ++counters.tile_requests;
     if (!r.session_id.empty() && r.session_id != session_id) {
       // Only the current (or last) session's tiles are held in memory.
-      send_index_parts({}, fmt::format("session '{}' is not held by this daemon (it holds '{}')", r.session_id,
+      send_index_parts({}, true, fmt::format("session '{}' is not held by this daemon (it holds '{}')", r.session_id,
                                        session_id));
       return;
     }

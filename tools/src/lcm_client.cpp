@@ -150,6 +150,7 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
         if (m->session_id != locked) return;
         for (std::size_t i = 0; i < m->tile_ids.size(); ++i)
           tiles.note_index(m->tile_ids[i], m->versions[i], m->n_chunks[i]);
+        if (!m->full) return;  // a broadcast of changed tiles only
         parts.insert(m->part);
         n_parts = m->n_parts;
         last_progress = Clock::now();
