@@ -4,10 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <deque>
 #include <mutex>
-#include <random>
-#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -17,7 +14,7 @@
 #include "adit/common/log.hpp"
 #include "adit/command_ack_t.hpp"
 #include "adit/daemon/spsc_queue.hpp"
-#include "adit/daemon/tile_store.hpp"
+#include "adit/daemon/tile_publisher.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
@@ -38,19 +35,13 @@ std::int64_t now_utime() {
       .count();
 }
 
-// Index entries per tile_index_t: 20 bytes each, 2000 keep a part near 40 KB.
-constexpr std::size_t kIndexEntriesPerPart = 2000;
-
-struct ChunkRef {
-  std::int64_t tile_id;
-  std::int32_t version;
-  std::int32_t chunk;
-  auto operator<=>(const ChunkRef&) const = default;
-};
+TilePublisherOptions publisher_options(const EndpointOptions& o) {
+  return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed};
+}
 
 }  // namespace
 
-struct LcmEndpoint::Impl {
+struct LcmEndpoint::Impl final : TileSink {
   EndpointOptions options;
   SessionHooks hooks;
   lcm::LCM lcm;
@@ -64,16 +55,8 @@ struct LcmEndpoint::Impl {
   protocol::SessionMachine machine;
   std::atomic<protocol::SessionState> published_state{protocol::SessionState::idle};
   std::string session_id;
-  TileStore store;
-  std::set<std::int64_t> dirty;
-  std::deque<ChunkRef> outgoing;
-  std::set<ChunkRef> queued;
-  double send_budget_bytes = 0;
-  Clock::time_point last_budget = Clock::now();
-  Clock::time_point last_tile_broadcast = Clock::now();
+  TilePublisher publisher;
   std::int64_t pose_seq = 0;
-  std::mt19937 drop_rng;
-  std::uniform_real_distribution<double> unit{0.0, 1.0};
   EndpointCounters counters;
   std::atomic<bool> running{true};
   std::thread thread;
@@ -89,8 +72,7 @@ struct LcmEndpoint::Impl {
         statuses(options.queue_capacity),
         tiles(options.queue_capacity),
         gate(options.payload_id, options.command_window),
-        store(options.tiles),
-        drop_rng(options.drop_seed) {
+        publisher(publisher_options(options), *this) {
     if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
       throw InputError("payload id", "payload_id", problem);
     if (const std::string problem = protocol::tile_params_problem(options.tiles); !problem.empty())
@@ -102,7 +84,7 @@ struct LcmEndpoint::Impl {
     thread = std::thread([this] { run(); });
   }
 
-  ~Impl() {
+  ~Impl() override {
     running = false;
     if (thread.joinable()) thread.join();
   }
@@ -121,15 +103,23 @@ struct LcmEndpoint::Impl {
     lcm.publish(channel(c), encode_buffer.data(), static_cast<unsigned>(size));
   }
 
+  void send(const tile_chunk_t& chunk) override { send(Channel::tile, chunk); }
+  void send(const tile_index_t& index) override { send(Channel::tile_index, index); }
+
   void run() {
     while (running) {
       lcm.handleTimeout(2);
       drain_events();
       drain_poses();
       drain_status();
-      drain_tiles();
-      broadcast_changed_tiles();
-      send_chunks();
+      TileUpdate t;
+      while (tiles.pop(t)) publisher.update(t.key, t.points, t.utime);
+      publisher.tick(Clock::now());
+      const TilePublisherCounts& c = publisher.counts();
+      counters.chunks_published = c.chunks_published;
+      counters.chunks_dropped_by_hook = c.chunks_dropped_by_hook;
+      counters.chunk_bytes_published = c.chunk_bytes_published;
+      counters.index_published = c.index_published;
     }
   }
 
@@ -219,10 +209,7 @@ struct LcmEndpoint::Impl {
     if (event == protocol::SessionEvent::start) {
       std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
       session_id = std::move(started);
-      store = TileStore(options.tiles);
-      dirty.clear();
-      outgoing.clear();
-      queued.clear();
+      publisher.reset(session_id);
       pose_seq = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
@@ -283,8 +270,8 @@ struct LcmEndpoint::Impl {
       for (const ThreadLoad& t : s.threads) m.threads.push_back({t.name, t.load, t.queue_depth, t.queue_capacity});
       m.n_threads = static_cast<std::int32_t>(m.threads.size());
       m.disk_free_bytes = s.disk_free_bytes;
-      m.map_points = store.total_points();
-      m.map_tiles = static_cast<std::int32_t>(store.tiles().size());
+      m.map_points = publisher.store().total_points();
+      m.map_tiles = static_cast<std::int32_t>(publisher.store().tiles().size());
       m.fault = s.fault;
       send(Channel::status, m);
       ++counters.status_published;
@@ -293,85 +280,6 @@ struct LcmEndpoint::Impl {
 
   // --- tiles ----------------------------------------------------------------
 
-  void drain_tiles() {
-    TileUpdate t;
-    while (tiles.pop(t)) dirty.insert(store.update(t.key, t.points, t.utime).id);
-  }
-
-  void broadcast_changed_tiles() {
-    const auto now = Clock::now();
-    if (dirty.empty() || now - last_tile_broadcast < std::chrono::duration<double>(options.tile_period_s)) return;
-    last_tile_broadcast = now;
-    // The index of just the changed tiles: a full one costs 20 bytes per tile
-    // every second; clients ask for it once (want_index).
-    std::vector<const EncodedTile*> changed;
-    for (const std::int64_t id : dirty) {
-      changed.push_back(store.find(id));
-      queue_tile(*changed.back(), -1);
-    }
-    dirty.clear();
-    send_index_parts(changed, false, "");
-  }
-
-  void queue_tile(const EncodedTile& tile, std::int32_t only_chunk) {
-    for (std::int32_t c = 0; c < tile.n_chunks; ++c) {
-      if (only_chunk >= 0 && c != only_chunk) continue;
-      const ChunkRef ref{tile.id, tile.version, c};
-      if (queued.insert(ref).second) outgoing.push_back(ref);
-    }
-  }
-
-  void send_index() {
-    std::vector<const EncodedTile*> all;
-    for (const auto& [id, tile] : store.tiles()) all.push_back(&tile);
-    send_index_parts(all, true, "");
-  }
-
-  void send_index_parts(const std::vector<const EncodedTile*>& all, bool full, const std::string& error) {
-    const std::int32_t n_parts =
-        static_cast<std::int32_t>(std::max<std::size_t>(1, (all.size() + kIndexEntriesPerPart - 1) / kIndexEntriesPerPart));
-    std::array<float, 3> lo{0, 0, 0};
-    std::array<float, 3> hi{0, 0, 0};
-    bool first = true;
-    for (const auto& [id, tile] : store.tiles()) {  // bounds of the whole map
-      const protocol::TileKey k = protocol::tile_key(id);
-      const std::array<double, 3> a{k.x * options.tiles.tile_size_m, k.y * options.tiles.tile_size_m,
-                                    k.z * options.tiles.tile_size_m};
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = first ? static_cast<float>(a[i]) : std::min(lo[i], static_cast<float>(a[i]));
-        hi[i] = first ? static_cast<float>(a[i] + options.tiles.tile_size_m)
-                      : std::max(hi[i], static_cast<float>(a[i] + options.tiles.tile_size_m));
-      }
-      first = false;
-    }
-    for (std::int32_t part = 0; part < n_parts; ++part) {
-      tile_index_t m;
-      m.utime = now_utime();
-      m.schema = 1;
-      m.payload_id = options.payload_id;
-      m.session_id = session_id;
-      m.error = error;
-      m.tile_size_m = static_cast<float>(options.tiles.tile_size_m);
-      m.full = full;
-      m.part = part;
-      m.n_parts = n_parts;
-      const std::size_t begin = static_cast<std::size_t>(part) * kIndexEntriesPerPart;
-      const std::size_t end = std::min(all.size(), begin + kIndexEntriesPerPart);
-      for (std::size_t i = begin; i < end; ++i) {
-        m.tile_ids.push_back(all[i]->id);
-        m.versions.push_back(all[i]->version);
-        m.n_chunks.push_back(all[i]->n_chunks);
-        m.n_points.push_back(all[i]->n_points);
-      }
-      m.n_tiles = static_cast<std::int32_t>(m.tile_ids.size());
-      m.total_points = store.total_points();
-      std::copy(lo.begin(), lo.end(), m.bounds_min);
-      std::copy(hi.begin(), hi.end(), m.bounds_max);
-      send(Channel::tile_index, m);
-      ++counters.index_published;
-    }
-  }
-
   void on_tile_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
     tile_request_t r;
     if (!protocol::checked_decode(rbuf->data, rbuf->data_size, r) || r.payload_id != options.payload_id) {
@@ -379,59 +287,7 @@ struct LcmEndpoint::Impl {
       return;
     }
     ++counters.tile_requests;
-    if (!r.session_id.empty() && r.session_id != session_id) {
-      // Only the current (or last) session's tiles are held in memory.
-      send_index_parts({}, true, fmt::format("session '{}' is not held by this daemon (it holds '{}')", r.session_id,
-                                       session_id));
-      return;
-    }
-    if (r.want_index) send_index();
-    for (std::size_t i = 0; i < r.tile_ids.size(); ++i) {
-      const EncodedTile* tile = store.find(r.tile_ids[i]);
-      if (tile == nullptr) continue;
-      // A client asking for an older version gets the current one whole.
-      const bool same = tile->version == r.versions[i];
-      queue_tile(*tile, same ? r.chunks[i] : -1);
-    }
-  }
-
-  // Sends queued chunks at options.chunk_bytes_per_s: a burst of a whole map
-  // would overflow the receivers' socket buffers and the Wi-Fi link.
-  void send_chunks() {
-    const auto now = Clock::now();
-    const double elapsed = std::chrono::duration<double>(now - last_budget).count();
-    last_budget = now;
-    // At most two chunks back to back: a receiver's default socket buffer
-    // (212 992 bytes on Linux) holds little more.
-    send_budget_bytes = std::min(send_budget_bytes + elapsed * options.chunk_bytes_per_s,
-                                 2.0 * protocol::kChunkPayloadBytes);
-    while (!outgoing.empty() && send_budget_bytes > 0) {
-      const ChunkRef ref = outgoing.front();
-      outgoing.pop_front();
-      queued.erase(ref);
-      const EncodedTile* tile = store.find(ref.tile_id);
-      if (tile == nullptr || tile->version != ref.version) continue;  // superseded: the new version is queued
-      const auto piece = protocol::chunk_of(tile->blob, ref.chunk);
-      send_budget_bytes -= static_cast<double>(piece.size());
-      if (options.drop_chunk_fraction > 0 && unit(drop_rng) < options.drop_chunk_fraction) {
-        ++counters.chunks_dropped_by_hook;
-        continue;
-      }
-      tile_chunk_t m;
-      m.utime = tile->utime;
-      m.schema = 1;
-      m.payload_id = options.payload_id;
-      m.session_id = session_id;
-      m.tile_id = tile->id;
-      m.version = tile->version;
-      m.chunk = ref.chunk;
-      m.n_chunks = tile->n_chunks;
-      m.data.assign(piece.begin(), piece.end());
-      m.size = static_cast<std::int32_t>(m.data.size());
-      send(Channel::tile, m);
-      ++counters.chunks_published;
-      counters.chunk_bytes_published += static_cast<std::uint64_t>(m.getEncodedSize());
-    }
+    publisher.answer(r);
   }
 };
 
