@@ -81,10 +81,9 @@ struct Harness {
     o.drop_seed = 7;
     SessionHooks hooks;
     hooks.start = [this] { return fmt::format("s{}", ++starts); };
-    hooks.stop = [this] {
-      ++stops;
-      endpoint->session_stopped();  // a daemon with nothing to flush
-    };
+    // The daemon flushes elsewhere and calls session_stopped() when done
+    // (the test does that from its own thread, like the daemon's main loop).
+    hooks.stop = [this] { ++stops; };
     hooks.sessions = [] { return std::vector<std::string>{"s0", "s1"}; };
     endpoint = std::make_unique<LcmEndpoint>(o, hooks);
   }
@@ -173,6 +172,11 @@ TEST(LcmEndpoint, StartAndStopChangeTheStateWithAcks) {
   r = h.adit({"stop"});
   ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("state STOPPING"), std::string::npos) << r.out;
+  EXPECT_EQ(h.endpoint->state(), SessionState::stopping);
+  r = h.adit({"start"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("still stopping the last session"), std::string::npos) << r.err;
+  h.endpoint->session_stopped();
   EXPECT_TRUE(h.wait_for(SessionState::idle));
   EXPECT_EQ(h.stops, 1);
 
