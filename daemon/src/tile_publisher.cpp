@@ -43,14 +43,14 @@ void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapP
 void TilePublisher::answer(const tile_request_t& request) {
   if (!request.session_id.empty() && request.session_id != session_id_) {
     // Only the current (or last) session's tiles are held in memory.
-    send_index({}, true,
+    send_index({}, true, request.request_id,
                fmt::format("session '{}' is not held by this daemon (it holds '{}')", request.session_id, session_id_));
     return;
   }
   if (request.want_index) {
     std::vector<const EncodedTile*> all;
     for (const auto& [id, tile] : store_.tiles()) all.push_back(&tile);
-    send_index(all, true, "");
+    send_index(all, true, request.request_id, "");
   }
   const std::size_t n = std::min({request.tile_ids.size(), request.versions.size(), request.chunks.size()});
   for (std::size_t i = 0; i < n; ++i) {
@@ -72,7 +72,7 @@ void TilePublisher::tick(Clock::time_point now) {
       queue_tile(*changed.back(), -1);
     }
     dirty_.clear();
-    send_index(changed, false, "");
+    send_index(changed, false, 0, "");
   }
   send_chunks(now);
 }
@@ -85,7 +85,8 @@ void TilePublisher::queue_tile(const EncodedTile& tile, std::int32_t only_chunk)
   }
 }
 
-void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, bool full, const std::string& error) {
+void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, bool full, std::int64_t request_id,
+                               const std::string& error) {
   const double size = options_.tiles.tile_size_m;
   std::array<float, 3> lo{0, 0, 0};
   std::array<float, 3> hi{0, 0, 0};
@@ -109,6 +110,7 @@ void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, boo
     m.schema = 1;
     m.payload_id = options_.payload_id;
     m.session_id = session_id_;
+    m.request_id = request_id;
     m.error = error;
     m.tile_size_m = static_cast<float>(size);
     m.full = full;

@@ -98,9 +98,9 @@ const std::vector<Field>& layout(LcmType type) {
   static const std::vector<Field> command{I64, I16, I64, STR, STR, I32, counted(Kind::string, 5),
                                           I32, counted(Kind::i8, 7)};
   static const std::vector<Field> ack{I64, I16, I64, STR, I8, STR, I8, STR, STR};
-  static const std::vector<Field> index{I64, I16, STR, STR, STR, F32, I8, I32, I32, I32,
-                                        counted(Kind::i64, 9), counted(Kind::i32, 9), counted(Kind::i32, 9),
-                                        counted(Kind::i32, 9), I64, {Kind::f32, 3}, {Kind::f32, 3}};
+  static const std::vector<Field> index{I64, I16, STR, STR, I64, STR, F32, I8, I32, I32, I32,
+                                        counted(Kind::i64, 10), counted(Kind::i32, 10), counted(Kind::i32, 10),
+                                        counted(Kind::i32, 10), I64, {Kind::f32, 3}, {Kind::f32, 3}};
   static const std::vector<Field> chunk{I64, I16, STR, STR, I64, I32, I32, I32, I32, counted(Kind::i8, 8)};
   static const std::vector<Field> request{I64, I16, I64, STR, STR, I8, I32,
                                           counted(Kind::i64, 6), counted(Kind::i32, 6), counted(Kind::i32, 6)};

@@ -52,6 +52,7 @@ TEST_F(TilePublisherTest, ChangedTilesGoOutAtMostOncePerPeriod) {
   EXPECT_EQ(versions, (std::set<std::int32_t>{1, 10}));
   ASSERT_EQ(sink.indexes.size(), 2u);
   EXPECT_FALSE(sink.indexes[0].full);
+  EXPECT_EQ(sink.indexes[0].request_id, 0) << "a broadcast answers no request";
   EXPECT_EQ(sink.indexes[1].versions, std::vector<std::int32_t>{10});
 }
 
@@ -69,6 +70,7 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   sink.indexes.clear();
 
   tile_request_t r{};
+  r.request_id = 77;
   r.session_id = "s1";
   r.tile_ids = {big, big, protocol::tile_id({5, 5, 5})};
   r.versions = {1, 1, 1};
@@ -91,6 +93,7 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   publisher.answer(r);  // asks for an outdated version: gets version 2 whole
   ASSERT_EQ(sink.indexes.size(), 1u);
   EXPECT_TRUE(sink.indexes[0].full);
+  EXPECT_EQ(sink.indexes[0].request_id, 77) << "an answer names its request";
   EXPECT_EQ(sink.indexes[0].n_tiles, 2);
   run_for(now, 0.5);  // (the broadcast of version 2 is merged with the answer)
   std::set<std::int32_t> chunks;
@@ -106,6 +109,7 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   publisher.answer(r);
   ASSERT_EQ(sink.indexes.size(), 1u);
   EXPECT_NE(sink.indexes[0].error.find("'s0' is not held"), std::string::npos);
+  EXPECT_EQ(sink.indexes[0].request_id, 77);
 }
 
 TEST_F(TilePublisherTest, ChunksArePaced) {

@@ -94,9 +94,9 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   c.auth_size = 0;
   std::optional<command_ack_t> answer;
   const Listen acks(impl_->lcm, impl_->channel(Channel::ack), [&](const lcm::ReceiveBuffer* rbuf) {
-        auto ack = decode<command_ack_t>(rbuf);
-        if (ack && ack->request_id == c.request_id) answer = std::move(ack);
-      });
+    auto ack = decode<command_ack_t>(rbuf);
+    if (ack && ack->request_id == c.request_id) answer = std::move(ack);
+  });
   const auto start = Clock::now();
   auto last_send = start - std::chrono::seconds(1);
   while (!answer && seconds_since(start) < impl_->options.timeout_s) {
@@ -138,34 +138,35 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
   std::set<std::int32_t> parts;
   std::int32_t n_parts = -1;
   std::string index_error;
+  std::set<std::int64_t> my_requests;  // other clients' errors are not ours
   auto last_progress = Clock::now();
   const Listen index(impl_->lcm, impl_->channel(Channel::tile_index), [&](const lcm::ReceiveBuffer* rbuf) {
-        const auto m = decode<tile_index_t>(rbuf);
-        if (!m || m->payload_id != impl_->options.payload_id) return;
-        if (!m->error.empty()) {
-          index_error = m->error;
-          return;
-        }
-        if (locked.empty()) locked = m->session_id;
-        if (m->session_id != locked) return;
-        for (std::size_t i = 0; i < m->tile_ids.size(); ++i)
-          tiles.note_index(m->tile_ids[i], m->versions[i], m->n_chunks[i]);
-        if (!m->full) return;  // a broadcast of changed tiles only
-        parts.insert(m->part);
-        n_parts = m->n_parts;
-        last_progress = Clock::now();
-      });
+    const auto m = decode<tile_index_t>(rbuf);
+    if (!m || m->payload_id != impl_->options.payload_id) return;
+    if (!m->error.empty()) {
+      if (my_requests.count(m->request_id) != 0) index_error = m->error;
+      return;
+    }
+    if (locked.empty()) locked = m->session_id;
+    if (m->session_id != locked) return;
+    for (std::size_t i = 0; i < m->tile_ids.size(); ++i)
+      tiles.note_index(m->tile_ids[i], m->versions[i], m->n_chunks[i]);
+    if (!m->full) return;  // a broadcast of changed tiles only
+    parts.insert(m->part);
+    n_parts = m->n_parts;
+    last_progress = Clock::now();
+  });
   auto last_chunk = Clock::now();
   const Listen chunks(impl_->lcm, impl_->channel(Channel::tile), [&](const lcm::ReceiveBuffer* rbuf) {
-        const auto m = decode<tile_chunk_t>(rbuf);
-        if (!m || locked.empty() || m->session_id != locked) return;
-        const auto outcome = tiles.add_chunk(*m);
-        last_chunk = Clock::now();
-        if (outcome == protocol::ChunkOutcome::stored || outcome == protocol::ChunkOutcome::completed) {
-          last_progress = last_chunk;
-          progress(tiles.chunks_have(), tiles.chunks_wanted());
-        }
-      });
+    const auto m = decode<tile_chunk_t>(rbuf);
+    if (!m || locked.empty() || m->session_id != locked) return;
+    const auto outcome = tiles.add_chunk(*m);
+    last_chunk = Clock::now();
+    if (outcome == protocol::ChunkOutcome::stored || outcome == protocol::ChunkOutcome::completed) {
+      last_progress = last_chunk;
+      progress(tiles.chunks_have(), tiles.chunks_wanted());
+    }
+  });
   const auto index_complete = [&] { return n_parts > 0 && static_cast<std::int32_t>(parts.size()) >= n_parts; };
 
   tile_request_t request;
@@ -196,6 +197,7 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
     if (quiet) {
       const auto missing = tiles.missing(kMaxRequestEntries);
       request.request_id = impl_->new_request_id();
+      my_requests.insert(request.request_id);
       request.utime = now_utime();
       request.session_id = locked;
       request.want_index = !index_complete();

@@ -71,7 +71,8 @@ class TilePublisher {
     auto operator<=>(const ChunkRef&) const = default;
   };
   void queue_tile(const EncodedTile& tile, std::int32_t only_chunk);
-  void send_index(const std::vector<const EncodedTile*>& tiles, bool full, const std::string& error);
+  void send_index(const std::vector<const EncodedTile*>& tiles, bool full, std::int64_t request_id,
+                  const std::string& error);
   void send_chunks(Clock::time_point now);
 
   TilePublisherOptions options_;
