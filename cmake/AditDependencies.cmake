@@ -15,6 +15,8 @@ pkg_check_modules(PCAP REQUIRED IMPORTED_TARGET libpcap)
 pkg_check_modules(GPIODCXX REQUIRED IMPORTED_TARGET libgpiodcxx)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+# LCM (liblcm-dev) ships only a pkg-config file; its lcm-gen is found in protocol/.
+pkg_check_modules(LCM REQUIRED IMPORTED_TARGET lcm)
 if(ADIT_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

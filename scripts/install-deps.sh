@@ -19,6 +19,10 @@ packages=(
   libgpiod-dev           # GPIO (libgpiod v1 C++ API)
   libsystemd-dev         # sd_notify
   libzstd-dev            # map tile compression
+  libssl-dev             # MD5 for the Ouster field digests (OpenSSL EVP)
+  liblcm-dev liblcm-bin libglib2.0-dev  # LCM messages and lcm-gen (lcm.pc needs glib)
+  libembree-dev          # ray casting in the simulator
+  libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

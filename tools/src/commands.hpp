@@ -16,4 +16,9 @@ void register_eval_commands(CLI::App& app, int& status);
 void register_can_commands(CLI::App& app, int& status);
 void register_calibrate_wheels_commands(CLI::App& app, int& status);
 
+// status, watch, start, stop, sessions, ping (the tablet protocol)
+void register_client_commands(CLI::App& app, int& status);
+
+void register_download_commands(CLI::App& app, int& status);
+
 }  // namespace adit::tools

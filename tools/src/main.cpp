@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
     adit::tools::register_eval_commands(app, status);
     adit::tools::register_can_commands(app, status);
     adit::tools::register_calibrate_wheels_commands(app, status);
+    adit::tools::register_client_commands(app, status);
+    adit::tools::register_download_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {

@@ -1,0 +1,132 @@
+#pragma once
+// The daemon's side of the tablet protocol (docs/PROTOCOL.md): one thread that
+// owns the LCM socket, publishes poses, status and map tiles handed over by
+// the pipeline through lock-free queues, answers tile requests with only the
+// missing chunks, and acknowledges commands through the session state machine.
+// LCM is confined to this file's implementation and the `adit` client.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "adit/protocol/map_point.hpp"
+#include "adit/protocol/session_state.hpp"
+#include "adit/protocol/tile_codec.hpp"
+
+namespace adit::daemon {
+
+struct PoseSample {
+  std::int64_t utime = 0;
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation{1, 0, 0, 0};  // w, x, y, z
+  std::array<double, 36> covariance{};
+  std::int32_t flags = 0;  // pose_t.FLAG_*
+};
+
+struct SensorHealth {
+  std::string name;
+  float packet_rate_hz = 0;
+  std::int64_t packets_dropped = 0;
+  std::int64_t last_seen_utime = 0;
+  float time_offset_s = 0;
+};
+
+struct ThreadLoad {
+  std::string name;
+  float load = 0;
+  std::int32_t queue_depth = 0;
+  std::int32_t queue_capacity = 0;
+};
+
+// What the daemon knows about its health; the endpoint adds state, session
+// and map size.
+struct StatusSample {
+  std::int64_t utime = 0;
+  std::vector<SensorHealth> sensors;
+  std::vector<ThreadLoad> threads;
+  std::int64_t disk_free_bytes = 0;
+  std::string fault;
+};
+
+// The whole new content of one tile (after voxel downsampling).
+struct TileUpdate {
+  std::int64_t utime = 0;
+  protocol::TileKey key;
+  std::vector<protocol::MapPoint> points;
+};
+
+// What commands make the daemon do; each runs on the endpoint thread and must
+// return quickly (the ack goes out after it, within 100 ms of the command).
+struct SessionHooks {
+  std::function<std::string()> start;  // begins a session, returns its id
+  std::function<void()> stop;          // begins the flush; call session_stopped() when done
+  std::function<std::vector<std::string>()> sessions;  // ids of sessions on disk
+  // EXPORT: writes the exports of the session, returns what was written.
+  std::function<std::string(const std::string& session, const std::vector<std::string>& args)> export_map;
+};
+
+struct EndpointOptions {
+  std::string lcm_url;
+  std::string payload_id;
+  protocol::TileParams tiles;
+  double tile_period_s = 1.0;          // changed tiles go out at most this often
+  double chunk_bytes_per_s = 4.0e6;    // pacing of tile chunks (broadcast and answers)
+  std::size_t queue_capacity = 256;    // per hand-off queue
+  std::size_t command_window = 1024;   // request ids remembered for replays
+  // Test hook: this fraction of tile chunks is silently not sent.
+  double drop_chunk_fraction = 0;
+  std::uint32_t drop_seed = 1;
+};
+
+struct EndpointCounters {
+  std::atomic<std::uint64_t> poses_published{0};
+  std::atomic<std::uint64_t> poses_dropped{0};  // hand-off queue full
+  std::atomic<std::uint64_t> status_published{0};
+  std::atomic<std::uint64_t> status_dropped{0};
+  std::atomic<std::uint64_t> tiles_dropped{0};
+  std::atomic<std::uint64_t> chunks_published{0};
+  std::atomic<std::uint64_t> chunks_dropped_by_hook{0};
+  std::atomic<std::uint64_t> chunk_bytes_published{0};
+  std::atomic<std::uint64_t> index_published{0};
+  std::atomic<std::uint64_t> commands_executed{0};
+  std::atomic<std::uint64_t> commands_rejected{0};
+  std::atomic<std::uint64_t> commands_replayed{0};
+  std::atomic<std::uint64_t> commands_malformed{0};
+  std::atomic<std::uint64_t> tile_requests{0};
+  std::atomic<std::uint64_t> tile_requests_malformed{0};
+  std::atomic<std::uint64_t> largest_message_bytes{0};
+};
+
+class LcmEndpoint {
+ public:
+  // Throws std::runtime_error when LCM cannot open `options.lcm_url`, and
+  // adit::InputError when the payload id is unusable.
+  LcmEndpoint(EndpointOptions options, SessionHooks hooks);
+  ~LcmEndpoint();
+  LcmEndpoint(const LcmEndpoint&) = delete;
+  LcmEndpoint& operator=(const LcmEndpoint&) = delete;
+
+  // Hand-offs: each may be called from one producer thread; false (and a
+  // counted drop) when the publisher is behind.
+  bool publish_pose(const PoseSample& pose);
+  bool publish_status(StatusSample&& status);
+  bool publish_tile(TileUpdate&& tile);
+
+  // The daemon finished flushing the stopping session (STOPPING -> IDLE).
+  void session_stopped();
+  // The GPIO button: starts when idle, stops when mapping.
+  void button_pressed();
+
+  protocol::SessionState state() const;
+  const EndpointCounters& counters() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace adit::daemon

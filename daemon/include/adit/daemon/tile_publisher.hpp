@@ -1,0 +1,93 @@
+#pragma once
+// The daemon's side of the tile stream, without sockets: keeps the session's
+// encoded tiles, broadcasts changed tiles at most once per period, answers
+// tile requests with exactly the chunks asked for (a tile whose version moved
+// on goes out whole), and paces chunks so receivers keep up. Messages leave
+// through a TileSink (the LCM endpoint, or a test).
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <random>
+#include <set>
+#include <span>
+#include <string>
+
+#include "adit/daemon/tile_store.hpp"
+#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_index_t.hpp"
+#include "adit/tile_request_t.hpp"
+
+namespace adit::daemon {
+
+class TileSink {
+ public:
+  virtual ~TileSink() = default;
+  virtual void send(const tile_chunk_t& chunk) = 0;
+  virtual void send(const tile_index_t& index) = 0;
+};
+
+struct TilePublisherOptions {
+  std::string payload_id;
+  protocol::TileParams tiles;
+  double period_s = 1.0;        // changed tiles go out at most this often
+  double bytes_per_s = 4.0e6;   // chunk pacing
+  double drop_fraction = 0;     // test hook: chunks silently not sent
+  std::uint32_t drop_seed = 1;
+};
+
+struct TilePublisherCounts {
+  std::uint64_t chunks_published = 0;
+  std::uint64_t chunks_dropped_by_hook = 0;
+  std::uint64_t chunk_bytes_published = 0;  // encoded tile_chunk_t bytes
+  std::uint64_t index_published = 0;
+};
+
+class TilePublisher {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  TilePublisher(TilePublisherOptions options, TileSink& sink);
+
+  // A new session: forgets every tile and everything queued.
+  void reset(std::string session_id);
+  // The whole new content of tile `key` (its version goes up by one).
+  void update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
+  // A client's request (payload already checked by the caller).
+  void answer(const tile_request_t& request);
+  // Broadcasts changed tiles when the period is up and sends paced chunks.
+  void tick(Clock::time_point now);
+
+  const TileStore& store() const { return store_; }
+  const std::string& session_id() const { return session_id_; }
+  const TilePublisherCounts& counts() const { return counts_; }
+  std::size_t queued_chunks() const { return outgoing_.size(); }
+
+ private:
+  struct ChunkRef {
+    std::int64_t tile_id;
+    std::int32_t version;
+    std::int32_t chunk;
+    auto operator<=>(const ChunkRef&) const = default;
+  };
+  void queue_tile(const EncodedTile& tile, std::int32_t only_chunk);
+  void send_index(const std::vector<const EncodedTile*>& tiles, bool full, std::int64_t request_id,
+                  const std::string& error);
+  void send_chunks(Clock::time_point now);
+
+  TilePublisherOptions options_;
+  TileSink& sink_;
+  std::string session_id_;
+  TileStore store_;
+  std::set<std::int64_t> dirty_;
+  std::deque<ChunkRef> outgoing_;
+  std::set<ChunkRef> queued_;
+  double budget_bytes_;
+  Clock::time_point last_budget_{};
+  Clock::time_point last_broadcast_{};
+  std::mt19937 drop_rng_;
+  std::uniform_real_distribution<double> unit_{0.0, 1.0};
+  TilePublisherCounts counts_;
+};
+
+}  // namespace adit::daemon

@@ -1,0 +1,332 @@
+#include "adit/daemon/lcm_endpoint.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/command_ack_t.hpp"
+#include "adit/daemon/spsc_queue.hpp"
+#include "adit/daemon/tile_publisher.hpp"
+#include "adit/pose_t.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
+#include "adit/protocol/command_gate.hpp"
+#include "adit/status_t.hpp"
+#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_index_t.hpp"
+#include "adit/tile_request_t.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using protocol::Channel;
+
+std::int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+TilePublisherOptions publisher_options(const EndpointOptions& o) {
+  return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed};
+}
+
+}  // namespace
+
+struct LcmEndpoint::Impl final : TileSink {
+  EndpointOptions options;
+  SessionHooks hooks;
+  lcm::LCM lcm;
+  std::array<std::string, 7> channels;
+  SpscQueue<PoseSample> poses;
+  SpscQueue<StatusSample> statuses;
+  SpscQueue<TileUpdate> tiles;
+  std::mutex events_mutex;  // control events are rare (button, end of flush)
+  std::vector<protocol::SessionEvent> events;
+  protocol::CommandGate gate;
+  protocol::SessionMachine machine;
+  std::atomic<protocol::SessionState> published_state{protocol::SessionState::idle};
+  std::string session_id;
+  TilePublisher publisher;
+  std::int64_t pose_seq = 0;
+  EndpointCounters counters;
+  std::atomic<bool> running{true};
+  std::thread thread;
+  // Reused message buffers: no allocation per pose once warmed up.
+  adit::pose_t pose_msg;
+  std::vector<std::uint8_t> encode_buffer;
+
+  Impl(EndpointOptions o, SessionHooks h)
+      : options(std::move(o)),
+        hooks(std::move(h)),
+        lcm(options.lcm_url),
+        poses(options.queue_capacity),
+        statuses(options.queue_capacity),
+        tiles(options.queue_capacity),
+        gate(options.payload_id, options.command_window),
+        publisher(publisher_options(options), *this) {
+    if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
+      throw InputError("payload id", "payload_id", problem);
+    if (const std::string problem = protocol::tile_params_problem(options.tiles); !problem.empty())
+      throw InputError("tile parameters", "tiles", problem);
+    if (!lcm.good()) throw std::runtime_error(fmt::format("LCM cannot open '{}'", options.lcm_url));
+    for (int c = 0; c < 7; ++c) channels[c] = protocol::channel_name(options.payload_id, static_cast<Channel>(c));
+    lcm.subscribe(channel(Channel::command), &Impl::on_command, this);
+    lcm.subscribe(channel(Channel::tile_request), &Impl::on_tile_request, this);
+    thread = std::thread([this] { run(); });
+  }
+
+  ~Impl() override {
+    running = false;
+    if (thread.joinable()) thread.join();
+  }
+
+  const std::string& channel(Channel c) const { return channels[static_cast<std::size_t>(c)]; }
+
+  template <typename Message>
+  void send(Channel c, const Message& message) {
+    const int size = message.getEncodedSize();
+    encode_buffer.resize(static_cast<std::size_t>(size));
+    message.encode(encode_buffer.data(), 0, size);
+    std::uint64_t largest = counters.largest_message_bytes.load();
+    while (static_cast<std::uint64_t>(size) > largest &&
+           !counters.largest_message_bytes.compare_exchange_weak(largest, static_cast<std::uint64_t>(size))) {
+    }
+    lcm.publish(channel(c), encode_buffer.data(), static_cast<unsigned>(size));
+  }
+
+  void send(const tile_chunk_t& chunk) override { send(Channel::tile, chunk); }
+  void send(const tile_index_t& index) override { send(Channel::tile_index, index); }
+
+  void run() {
+    while (running) {
+      lcm.handleTimeout(2);
+      drain_events();
+      drain_poses();
+      drain_status();
+      TileUpdate t;
+      while (tiles.pop(t)) publisher.update(t.key, t.points, t.utime);
+      publisher.tick(Clock::now());
+      const TilePublisherCounts& c = publisher.counts();
+      counters.chunks_published = c.chunks_published;
+      counters.chunks_dropped_by_hook = c.chunks_dropped_by_hook;
+      counters.chunk_bytes_published = c.chunk_bytes_published;
+      counters.index_published = c.index_published;
+    }
+  }
+
+  // --- commands -----------------------------------------------------------
+
+  void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    protocol::GateResult r = gate.inspect(rbuf->data, rbuf->data_size);
+    using Kind = protocol::GateResult::Kind;
+    if (r.kind == Kind::malformed) {
+      ++counters.commands_malformed;
+      return;
+    }
+    if (r.kind == Kind::replay) {
+      ++counters.commands_replayed;
+      send(Channel::ack, r.previous);
+      return;
+    }
+    command_ack_t ack;
+    ack.utime = now_utime();
+    ack.schema = 1;
+    ack.request_id = r.command.request_id;
+    ack.payload_id = options.payload_id;
+    if (r.kind == Kind::reject) {
+      ack.accepted = false;
+      ack.reason = r.reason;
+    } else {
+      // A hook that throws must not take the endpoint thread down: the
+      // command is answered as failed and the state stays as it was.
+      try {
+        execute(r.verb, r.command, ack);
+      } catch (const std::exception& e) {
+        ack.accepted = false;
+        ack.reason = fmt::format("{} failed: {}", protocol::verb_name(r.verb), e.what());
+      }
+    }
+    (ack.accepted ? counters.commands_executed : counters.commands_rejected)++;
+    ack.state = static_cast<std::int8_t>(machine.state());
+    ack.session_id = session_id;
+    gate.remember(ack);
+    send(Channel::ack, ack);
+  }
+
+  void execute(protocol::Verb verb, const command_t& command, command_ack_t& ack) {
+    using protocol::Verb;
+    switch (verb) {
+      case Verb::start: {
+        apply_transition(protocol::SessionEvent::start, ack);
+        return;
+      }
+      case Verb::stop: {
+        apply_transition(protocol::SessionEvent::stop, ack);
+        return;
+      }
+      case Verb::ping:
+        ack.accepted = true;
+        ack.reason = "pong";
+        return;
+      case Verb::sessions: {
+        ack.accepted = true;
+        ack.reason = "sessions listed";
+        if (hooks.sessions)
+          for (const std::string& s : hooks.sessions()) ack.detail += s + "\n";
+        return;
+      }
+      case Verb::export_map: {
+        if (!hooks.export_map) {
+          ack.accepted = false;
+          ack.reason = "this daemon cannot export";
+          return;
+        }
+        const std::string session = command.args.empty() ? session_id : command.args.front();
+        ack.accepted = true;
+        ack.reason = "exported";
+        ack.detail = hooks.export_map(session, command.args);
+        return;
+      }
+    }
+  }
+
+  // The hooks run before the machine moves, so a hook that throws leaves the
+  // state unchanged.
+  void apply_transition(protocol::SessionEvent event, command_ack_t& ack) {
+    const protocol::Transition t = protocol::next_state(machine.state(), event);
+    ack.accepted = t.accepted;
+    ack.reason = t.reason;
+    if (!t.accepted) return;
+    if (event == protocol::SessionEvent::start) {
+      std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
+      session_id = std::move(started);
+      publisher.reset(session_id);
+      pose_seq = 0;
+      ack.reason += ": session " + session_id;
+    } else if (event == protocol::SessionEvent::stop && hooks.stop) {
+      hooks.stop();
+    }
+    machine.apply(event);
+    published_state = machine.state();
+  }
+
+  void drain_events() {
+    std::vector<protocol::SessionEvent> pending;
+    {
+      const std::lock_guard lock(events_mutex);
+      pending.swap(events);
+    }
+    for (const protocol::SessionEvent event : pending) {
+      command_ack_t result;
+      try {
+        apply_transition(event, result);
+      } catch (const std::exception& e) {
+        result.accepted = false;
+        result.reason = e.what();
+      }
+      if (!result.accepted) log::warn("session: {} ({})", result.reason, protocol::state_name(machine.state()));
+    }
+  }
+
+  // --- poses, status --------------------------------------------------------
+
+  void drain_poses() {
+    PoseSample p;
+    while (poses.pop(p)) {
+      pose_msg.utime = p.utime;
+      pose_msg.schema = 1;
+      pose_msg.session_id = session_id;
+      pose_msg.seq = pose_seq++;
+      std::copy(p.position.begin(), p.position.end(), pose_msg.position);
+      std::copy(p.orientation.begin(), p.orientation.end(), pose_msg.orientation);
+      std::copy(p.covariance.begin(), p.covariance.end(), pose_msg.covariance);
+      pose_msg.flags = p.flags;
+      send(Channel::pose, pose_msg);
+      ++counters.poses_published;
+    }
+  }
+
+  void drain_status() {
+    StatusSample s;
+    while (statuses.pop(s)) {
+      status_t m;
+      m.utime = s.utime;
+      m.schema = 1;
+      m.payload_id = options.payload_id;
+      m.state = static_cast<std::int8_t>(machine.state());
+      m.session_id = session_id;
+      for (const SensorHealth& h : s.sensors)
+        m.sensors.push_back({h.name, h.packet_rate_hz, h.packets_dropped, h.last_seen_utime, h.time_offset_s});
+      m.n_sensors = static_cast<std::int32_t>(m.sensors.size());
+      for (const ThreadLoad& t : s.threads) m.threads.push_back({t.name, t.load, t.queue_depth, t.queue_capacity});
+      m.n_threads = static_cast<std::int32_t>(m.threads.size());
+      m.disk_free_bytes = s.disk_free_bytes;
+      m.map_points = publisher.store().total_points();
+      m.map_tiles = static_cast<std::int32_t>(publisher.store().tiles().size());
+      m.fault = s.fault;
+      send(Channel::status, m);
+      ++counters.status_published;
+    }
+  }
+
+  // --- tiles ----------------------------------------------------------------
+
+  void on_tile_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    tile_request_t r;
+    if (!protocol::checked_decode(rbuf->data, rbuf->data_size, r) || r.payload_id != options.payload_id) {
+      ++counters.tile_requests_malformed;
+      return;
+    }
+    ++counters.tile_requests;
+    publisher.answer(r);
+  }
+};
+
+LcmEndpoint::LcmEndpoint(EndpointOptions options, SessionHooks hooks)
+    : impl_(std::make_unique<Impl>(std::move(options), std::move(hooks))) {}
+
+LcmEndpoint::~LcmEndpoint() = default;
+
+bool LcmEndpoint::publish_pose(const PoseSample& pose) {
+  if (impl_->poses.push(pose)) return true;
+  ++impl_->counters.poses_dropped;
+  return false;
+}
+
+bool LcmEndpoint::publish_status(StatusSample&& status) {
+  if (impl_->statuses.push(std::move(status))) return true;
+  ++impl_->counters.status_dropped;
+  return false;
+}
+
+bool LcmEndpoint::publish_tile(TileUpdate&& tile) {
+  if (impl_->tiles.push(std::move(tile))) return true;
+  ++impl_->counters.tiles_dropped;
+  return false;
+}
+
+void LcmEndpoint::session_stopped() {
+  const std::lock_guard lock(impl_->events_mutex);
+  impl_->events.push_back(protocol::SessionEvent::stopped);
+}
+
+void LcmEndpoint::button_pressed() {
+  const std::lock_guard lock(impl_->events_mutex);
+  impl_->events.push_back(impl_->published_state.load() == protocol::SessionState::idle ? protocol::SessionEvent::start
+                                                                                        : protocol::SessionEvent::stop);
+}
+
+protocol::SessionState LcmEndpoint::state() const { return impl_->published_state.load(); }
+
+const EndpointCounters& LcmEndpoint::counters() const { return impl_->counters; }
+
+}  // namespace adit::daemon

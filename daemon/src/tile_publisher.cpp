@@ -1,0 +1,172 @@
+#include "adit/daemon/tile_publisher.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include <fmt/format.h>
+
+namespace adit::daemon {
+namespace {
+
+// Index entries per tile_index_t: 20 bytes each, 2000 keep a part near 40 KB.
+constexpr std::size_t kIndexEntriesPerPart = 2000;
+// At most two chunks back to back: a receiver's default socket buffer
+// (212 992 bytes on Linux) holds little more.
+constexpr double kBurstBytes = 2.0 * protocol::kChunkPayloadBytes;
+
+std::int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+TilePublisher::TilePublisher(TilePublisherOptions options, TileSink& sink)
+    : options_(std::move(options)),
+      sink_(sink),
+      store_(options_.tiles),
+      budget_bytes_(kBurstBytes),
+      drop_rng_(options_.drop_seed) {}
+
+void TilePublisher::reset(std::string session_id) {
+  session_id_ = std::move(session_id);
+  store_ = TileStore(options_.tiles);
+  dirty_.clear();
+  outgoing_.clear();
+  queued_.clear();
+}
+
+void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime) {
+  dirty_.insert(store_.update(key, points, utime).id);
+}
+
+void TilePublisher::answer(const tile_request_t& request) {
+  if (!request.session_id.empty() && request.session_id != session_id_) {
+    // Only the current (or last) session's tiles are held in memory.
+    send_index({}, true, request.request_id,
+               fmt::format("session '{}' is not held by this daemon (it holds '{}')", request.session_id, session_id_));
+    return;
+  }
+  if (request.want_index) {
+    std::vector<const EncodedTile*> all;
+    for (const auto& [id, tile] : store_.tiles()) all.push_back(&tile);
+    send_index(all, true, request.request_id, "");
+  }
+  const std::size_t n = std::min({request.tile_ids.size(), request.versions.size(), request.chunks.size()});
+  for (std::size_t i = 0; i < n; ++i) {
+    const EncodedTile* tile = store_.find(request.tile_ids[i]);
+    if (tile == nullptr) continue;
+    // A client asking for an older version gets the current one whole.
+    queue_tile(*tile, tile->version == request.versions[i] ? request.chunks[i] : -1);
+  }
+}
+
+void TilePublisher::tick(Clock::time_point now) {
+  if (!dirty_.empty() && now - last_broadcast_ >= std::chrono::duration<double>(options_.period_s)) {
+    last_broadcast_ = now;
+    // The index of just the changed tiles: a full one costs 20 bytes per tile
+    // every second; clients ask for that once (want_index).
+    std::vector<const EncodedTile*> changed;
+    for (const std::int64_t id : dirty_) {
+      changed.push_back(store_.find(id));
+      queue_tile(*changed.back(), -1);
+    }
+    dirty_.clear();
+    send_index(changed, false, 0, "");
+  }
+  send_chunks(now);
+}
+
+void TilePublisher::queue_tile(const EncodedTile& tile, std::int32_t only_chunk) {
+  for (std::int32_t c = 0; c < tile.n_chunks; ++c) {
+    if (only_chunk >= 0 && c != only_chunk) continue;
+    const ChunkRef ref{tile.id, tile.version, c};
+    if (queued_.insert(ref).second) outgoing_.push_back(ref);
+  }
+}
+
+void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, bool full, std::int64_t request_id,
+                               const std::string& error) {
+  const double size = options_.tiles.tile_size_m;
+  std::array<float, 3> lo{0, 0, 0};
+  std::array<float, 3> hi{0, 0, 0};
+  bool first = true;
+  for (const auto& [id, tile] : store_.tiles()) {  // bounds of the whole map
+    const protocol::TileKey k = protocol::tile_key(id);
+    const std::array<double, 3> corner{k.x * size, k.y * size, k.z * size};
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto low = static_cast<float>(corner[i]);
+      const auto high = static_cast<float>(corner[i] + size);
+      lo[i] = first ? low : std::min(lo[i], low);
+      hi[i] = first ? high : std::max(hi[i], high);
+    }
+    first = false;
+  }
+  const auto n_parts = static_cast<std::int32_t>(
+      std::max<std::size_t>(1, (tiles.size() + kIndexEntriesPerPart - 1) / kIndexEntriesPerPart));
+  for (std::int32_t part = 0; part < n_parts; ++part) {
+    tile_index_t m;
+    m.utime = now_utime();
+    m.schema = 1;
+    m.payload_id = options_.payload_id;
+    m.session_id = session_id_;
+    m.request_id = request_id;
+    m.error = error;
+    m.tile_size_m = static_cast<float>(size);
+    m.full = full;
+    m.part = part;
+    m.n_parts = n_parts;
+    const std::size_t begin = static_cast<std::size_t>(part) * kIndexEntriesPerPart;
+    const std::size_t end = std::min(tiles.size(), begin + kIndexEntriesPerPart);
+    for (std::size_t i = begin; i < end; ++i) {
+      m.tile_ids.push_back(tiles[i]->id);
+      m.versions.push_back(tiles[i]->version);
+      m.n_chunks.push_back(tiles[i]->n_chunks);
+      m.n_points.push_back(tiles[i]->n_points);
+    }
+    m.n_tiles = static_cast<std::int32_t>(m.tile_ids.size());
+    m.total_points = store_.total_points();
+    std::copy(lo.begin(), lo.end(), m.bounds_min);
+    std::copy(hi.begin(), hi.end(), m.bounds_max);
+    sink_.send(m);
+    ++counts_.index_published;
+  }
+}
+
+// Sends queued chunks at options_.bytes_per_s: a burst of a whole map would
+// overflow the receivers' socket buffers and the Wi-Fi link.
+void TilePublisher::send_chunks(Clock::time_point now) {
+  const double elapsed =
+      last_budget_ == Clock::time_point{} ? 0.0 : std::chrono::duration<double>(now - last_budget_).count();
+  last_budget_ = now;
+  budget_bytes_ = std::min(budget_bytes_ + elapsed * options_.bytes_per_s, kBurstBytes);
+  while (!outgoing_.empty() && budget_bytes_ > 0) {
+    const ChunkRef ref = outgoing_.front();
+    outgoing_.pop_front();
+    queued_.erase(ref);
+    const EncodedTile* tile = store_.find(ref.tile_id);
+    if (tile == nullptr || tile->version != ref.version) continue;  // superseded: the new version is queued
+    const auto piece = protocol::chunk_of(tile->blob, ref.chunk);
+    budget_bytes_ -= static_cast<double>(piece.size());
+    if (options_.drop_fraction > 0 && unit_(drop_rng_) < options_.drop_fraction) {
+      ++counts_.chunks_dropped_by_hook;
+      continue;
+    }
+    tile_chunk_t m;
+    m.utime = tile->utime;
+    m.schema = 1;
+    m.payload_id = options_.payload_id;
+    m.session_id = session_id_;
+    m.tile_id = tile->id;
+    m.version = tile->version;
+    m.chunk = ref.chunk;
+    m.n_chunks = tile->n_chunks;
+    m.data.assign(piece.begin(), piece.end());
+    m.size = static_cast<std::int32_t>(m.data.size());
+    sink_.send(m);
+    ++counts_.chunks_published;
+    counts_.chunk_bytes_published += static_cast<std::uint64_t>(m.getEncodedSize());
+  }
+}
+
+}  // namespace adit::daemon

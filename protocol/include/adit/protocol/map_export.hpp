@@ -1,0 +1,31 @@
+#pragma once
+// Map files for operators: binary PLY (CloudCompare, MeshLab), binary PCD
+// (PCL) and LAS 1.4 point data record format 6 (every survey package), all
+// written by hand: Debian has no LAS library.
+
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "adit/protocol/map_point.hpp"
+
+namespace adit::protocol {
+
+enum class MapFormat { ply, pcd, las };
+std::optional<MapFormat> parse_map_format(std::string_view name);
+
+// Throws adit::InputError naming the file when it cannot be written.
+void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points);
+
+// LAS 1.4 R15 constants the writer uses (and the tests check against).
+inline constexpr std::size_t kLasHeaderSize = 375;
+inline constexpr std::size_t kLasPointFormat6Length = 30;
+inline constexpr double kLasScale = 0.001;  // 1 mm, like the tile quantum
+// Seconds from the Unix epoch to the GPS epoch (1980-01-06) and GPS - UTC leap
+// seconds since 2017; Adjusted Standard GPS Time is GPS seconds - 1e9.
+inline constexpr double kGpsEpochUnixSeconds = 315964800.0;
+inline constexpr double kGpsLeapSeconds = 18.0;
+double adjusted_standard_gps_time(double unix_seconds);
+
+}  // namespace adit::protocol

@@ -1,0 +1,408 @@
+// The daemon's LCM endpoint and the `adit` client end to end over real LCM
+// UDP multicast on this host (ttl=0), with synthetic poses and tiles.
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "adit/command_ack_t.hpp"
+#include "adit/command_t.hpp"
+#include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/drivers/lidar/scan_files.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/tile_chunk_t.hpp"
+#include "map_readers.hpp"
+#include "run_program.hpp"
+#include "shared_data.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::Channel;
+using protocol::MapPoint;
+using protocol::SessionState;
+
+std::string unique_url() {
+  return fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + ::getpid() % 30000);
+}
+
+// A floor and two walls of a 40 m x 20 m room on a 5 cm grid with up to 1 cm
+// of roughness (in whole millimetres), binned into 20 m tiles: two tiles of
+// ~180 000 points, a dozen chunks each.
+std::map<protocol::TileKey, std::vector<MapPoint>> room() {
+  std::map<protocol::TileKey, std::vector<MapPoint>> tiles;
+  std::uint32_t state = 1;
+  const auto rough = [&] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<int>((state >> 16) % 21) * 0.001 - 0.010;
+  };
+  const auto add = [&](double x, double y, double z, int i) {
+    z += rough();
+    tiles[protocol::tile_of(x, y, z, 20.0)].push_back({x, y, z, static_cast<float>(i % 200), 0});
+  };
+  for (int i = 0; i < 800; ++i)
+    for (int j = 0; j < 399; ++j) add(0.025 + i * 0.05, 0.025 + j * 0.05, 0.5, i + j);
+  for (int i = 0; i < 800; ++i)
+    for (int k = 0; k < 60; ++k) {
+      add(0.025 + i * 0.05, 0.3, 0.6 + k * 0.05, k);
+      add(0.025 + i * 0.05, 19.7, 0.6 + k * 0.05, 2 * k);
+    }
+  return tiles;
+}
+
+// Millimetre integer coordinates: what survives 1 mm quantisation exactly.
+using MmPoint = std::tuple<long, long, long>;
+MmPoint mm(double x, double y, double z) { return {std::lround(x * 1000), std::lround(y * 1000), std::lround(z * 1000)}; }
+
+struct Harness {
+  std::string url = unique_url();
+  std::string payload = fmt::format("test-{}", ::getpid());
+  std::atomic<int> starts{0};
+  std::atomic<int> stops{0};
+  std::unique_ptr<LcmEndpoint> endpoint;
+
+  explicit Harness(double drop = 0.0) {
+    EndpointOptions o;
+    o.lcm_url = url;
+    o.payload_id = payload;
+    o.drop_chunk_fraction = drop;
+    o.drop_seed = 7;
+    SessionHooks hooks;
+    hooks.start = [this] { return fmt::format("s{}", ++starts); };
+    // The daemon flushes elsewhere and calls session_stopped() when done
+    // (the test does that from its own thread, like the daemon's main loop).
+    hooks.stop = [this] { ++stops; };
+    hooks.sessions = [] { return std::vector<std::string>{"s0", "s1"}; };
+    endpoint = std::make_unique<LcmEndpoint>(o, hooks);
+  }
+
+  test::ProgramResult adit(std::vector<std::string> args, double timeout_s = 5) const {
+    args.insert(args.begin(), (test::binary_dir() / "bin" / "adit").string());
+    for (const std::string& a : {std::string("--payload"), payload, std::string("--lcm-url"), url,
+                                 std::string("--timeout"), fmt::format("{}", timeout_s)})
+      args.push_back(a);
+    return test::run_program(args);
+  }
+
+  bool wait_for(SessionState state) const {
+    for (int i = 0; i < 200 && endpoint->state() != state; ++i) std::this_thread::sleep_for(10ms);
+    return endpoint->state() == state;
+  }
+};
+
+// Listens to every ADIT/ channel on its own thread: sizes and acks.
+struct Sniffer {
+  lcm::LCM lcm;
+  std::atomic<bool> running{true};
+  std::atomic<std::size_t> largest{0};
+  std::atomic<std::size_t> messages{0};
+  std::mutex mutex;
+  std::vector<command_ack_t> acks;
+  std::vector<std::pair<std::int64_t, std::int32_t>> chunk_versions;
+  std::thread thread;
+
+  explicit Sniffer(const std::string& url) : lcm(url) {
+    lcm.subscribe("ADIT/.*", &Sniffer::on, this);
+    thread = std::thread([this] {
+      while (running) lcm.handleTimeout(10);
+    });
+  }
+  ~Sniffer() {
+    running = false;
+    thread.join();
+  }
+  void on(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    ++messages;
+    std::size_t seen = largest;
+    while (rbuf->data_size > seen && !largest.compare_exchange_weak(seen, rbuf->data_size)) {
+    }
+    const std::lock_guard lock(mutex);
+    if (channel.ends_with("/ACK")) {
+      command_ack_t ack;
+      if (ack.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) acks.push_back(ack);
+    } else if (channel.ends_with("/TILE")) {
+      tile_chunk_t c;
+      if (c.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) chunk_versions.emplace_back(c.tile_id, c.version);
+    }
+  }
+  std::vector<command_ack_t> acks_for(std::int64_t request_id) {
+    const std::lock_guard lock(mutex);
+    std::vector<command_ack_t> out;
+    for (const auto& a : acks)
+      if (a.request_id == request_id) out.push_back(a);
+    return out;
+  }
+};
+
+command_t command(const Harness& h, std::int64_t id, const std::string& verb) {
+  command_t c;
+  c.schema = 1;
+  c.request_id = id;
+  c.payload_id = h.payload;
+  c.verb = verb;
+  c.n_args = 0;  // LCM types leave numbers uninitialised
+  c.auth_size = 0;
+  return c;
+}
+
+TEST(LcmEndpoint, StartAndStopChangeTheStateWithAcks) {
+  Harness h;
+  auto r = h.adit({"start"});
+  ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("state MAPPING, session s1"), std::string::npos) << r.out;
+  EXPECT_EQ(h.endpoint->state(), SessionState::mapping);
+
+  r = h.adit({"start"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("START rejected: already mapping (state MAPPING)"), std::string::npos) << r.err;
+  EXPECT_EQ(h.starts, 1);
+
+  r = h.adit({"stop"});
+  ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("state STOPPING"), std::string::npos) << r.out;
+  EXPECT_EQ(h.endpoint->state(), SessionState::stopping);
+  r = h.adit({"start"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("still stopping the last session"), std::string::npos) << r.err;
+  h.endpoint->session_stopped();
+  EXPECT_TRUE(h.wait_for(SessionState::idle));
+  EXPECT_EQ(h.stops, 1);
+
+  r = h.adit({"sessions"});
+  EXPECT_EQ(r.exit_status, 0);
+  EXPECT_EQ(r.out, "s0\ns1\n");
+  r = h.adit({"stop"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("not mapping"), std::string::npos) << r.err;
+}
+
+TEST(LcmEndpoint, AcksArriveWithin100ms) {
+  Harness h;
+  Sniffer sniffer(h.url);
+  lcm::LCM lcm(h.url);
+  std::this_thread::sleep_for(50ms);
+  for (std::int64_t id = 100; id < 105; ++id) {
+    const auto sent = std::chrono::steady_clock::now();
+    const command_t c = command(h, id, "PING");
+    lcm.publish(protocol::channel_name(h.payload, Channel::command), &c);
+    while (sniffer.acks_for(id).empty() && std::chrono::steady_clock::now() - sent < 1s)
+      std::this_thread::sleep_for(1ms);
+    const auto latency = std::chrono::steady_clock::now() - sent;
+    ASSERT_FALSE(sniffer.acks_for(id).empty());
+    EXPECT_LT(latency, 100ms);
+  }
+}
+
+TEST(LcmEndpoint, PosesAndStatusArriveInWatch) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  std::atomic<bool> feeding{true};
+  std::thread feeder([&] {
+    for (int i = 0; feeding; ++i) {
+      PoseSample p;
+      p.utime = i * 100'000;
+      p.position = {0.1 * i, 0, 1};
+      p.flags = 1;
+      h.endpoint->publish_pose(p);  // scan rate: 10 Hz
+      if (i % 5 == 0) {             // status: 2 Hz
+        StatusSample s;
+        s.sensors.push_back({"lidar0", 10.0f, 0, p.utime, 0.0f});
+        s.disk_free_bytes = 5'000'000'000;
+        h.endpoint->publish_status(std::move(s));
+      }
+      std::this_thread::sleep_for(100ms);
+    }
+  });
+  const auto r = h.adit({"watch", "--duration", "2"});
+  feeding = false;
+  feeder.join();
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("MAPPING s1 | lidar0 10.0 Hz"), std::string::npos) << r.out;
+  std::size_t poses = 0;
+  const auto at = r.out.rfind('\n', r.out.size() - 2);
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at + 1, "%zu poses received", &poses), 1) << r.out;
+  EXPECT_GE(poses, 15u);  // 10 Hz for 2 s, minus start-up
+  EXPECT_LE(poses, 21u);
+  const auto status = h.adit({"status"}, 1);
+  EXPECT_EQ(status.exit_status, 1) << "nobody publishes status any more: " << status.out;
+}
+
+TEST(LcmEndpoint, DownloadAssemblesTheWholeMapDespite20PercentDroppedChunks) {
+  Harness h(0.2);
+  Sniffer sniffer(h.url);
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  std::set<MmPoint> expected;
+  std::size_t expected_count = 0;
+  for (auto& [key, points] : room()) {
+    for (const auto& p : points) expected.insert(mm(p.x, p.y, p.z));
+    expected_count += points.size();
+    h.endpoint->publish_tile({1'763'700'000'000'000, key, std::move(points)});
+  }
+  std::this_thread::sleep_for(1500ms);  // the changed tiles go out once, losing ~20 %
+
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("adit-download-{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  for (const std::string format : {"ply", "pcd", "las"}) {
+    const auto file = dir / ("map." + format);
+    const auto r = h.adit({"download", "--format", format, "--out", file.string()}, 10);
+    ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+    EXPECT_NE(r.err.find("100%"), std::string::npos) << "progress bar: " << r.err;
+    std::vector<test::XyzI> points;
+    if (format == "ply") points = test::read_ply(file);
+    if (format == "las") points = test::read_las_checked(file);
+    if (format == "pcd") {
+      std::vector<drivers::CloudPoint> cloud;
+      drivers::read_pcd(file, cloud);
+      for (const auto& c : cloud) points.push_back({c.x, c.y, c.z, c.intensity});
+    }
+    ASSERT_EQ(points.size(), expected_count) << format;
+    std::set<MmPoint> got;
+    for (const auto& p : points) got.insert(mm(p.x, p.y, p.z));
+    EXPECT_EQ(got, expected) << format;
+  }
+  std::filesystem::remove_all(dir);
+  const auto& c = h.endpoint->counters();
+  // The hook drops each chunk with p = 0.2: over ~40 chunk sends that is
+  // 8 expected; at least 3 and a fraction near 0.2 show it was exercised.
+  const double dropped = static_cast<double>(c.chunks_dropped_by_hook.load());
+  const double attempts = dropped + static_cast<double>(c.chunks_published.load());
+  EXPECT_GE(dropped, 3.0);
+  EXPECT_NEAR(dropped / attempts, 0.2, 0.12) << dropped << " of " << attempts;
+  std::printf("chunks: %llu published, %llu dropped by the hook; %llu tile requests\n",
+              static_cast<unsigned long long>(c.chunks_published.load()),
+              static_cast<unsigned long long>(c.chunks_dropped_by_hook.load()),
+              static_cast<unsigned long long>(c.tile_requests.load()));
+  EXPECT_GT(c.tile_requests.load(), 3u);
+  EXPECT_LT(sniffer.largest.load(), protocol::kMaxMessageBytes);
+  EXPECT_LT(c.largest_message_bytes.load(), protocol::kMaxMessageBytes);
+  EXPECT_GT(sniffer.messages.load(), 10u);
+}
+
+TEST(LcmEndpoint, ChangedTilesGoOutAtMostOnceASecond) {
+  Harness h;
+  Sniffer sniffer(h.url);
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 25; ++i) {  // the mapper changes one tile at 10 Hz
+    std::vector<MapPoint> points;
+    for (int j = 0; j <= i; ++j) points.push_back({1.0 + j * 0.05, 2.0, 0.5, 1, 0});
+    h.endpoint->publish_tile({i, protocol::TileKey{0, 0, 0}, std::move(points)});
+    std::this_thread::sleep_for(100ms);
+  }
+  std::this_thread::sleep_for(1100ms);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::set<std::int32_t> versions;
+  {
+    const std::lock_guard lock(sniffer.mutex);
+    for (const auto& [id, version] : sniffer.chunk_versions) versions.insert(version);
+  }
+  EXPECT_GE(versions.size(), 2u);
+  EXPECT_LE(static_cast<double>(versions.size()), std::ceil(seconds) + 1);
+  EXPECT_TRUE(versions.count(25)) << "the last version must go out";
+}
+
+TEST(LcmEndpoint, BadCommandsAreRejectedOrIgnoredAndTheStateStays) {
+  Harness h;
+  Sniffer sniffer(h.url);
+  lcm::LCM lcm(h.url);
+  const std::string channel = protocol::channel_name(h.payload, Channel::command);
+  const auto ack_of = [&](std::int64_t id) {
+    for (int i = 0; i < 100 && sniffer.acks_for(id).empty(); ++i) std::this_thread::sleep_for(10ms);
+    const auto acks = sniffer.acks_for(id);
+    return acks.empty() ? command_ack_t{} : acks.back();
+  };
+  std::this_thread::sleep_for(50ms);
+
+  command_t c = command(h, 11, "LAUNCH");
+  lcm.publish(channel, &c);
+  auto ack = ack_of(11);
+  EXPECT_FALSE(ack.accepted);
+  EXPECT_NE(ack.reason.find("unknown verb 'LAUNCH'"), std::string::npos) << ack.reason;
+
+  c = command(h, 12, "START");
+  c.payload_id = "someone-else";
+  lcm.publish(channel, &c);
+  ack = ack_of(12);
+  EXPECT_FALSE(ack.accepted);
+  EXPECT_NE(ack.reason.find("addressed to payload 'someone-else'"), std::string::npos) << ack.reason;
+
+  const std::uint8_t junk[] = {0xde, 0xad, 0xbe, 0xef, 1, 2, 3};
+  lcm.publish(channel, junk, sizeof junk);
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(h.endpoint->counters().commands_malformed.load(), 1u);
+  EXPECT_EQ(h.endpoint->state(), SessionState::idle);
+  EXPECT_EQ(h.starts, 0);
+
+  c = command(h, 13, "START");
+  lcm.publish(channel, &c);
+  const command_ack_t first = ack_of(13);
+  ASSERT_TRUE(first.accepted) << first.reason;
+  lcm.publish(channel, &c);  // the client's retry, or a replay
+  lcm.publish(channel, &c);
+  for (int i = 0; i < 100 && sniffer.acks_for(13).size() < 3; ++i) std::this_thread::sleep_for(10ms);
+  const auto acks = sniffer.acks_for(13);
+  ASSERT_EQ(acks.size(), 3u);
+  for (const auto& a : acks) {
+    EXPECT_TRUE(a.accepted);
+    EXPECT_EQ(a.reason, first.reason);
+    EXPECT_EQ(a.utime, first.utime) << "a replay is answered with the stored ack";
+  }
+  EXPECT_EQ(h.starts, 1) << "a replayed START must not start a second session";
+  EXPECT_EQ(h.endpoint->counters().commands_replayed.load(), 2u);
+  EXPECT_EQ(h.endpoint->state(), SessionState::mapping);
+}
+
+TEST(LcmEndpoint, AFailingStartHookIsRejectedAndLeavesTheStateIdle) {
+  EndpointOptions o;
+  o.lcm_url = unique_url();
+  o.payload_id = fmt::format("fail-{}", ::getpid());
+  SessionHooks hooks;
+  hooks.start = []() -> std::string { throw std::runtime_error("disk full"); };
+  LcmEndpoint endpoint(o, hooks);
+  const auto adit = (test::binary_dir() / "bin" / "adit").string();
+  const auto r =
+      test::run_program({adit, "start", "--payload", o.payload_id, "--lcm-url", o.lcm_url, "--timeout", "3"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("START rejected: START failed: disk full (state IDLE)"), std::string::npos) << r.err;
+  EXPECT_EQ(endpoint.state(), SessionState::idle);
+}
+
+TEST(LcmEndpoint, DownloadOfASessionTheDaemonDoesNotHoldSaysSo) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  const auto r = h.adit({"download", "--session", "s9", "--format", "ply", "--out", "/nonexistent/x.ply"}, 2);
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("download failed: session 's9' is not held by this daemon (it holds 's1')"), std::string::npos)
+      << r.err;
+}
+
+TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {
+  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 50000 + ::getpid() % 10000);
+  const auto adit = (test::binary_dir() / "bin" / "adit").string();
+  const auto start = std::chrono::steady_clock::now();
+  auto r = test::run_program({adit, "start", "--payload", "nobody", "--lcm-url", url, "--timeout", "0.5"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("no payload 'nobody' answered within 0.5 s"), std::string::npos) << r.err;
+  r = test::run_program({adit, "download", "--payload", "nobody", "--lcm-url", url, "--timeout", "0.5", "--format",
+                         "las", "--out", "/nonexistent/x.las"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("no payload 'nobody' answered"), std::string::npos) << r.err;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  r = test::run_program({adit, "status", "--payload", "bad/id", "--lcm-url", url});
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+}
+
+}  // namespace
+}  // namespace adit::daemon

@@ -1,0 +1,168 @@
+// adit status | watch | start | stop | sessions | ping: talk to a running aditd
+// over LCM (docs/PROTOCOL.md).
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/protocol/session_state.hpp"
+#include "client_options.hpp"
+#include "commands.hpp"
+
+namespace adit::tools {
+namespace {
+
+std::string state_text(std::int8_t state) {
+  if (state < 0 || state > 2) return fmt::format("state {}", state);
+  return std::string(protocol::state_name(static_cast<protocol::SessionState>(state)));
+}
+
+int no_answer(const ClientOptions& o) {
+  fmt::print(stderr, "adit: error: no payload '{}' answered within {} s on {}\n", o.payload_id, o.timeout_s,
+             o.lcm_url);
+  return kExitFailure;
+}
+
+// Sends one command and prints its ack; exit 0 only when accepted.
+int run_command(const ClientOptions& options, const std::string& verb, bool print_detail) {
+  LcmClient client(options);
+  const auto ack = client.command(verb);
+  if (!ack) return no_answer(options);
+  if (!ack->accepted) {
+    fmt::print(stderr, "adit: {} rejected: {} (state {})\n", verb, ack->reason, state_text(ack->state));
+    return kExitFailure;
+  }
+  if (print_detail) {
+    fmt::print("{}", ack->detail);
+  } else {
+    fmt::print("{}: {} (state {}{})\n", verb, ack->reason, state_text(ack->state),
+               ack->session_id.empty() ? "" : ", session " + ack->session_id);
+  }
+  return kExitOk;
+}
+
+std::string pose_flags(std::int32_t flags) {
+  std::string out = (flags & pose_t::FLAG_VALID) ? "valid" : "INVALID";
+  if (flags & pose_t::FLAG_DEGENERATE) out += ",degenerate";
+  if (flags & pose_t::FLAG_HELD) out += ",held";
+  return out;
+}
+
+std::string status_line(const status_t& s) {
+  std::string line = fmt::format("{} {}", state_text(s.state), s.session_id.empty() ? "-" : s.session_id);
+  for (const auto& h : s.sensors) line += fmt::format(" | {} {:.1f} Hz drop {}", h.name, h.packet_rate_hz, h.packets_dropped);
+  line += fmt::format(" | map {} pts {} tiles | disk {:.1f} GB", s.map_points, s.map_tiles, s.disk_free_bytes / 1e9);
+  if (!s.fault.empty()) line += " | FAULT " + s.fault;
+  return line;
+}
+
+void register_status(CLI::App& app, int& status) {
+  auto options = std::make_shared<ClientOptions>();
+  CLI::App* sub = app.add_subcommand("status", "Print the payload's state and health once");
+  add_client_options(*sub, *options);
+  sub->callback([options, &status] {
+    LcmClient client(*options);
+    const auto s = client.wait_status();
+    if (!s) {
+      status = no_answer(*options);
+      return;
+    }
+    fmt::print("payload   {}\nstate     {}\nsession   {}\nmap       {} points in {} tiles\ndisk free {:.1f} GB\n",
+               s->payload_id, state_text(s->state), s->session_id.empty() ? "-" : s->session_id, s->map_points,
+               s->map_tiles, s->disk_free_bytes / 1e9);
+    for (const auto& h : s->sensors)
+      fmt::print("sensor    {}: {:.1f} Hz, {} dropped, time offset {:.3f} s\n", h.name, h.packet_rate_hz,
+                 h.packets_dropped, h.time_offset_s);
+    for (const auto& t : s->threads)
+      fmt::print("thread    {}: load {:.0f}%, queue {}/{}\n", t.name, 100 * t.load, t.queue_depth, t.queue_capacity);
+    fmt::print("fault     {}\n", s->fault.empty() ? "none" : s->fault);
+    status = kExitOk;
+  });
+}
+
+void register_watch(CLI::App& app, int& status) {
+  auto options = std::make_shared<ClientOptions>();
+  auto duration = std::make_shared<double>(0.0);
+  CLI::App* sub = app.add_subcommand("watch", "Show pose, rates and health on one live line");
+  add_client_options(*sub, *options);
+  sub->add_option("--duration", *duration, "Stop after this many seconds (0: until interrupted)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sub->callback([options, duration, &status] {
+    using Clock = std::chrono::steady_clock;
+    LcmClient client(*options);
+    const auto start = Clock::now();
+    auto last_message = start;
+    auto last_print = start;
+    std::size_t poses = 0;
+    double pose_rate = 0;
+    auto rate_window = start;
+    std::size_t rate_count = 0;
+    pose_t pose;
+    std::string health = "(no status yet)";
+    bool any = false;
+    const auto print = [&] {
+      fmt::print("\r\033[K#{} x {:.2f} y {:.2f} z {:.2f} {} {:.1f} Hz | {}", pose.seq, pose.position[0],
+                 pose.position[1], pose.position[2], pose_flags(pose.flags), pose_rate, health);
+      std::fflush(stdout);
+      last_print = Clock::now();
+    };
+    const auto elapsed = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    bool silent = false;
+    client.watch(
+        [&](const pose_t& p) {
+          pose = p;
+          ++poses;
+          ++rate_count;
+          any = true;
+          last_message = Clock::now();
+          if (elapsed(rate_window) >= 1.0) {
+            pose_rate = rate_count / elapsed(rate_window);
+            rate_count = 0;
+            rate_window = Clock::now();
+          }
+          if (elapsed(last_print) >= 0.1) print();
+        },
+        [&](const status_t& s) {
+          health = status_line(s);
+          any = true;
+          last_message = Clock::now();
+          print();
+        },
+        [&] {
+          if (elapsed(last_message) > options->timeout_s) silent = true;
+          return silent || (*duration > 0 && elapsed(start) >= *duration);
+        });
+    if (any) fmt::print("\n{} poses received\n", poses);
+    status = silent && !any ? no_answer(*options) : kExitOk;
+    if (silent && any) {
+      fmt::print(stderr, "adit: error: payload '{}' went silent for {} s\n", options->payload_id, options->timeout_s);
+      status = kExitFailure;
+    }
+  });
+}
+
+void register_verb(CLI::App& app, int& status, const std::string& name, const std::string& verb,
+                   const std::string& help, bool print_detail) {
+  auto options = std::make_shared<ClientOptions>();
+  CLI::App* sub = app.add_subcommand(name, help);
+  add_client_options(*sub, *options);
+  sub->callback([options, &status, verb, print_detail] { status = run_command(*options, verb, print_detail); });
+}
+
+}  // namespace
+
+void register_client_commands(CLI::App& app, int& status) {
+  register_status(app, status);
+  register_watch(app, status);
+  register_verb(app, status, "start", "START", "Start a mapping session", false);
+  register_verb(app, status, "stop", "STOP", "Stop the mapping session (the payload flushes, then goes idle)", false);
+  register_verb(app, status, "sessions", "SESSIONS", "List the sessions stored on the payload", true);
+  register_verb(app, status, "ping", "PING", "Check that the payload answers commands", false);
+}
+
+}  // namespace adit::tools

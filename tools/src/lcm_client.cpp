@@ -1,0 +1,222 @@
+#include "lcm_client.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "adit/command_t.hpp"
+#include "adit/common/error.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
+#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_index_t.hpp"
+#include "adit/tile_request_t.hpp"
+
+namespace adit::tools {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using protocol::Channel;
+
+std::int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Decodes one message body, or nullopt when it is not a `Message`.
+template <typename Message>
+std::optional<Message> decode(const lcm::ReceiveBuffer* rbuf) {
+  Message m;
+  if (!protocol::checked_decode(rbuf->data, rbuf->data_size, m)) return std::nullopt;
+  return m;
+}
+
+constexpr std::size_t kMaxRequestEntries = 3000;  // tile_request_t stays < 60 KB
+
+// A subscription for as long as it lives (LCM 1.3 takes no std::function).
+class Listen {
+ public:
+  using Handler = std::function<void(const lcm::ReceiveBuffer*)>;
+  Listen(lcm::LCM& lcm, const std::string& channel, Handler handler) : lcm_(lcm), handler_(std::move(handler)) {
+    subscription_ = lcm_.subscribe(channel, &Listen::on_message, this);
+  }
+  ~Listen() { lcm_.unsubscribe(subscription_); }
+  Listen(const Listen&) = delete;
+  Listen& operator=(const Listen&) = delete;
+
+ private:
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) { handler_(rbuf); }
+  lcm::LCM& lcm_;
+  Handler handler_;
+  lcm::Subscription* subscription_ = nullptr;
+};
+
+}  // namespace
+
+struct LcmClient::Impl {
+  ClientOptions options;
+  lcm::LCM lcm;
+  std::mt19937_64 rng{std::random_device{}()};
+
+  explicit Impl(ClientOptions o) : options(std::move(o)), lcm(options.lcm_url) {
+    if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
+      throw InputError("--payload", "payload", problem);
+    if (!lcm.good()) throw InputError("--lcm-url", "lcm-url", fmt::format("LCM cannot open '{}'", options.lcm_url));
+  }
+
+  std::string channel(Channel c) const { return protocol::channel_name(options.payload_id, c); }
+  std::int64_t new_request_id() {
+    std::int64_t id = 0;
+    while (id <= 0) id = static_cast<std::int64_t>(rng() >> 1);
+    return id;
+  }
+  // Handles messages for at most `seconds` (returns earlier when one arrives).
+  void handle_for(double seconds) { lcm.handleTimeout(std::max(1, static_cast<int>(seconds * 1000))); }
+};
+
+LcmClient::LcmClient(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+LcmClient::~LcmClient() = default;
+
+std::optional<command_ack_t> LcmClient::command(const std::string& verb, const std::vector<std::string>& args) {
+  command_t c;
+  c.schema = 1;
+  c.request_id = impl_->new_request_id();
+  c.payload_id = impl_->options.payload_id;
+  c.verb = verb;
+  c.args = args;
+  c.n_args = static_cast<std::int32_t>(args.size());
+  c.auth_size = 0;
+  std::optional<command_ack_t> answer;
+  const Listen acks(impl_->lcm, impl_->channel(Channel::ack), [&](const lcm::ReceiveBuffer* rbuf) {
+    auto ack = decode<command_ack_t>(rbuf);
+    if (ack && ack->request_id == c.request_id) answer = std::move(ack);
+  });
+  const auto start = Clock::now();
+  auto last_send = start - std::chrono::seconds(1);
+  while (!answer && seconds_since(start) < impl_->options.timeout_s) {
+    if (seconds_since(last_send) >= 0.25) {
+      c.utime = now_utime();
+      impl_->lcm.publish(impl_->channel(Channel::command), &c);
+      last_send = Clock::now();
+    }
+    impl_->handle_for(0.05);
+  }
+  return answer;
+}
+
+std::optional<status_t> LcmClient::wait_status() {
+  std::optional<status_t> status;
+  const Listen statuses(impl_->lcm, impl_->channel(Channel::status), [&](const lcm::ReceiveBuffer* rbuf) {
+    if (auto s = decode<status_t>(rbuf)) status = std::move(s);
+  });
+  const auto start = Clock::now();
+  while (!status && seconds_since(start) < impl_->options.timeout_s) impl_->handle_for(0.05);
+  return status;
+}
+
+void LcmClient::watch(const std::function<void(const pose_t&)>& on_pose,
+                      const std::function<void(const status_t&)>& on_status, const std::function<bool()>& until) {
+  const Listen poses(impl_->lcm, impl_->channel(Channel::pose), [&](const lcm::ReceiveBuffer* rbuf) {
+    if (auto p = decode<pose_t>(rbuf)) on_pose(*p);
+  });
+  const Listen statuses(impl_->lcm, impl_->channel(Channel::status), [&](const lcm::ReceiveBuffer* rbuf) {
+    if (auto s = decode<status_t>(rbuf)) on_status(*s);
+  });
+  while (!until()) impl_->handle_for(0.05);
+}
+
+LcmClient::DownloadResult LcmClient::download(const std::string& session, protocol::TileAssembler& tiles,
+                                              const std::function<void(std::size_t, std::size_t)>& progress) {
+  DownloadResult result;
+  std::string locked = session;  // "" until the daemon names its current session
+  std::set<std::int32_t> parts;
+  std::int32_t n_parts = -1;
+  std::string index_error;
+  std::set<std::int64_t> my_requests;  // other clients' errors are not ours
+  auto last_progress = Clock::now();
+  const Listen index(impl_->lcm, impl_->channel(Channel::tile_index), [&](const lcm::ReceiveBuffer* rbuf) {
+    const auto m = decode<tile_index_t>(rbuf);
+    if (!m || m->payload_id != impl_->options.payload_id) return;
+    if (!m->error.empty()) {
+      if (my_requests.count(m->request_id) != 0) index_error = m->error;
+      return;
+    }
+    if (locked.empty()) locked = m->session_id;
+    if (m->session_id != locked) return;
+    for (std::size_t i = 0; i < m->tile_ids.size(); ++i)
+      tiles.note_index(m->tile_ids[i], m->versions[i], m->n_chunks[i]);
+    if (!m->full) return;  // a broadcast of changed tiles only
+    parts.insert(m->part);
+    n_parts = m->n_parts;
+    last_progress = Clock::now();
+  });
+  auto last_chunk = Clock::now();
+  const Listen chunks(impl_->lcm, impl_->channel(Channel::tile), [&](const lcm::ReceiveBuffer* rbuf) {
+    const auto m = decode<tile_chunk_t>(rbuf);
+    if (!m || locked.empty() || m->session_id != locked) return;
+    const auto outcome = tiles.add_chunk(*m);
+    last_chunk = Clock::now();
+    if (outcome == protocol::ChunkOutcome::stored || outcome == protocol::ChunkOutcome::completed) {
+      last_progress = last_chunk;
+      progress(tiles.chunks_have(), tiles.chunks_wanted());
+    }
+  });
+  const auto index_complete = [&] { return n_parts > 0 && static_cast<std::int32_t>(parts.size()) >= n_parts; };
+
+  tile_request_t request;
+  request.schema = 1;
+  request.payload_id = impl_->options.payload_id;
+  request.session_id = session;
+  auto last_send = Clock::now() - std::chrono::seconds(10);
+  while (true) {
+    if (!index_error.empty()) {
+      result.error = index_error;
+      break;
+    }
+    if (seconds_since(last_progress) > impl_->options.timeout_s) {
+      result.error = index_complete()
+                         ? fmt::format("no tile data for {} s ({} of {} chunks)", impl_->options.timeout_s,
+                                       tiles.chunks_have(), tiles.chunks_wanted())
+                         : fmt::format("no payload '{}' answered within {} s", impl_->options.payload_id,
+                                       impl_->options.timeout_s);
+      break;
+    }
+    if (index_complete() && tiles.complete()) {
+      result.ok = true;
+      break;
+    }
+    // Ask again once the stream has been quiet for a moment: what is still
+    // missing then was lost (or never sent).
+    const bool quiet = seconds_since(last_chunk) > 0.3 && seconds_since(last_send) > 0.5;
+    if (quiet) {
+      const auto missing = tiles.missing(kMaxRequestEntries);
+      request.request_id = impl_->new_request_id();
+      my_requests.insert(request.request_id);
+      request.utime = now_utime();
+      request.session_id = locked;
+      request.want_index = !index_complete();
+      request.tile_ids.clear();
+      request.versions.clear();
+      request.chunks.clear();
+      for (const auto& m : missing) {
+        request.tile_ids.push_back(m.tile_id);
+        request.versions.push_back(m.version);
+        request.chunks.push_back(m.chunk);
+      }
+      request.n_entries = static_cast<std::int32_t>(missing.size());
+      impl_->lcm.publish(impl_->channel(Channel::tile_request), &request);
+      ++result.requests;
+      last_send = Clock::now();
+    }
+    impl_->handle_for(0.05);
+  }
+  return result;
+}
+
+}  // namespace adit::tools

@@ -1,0 +1,58 @@
+#pragma once
+// The client side of the tablet protocol (docs/PROTOCOL.md), shared by the
+// `adit` status/watch/start/stop/sessions/download commands: one LCM socket,
+// one payload, typed waits with timeouts.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "adit/command_ack_t.hpp"
+#include "adit/pose_t.hpp"
+#include "adit/protocol/tile_assembler.hpp"
+#include "adit/status_t.hpp"
+
+namespace adit::tools {
+
+struct ClientOptions {
+  std::string lcm_url;
+  std::string payload_id;
+  double timeout_s = 5;
+};
+
+class LcmClient {
+ public:
+  // Throws InputError for a bad payload id and runtime_error when LCM fails.
+  explicit LcmClient(ClientOptions options);
+  ~LcmClient();
+
+  // Sends `verb` and waits for its ack, resending with the same request id
+  // every 250 ms (the daemon answers replays without executing them again).
+  std::optional<command_ack_t> command(const std::string& verb, const std::vector<std::string>& args = {});
+  std::optional<status_t> wait_status();
+
+  // Calls `on_pose`/`on_status` for every message until `until` returns true.
+  void watch(const std::function<void(const pose_t&)>& on_pose, const std::function<void(const status_t&)>& on_status,
+             const std::function<bool()>& until);
+
+  struct DownloadResult {
+    bool ok = false;
+    std::string error;
+    std::size_t requests = 0;
+  };
+  // Fetches the tile index and every tile of `session` ("" = the current one)
+  // into `tiles`, re-requesting what is missing until complete or no progress
+  // for the timeout. `progress(have, wanted)` is called as chunks arrive.
+  DownloadResult download(const std::string& session, protocol::TileAssembler& tiles,
+                          const std::function<void(std::size_t, std::size_t)>& progress);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace adit::tools
