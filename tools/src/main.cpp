@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
     int status = adit::kExitOk;
     adit::tools::register_config_commands(app, status);
     adit::tools::register_lidar_commands(app, status);
+    adit::tools::register_can_commands(app, status);
+    adit::tools::register_calibrate_wheels_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {

@@ -1,0 +1,158 @@
+#include "adit/slam/wheel_odometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Dense>
+
+namespace adit::slam {
+
+std::int64_t counter_delta(std::uint64_t previous, std::uint64_t current, unsigned bits) {
+  bits = std::clamp(bits, 1U, 64U);
+  const std::uint64_t diff = current - previous;  // modulo 2^64
+  if (bits == 64) return static_cast<std::int64_t>(diff);
+  const std::uint64_t mask = (std::uint64_t{1} << bits) - 1;
+  const std::uint64_t d = diff & mask;
+  const std::uint64_t half = std::uint64_t{1} << (bits - 1);
+  return d >= half ? static_cast<std::int64_t>(d) - static_cast<std::int64_t>(mask) - 1 : static_cast<std::int64_t>(d);
+}
+
+void integrate_wheel_travel(Pose2& pose, Eigen::Matrix3d& covariance, double ds_left, double ds_right,
+                            double effective_track, const WheelNoise& noise) {
+  const double b = effective_track;
+  const double ds = 0.5 * (ds_left + ds_right);
+  const double dtheta = (ds_right - ds_left) / b;
+  const double mid = pose.theta + 0.5 * dtheta;
+  const double c = std::cos(mid);
+  const double s = std::sin(mid);
+
+  // Siegwart et al. eq. 5.9-5.11: F_p with respect to the pose, F_d with
+  // respect to (ds_right, ds_left).
+  Eigen::Matrix3d fp = Eigen::Matrix3d::Identity();
+  fp(0, 2) = -ds * s;
+  fp(1, 2) = ds * c;
+  Eigen::Matrix<double, 3, 2> fd;
+  fd << 0.5 * c - ds / (2 * b) * s, 0.5 * c + ds / (2 * b) * s,  //
+      0.5 * s + ds / (2 * b) * c, 0.5 * s - ds / (2 * b) * c,      //
+      1.0 / b, -1.0 / b;
+  const Eigen::Vector2d wheel_variance(noise.k_right * std::abs(ds_right), noise.k_left * std::abs(ds_left));
+  covariance = fp * covariance * fp.transpose() + fd * wheel_variance.asDiagonal() * fd.transpose();
+  covariance(2, 2) += noise.k_turn * std::abs(dtheta);
+
+  pose.x += ds * c;
+  pose.y += ds * s;
+  pose.theta = wrap_angle(pose.theta + dtheta);
+}
+
+WheelOdometry::WheelOdometry(const WheelGeometry& geometry, const WheelNoise& noise, const WheelLimits& limits)
+    : geometry_(geometry), noise_(noise), limits_(limits) {}
+
+void WheelOdometry::reset(const Pose2& pose) {
+  pose_ = pose;
+  covariance_.setZero();
+  distance_ = 0.0;
+  have_previous_ = false;
+  have_counts_ = false;
+  rejected_in_a_row_ = 0;
+}
+
+WheelStep WheelOdometry::add_speeds(double t, double v_left, double v_right) { return step(t, v_left, v_right, false); }
+
+WheelStep WheelOdometry::add_wheel_rates(double t, double w_left, double w_right) {
+  return step(t, w_left * geometry_.left_radius, w_right * geometry_.right_radius, false);
+}
+
+WheelStep WheelOdometry::add_counts(double t, std::uint64_t left, std::uint64_t right) {
+  if (!have_counts_ || !have_previous_) {
+    left_count_ = left;
+    right_count_ = right;
+    have_counts_ = true;
+    return step(t, 0.0, 0.0, true);
+  }
+  const double dt = t - t_previous_;
+  if (!(dt > 0.0)) return step(t, 0.0, 0.0, true);  // reports time_backwards
+  const std::int64_t dl = counter_delta(left_count_, left, geometry_.counter_bits);
+  const std::int64_t dr = counter_delta(right_count_, right, geometry_.counter_bits);
+  const double per_count = 2.0 * std::numbers::pi / geometry_.counts_per_revolution;
+  const WheelStep result =
+      step(t, static_cast<double>(dl) * per_count * geometry_.left_radius / dt,
+           static_cast<double>(dr) * per_count * geometry_.right_radius / dt, true);
+  // A rejected reading keeps the old baseline, so the next good reading
+  // covers the whole interval exactly (encoder counts are absolute).
+  if (result != WheelStep::impossible && result != WheelStep::slip && result != WheelStep::time_backwards) {
+    if ((dl > 0 && left < left_count_) || (dl < 0 && left > left_count_)) ++stats_.counter_wraps;
+    if ((dr > 0 && right < right_count_) || (dr < 0 && right > right_count_)) ++stats_.counter_wraps;
+    left_count_ = left;
+    right_count_ = right;
+  }
+  return result;
+}
+
+WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from_counts) {
+  const auto baseline = [&](double vl, double vr) {
+    t_previous_ = t;
+    v_left_previous_ = vl;
+    v_right_previous_ = vr;
+    rejected_in_a_row_ = 0;
+    have_previous_ = true;
+  };
+  const bool plausible = std::isfinite(v_left) && std::isfinite(v_right) && std::abs(v_left) <= limits_.max_speed &&
+                         std::abs(v_right) <= limits_.max_speed;
+  if (!std::isfinite(t)) {
+    ++stats_.time_backwards;
+    return WheelStep::time_backwards;
+  }
+  if (!have_previous_) {
+    baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+    return WheelStep::first;
+  }
+  const double dt = t - t_previous_;
+  if (!(dt > 0.0)) {
+    ++stats_.time_backwards;
+    return WheelStep::time_backwards;
+  }
+  if (dt > limits_.max_gap) {
+    ++stats_.gaps;
+    baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+    return WheelStep::gap;
+  }
+  WheelStep verdict = WheelStep::integrated;
+  if (!plausible) {
+    verdict = WheelStep::impossible;
+  } else if (const double dv_max = limits_.max_acceleration * std::max(dt, limits_.min_interval) + limits_.speed_noise;
+             !from_counts && (std::abs(v_left - v_left_previous_) > dv_max || std::abs(v_right - v_right_previous_) > dv_max)) {
+    // Not for counts: one count of quantisation at a high sample rate looks
+    // like a huge acceleration; counts are only checked for impossible speed.
+    verdict = WheelStep::slip;
+  }
+  if (verdict != WheelStep::integrated) {
+    ++(verdict == WheelStep::impossible ? stats_.impossible : stats_.slips);
+    if (++rejected_in_a_row_ > limits_.max_rejected) {
+      ++stats_.rebaselined;
+      baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+      return WheelStep::rebaselined;
+    }
+    if (from_counts) return verdict;  // baseline kept; the next good reading covers this interval
+    // Speeds: hold the last trusted speed over this interval.
+    const double hl = v_left_previous_ * dt * geometry_.left_scale;
+    const double hr = v_right_previous_ * dt * geometry_.right_scale;
+    integrate_wheel_travel(pose_, covariance_, hl, hr, geometry_.effective_track(), noise_);
+    distance_ += std::abs(0.5 * (hl + hr));
+    t_previous_ = t;
+    return verdict;
+  }
+  // Counts give the exact travel over the interval; speeds are sampled, so
+  // the trapezoid rule integrates them.
+  const double vl = from_counts ? v_left : 0.5 * (v_left + v_left_previous_);
+  const double vr = from_counts ? v_right : 0.5 * (v_right + v_right_previous_);
+  const double dl = vl * dt * geometry_.left_scale;
+  const double dr = vr * dt * geometry_.right_scale;
+  integrate_wheel_travel(pose_, covariance_, dl, dr, geometry_.effective_track(), noise_);
+  distance_ += std::abs(0.5 * (dl + dr));
+  ++stats_.integrated;
+  baseline(v_left, v_right);
+  return WheelStep::integrated;
+}
+
+}  // namespace adit::slam

@@ -1,0 +1,140 @@
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "adit/slam/wheel_odometry.hpp"
+
+namespace slam = adit::slam;
+
+namespace {
+slam::WheelGeometry geometry() {
+  slam::WheelGeometry g;
+  g.left_radius = 0.1;
+  g.right_radius = 0.1;
+  g.track_width = 0.5;
+  g.counts_per_revolution = 1000;
+  g.counter_bits = 16;
+  return g;
+}
+}  // namespace
+
+TEST(WheelOdometry, StraightLineAndCovarianceGrowsWithDistance) {
+  slam::WheelOdometry odo(geometry());
+  EXPECT_EQ(odo.add_speeds(0.0, 1.0, 1.0), slam::WheelStep::first);
+  double previous_variance = 0.0;
+  for (int i = 1; i <= 100; ++i) {
+    ASSERT_EQ(odo.add_speeds(i * 0.01, 1.0, 1.0), slam::WheelStep::integrated);
+    const double variance = odo.covariance().trace();
+    EXPECT_GT(variance, previous_variance);
+    previous_variance = variance;
+  }
+  EXPECT_NEAR(odo.pose().x, 1.0, 1e-12);
+  EXPECT_NEAR(odo.pose().y, 0.0, 1e-12);
+  EXPECT_NEAR(odo.distance(), 1.0, 1e-12);
+  // Lateral uncertainty appears only through heading uncertainty.
+  EXPECT_GT(odo.covariance()(1, 1), 0.0);
+}
+
+TEST(WheelOdometry, CircleClosesAndTurningAddsHeadingVariance) {
+  const slam::WheelGeometry g = geometry();
+  slam::WheelOdometry odo(g);
+  // Radius 1 m: v_l = w (R - b/2), v_r = w (R + b/2), with w = 1 rad/s for 2 pi s.
+  const double w = 1.0;
+  const int steps = 6283;
+  const double dt = 2 * std::numbers::pi / steps;
+  for (int i = 0; i <= steps; ++i) odo.add_speeds(i * dt, w * (1 - 0.25), w * (1 + 0.25));
+  EXPECT_NEAR(odo.pose().x, 0.0, 1e-6);
+  EXPECT_NEAR(odo.pose().y, 0.0, 1e-6);
+  EXPECT_NEAR(odo.pose().theta, 0.0, 1e-6);
+
+  // Same wheel travel in total, so Siegwart's wheel terms are equal; the
+  // turning term makes the turning run's heading less certain.
+  slam::WheelOdometry straight(g);
+  slam::WheelOdometry turning(g);
+  for (int i = 0; i <= 100; ++i) {
+    straight.add_speeds(i * 0.01, 1.0, 1.0);
+    turning.add_speeds(i * 0.01, 0.5, 1.5);  // same centre distance
+  }
+  EXPECT_NEAR(straight.distance(), turning.distance(), 1e-12);
+  EXPECT_GT(turning.covariance()(2, 2), straight.covariance()(2, 2));
+}
+
+TEST(WheelOdometry, SkidFactorWidensTheEffectiveTrack) {
+  slam::WheelGeometry g = geometry();
+  g.skid_factor = 2.0;
+  slam::WheelOdometry odo(g);
+  for (int i = 0; i <= 10; ++i) odo.add_speeds(i * 0.1, -0.5, 0.5);
+  EXPECT_NEAR(odo.pose().theta, 1.0 / (0.5 * 2.0), 1e-12);
+}
+
+TEST(WheelOdometry, CounterDeltaWraps) {
+  EXPECT_EQ(slam::counter_delta(65530, 5, 16), 11);
+  EXPECT_EQ(slam::counter_delta(5, 65530, 16), -11);
+  EXPECT_EQ(slam::counter_delta(0xFFFFFFFFFFFFFFFFULL, 1, 64), 2);
+  EXPECT_EQ(slam::counter_delta(100, 90, 32), -10);
+  EXPECT_EQ(slam::counter_delta(0, 32767, 16), 32767);
+  EXPECT_EQ(slam::counter_delta(0, 32768, 16), -32768);
+}
+
+TEST(WheelOdometry, EncoderCountsAcrossWrapIntegrateExactly) {
+  slam::WheelOdometry odo(geometry());
+  // 1 revolution = 1000 counts = 0.2 pi m; start near the 16-bit top.
+  std::uint64_t c = 65000;
+  odo.add_counts(0.0, c, c);
+  for (int i = 1; i <= 20; ++i) {
+    c = (c + 100) & 0xFFFF;
+    ASSERT_EQ(odo.add_counts(i * 0.1, c, c), slam::WheelStep::integrated);
+  }
+  EXPECT_NEAR(odo.pose().x, 2.0 * 0.2 * std::numbers::pi, 1e-9);
+  EXPECT_EQ(odo.stats().counter_wraps, 2U);  // left and right wrapped once each
+}
+
+TEST(WheelOdometry, CounterGlitchIsRejectedAndTheNextGoodReadingCoversTheInterval) {
+  slam::WheelOdometry odo(geometry());
+  odo.add_counts(0.0, 0, 0);
+  odo.add_counts(0.1, 100, 100);
+  // A corrupted reading: 30000 counts in 0.1 s is 188 m/s.
+  EXPECT_EQ(odo.add_counts(0.2, 30100, 200), slam::WheelStep::impossible);
+  EXPECT_EQ(odo.add_counts(0.3, 300, 300), slam::WheelStep::integrated);
+  EXPECT_NEAR(odo.pose().x, 300 * 0.2 * std::numbers::pi / 1000, 1e-9);
+  EXPECT_NEAR(odo.pose().theta, 0.0, 1e-12);
+  EXPECT_EQ(odo.stats().impossible, 1U);
+}
+
+TEST(WheelOdometry, SpeedSpikeIsHeldNotIntegrated) {
+  slam::WheelOdometry odo(geometry());
+  odo.add_speeds(0.0, 1.0, 1.0);
+  odo.add_speeds(0.1, 1.0, 1.0);
+  EXPECT_EQ(odo.add_speeds(0.2, 9.0, 1.0), slam::WheelStep::slip);  // 80 m/s^2 on one wheel
+  EXPECT_EQ(odo.add_speeds(0.3, 1.0, 1.0), slam::WheelStep::integrated);
+  EXPECT_NEAR(odo.pose().x, 0.3, 1e-9);
+  EXPECT_NEAR(odo.pose().theta, 0.0, 1e-12);
+  EXPECT_EQ(odo.add_speeds(0.4, 100.0, 1.0), slam::WheelStep::impossible);
+  EXPECT_EQ(odo.add_speeds(0.5, NAN, 1.0), slam::WheelStep::impossible);
+  EXPECT_EQ(odo.stats().slips, 1U);
+  EXPECT_EQ(odo.stats().impossible, 2U);
+}
+
+TEST(WheelOdometry, RealStepChangeIsAcceptedAfterRepeatedRejections) {
+  slam::WheelLimits limits;
+  limits.max_rejected = 3;
+  slam::WheelOdometry odo(geometry(), {}, limits);
+  odo.add_speeds(0.0, 0.0, 0.0);
+  odo.add_speeds(0.01, 0.0, 0.0);
+  for (int i = 2; i <= 4; ++i) EXPECT_EQ(odo.add_speeds(i * 0.01, 5.0, 5.0), slam::WheelStep::slip);
+  EXPECT_EQ(odo.add_speeds(0.05, 5.0, 5.0), slam::WheelStep::rebaselined);
+  EXPECT_EQ(odo.add_speeds(0.06, 5.0, 5.0), slam::WheelStep::integrated);
+  EXPECT_EQ(odo.stats().rebaselined, 1U);
+}
+
+TEST(WheelOdometry, TimeBackwardsAndGapsAreNotIntegrated) {
+  slam::WheelOdometry odo(geometry());
+  odo.add_speeds(1.0, 1.0, 1.0);
+  EXPECT_EQ(odo.add_speeds(0.5, 1.0, 1.0), slam::WheelStep::time_backwards);
+  EXPECT_EQ(odo.add_speeds(1.0, 1.0, 1.0), slam::WheelStep::time_backwards);
+  EXPECT_EQ(odo.add_speeds(5.0, 1.0, 1.0), slam::WheelStep::gap);
+  EXPECT_EQ(odo.pose().x, 0.0);
+  EXPECT_EQ(odo.add_speeds(5.1, 1.0, 1.0), slam::WheelStep::integrated);
+  EXPECT_NEAR(odo.pose().x, 0.1, 1e-12);
+}
