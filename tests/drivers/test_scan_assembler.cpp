@@ -143,6 +143,27 @@ TEST(ScanAssembler, JitterBackAcrossTheCutDoesNotCutTwice) {
   EXPECT_EQ(assembler.flush()->points.size(), 4u);
 }
 
+TEST(ScanAssembler, CutsWhereAFieldOfViewGapJumpsOverTheCut) {
+  // A sensor sending only 270°..90° (cut at 180°): the firings jump from 89° to 271°.
+  ScanAssemblerConfig c = config(180.0F);
+  ScanAssembler assembler(c);
+  const float az[] = {300.0F, 10.0F, 60.0F, 89.0F, 271.0F, 330.0F, 20.0F, 89.5F, 270.5F};
+  std::vector<DecodedPoint> pts(std::size(az));
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].azimuth_deg = az[i];
+    pts[i].sensor_time_ns = static_cast<std::int64_t>(i) * 1000;
+  }
+  std::vector<std::size_t> sizes;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const DecodedPacket p{PacketStatus::ok, pts[i].sensor_time_ns, static_cast<std::uint32_t>(i), std::span(pts).subspan(i, 1)};
+    if (LidarScan* scan = assembler.add(p)) sizes.push_back(scan->points.size());
+  }
+  ASSERT_EQ(sizes.size(), 2u);
+  EXPECT_EQ(sizes[0], 4u);  // 300 … 89
+  EXPECT_EQ(sizes[1], 4u);  // 271 … 89.5
+  EXPECT_EQ(assembler.totals().complete_scans, 1u);
+}
+
 TEST(ScanAssembler, DropsPointsBeyondCapacityAndIgnoresBadPackets) {
   ScanAssemblerConfig c = config();
   c.max_points_per_scan = 6;

@@ -242,6 +242,25 @@ TEST(VelodyneRealdata, Vlp16DualManualAzimuthsStayWithinOneBlockOfTheReference) 
   std::printf("manual azimuths: %zu/%zu within one block step, largest difference %.3f deg\n", matched, total, worst);
 }
 
+// The VLP-32C capture comes from a sensor set to send only 270°..90°: each
+// packet that reaches 90° jumps to 270° inside itself. The decoder times the
+// firings after the jump by the rotation rate, the assembler cuts there and
+// does not count the skipped half turn as lost packets.
+TEST(VelodyneRealdata, Vlp32cFieldOfViewGapsAreNeitherLossNorBrokenScans) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-vlp32c");
+  const Decoded decoded = decode_capture(dir, VelodyneModel::vlp32c, "VLP32.yaml", 180.0F);
+  EXPECT_EQ(decoded.totals.missing_packets, 0u);
+  std::vector<const LidarScan*> complete;
+  for (const LidarScan& scan : decoded.scans) {
+    if (scan.stats.complete) complete.push_back(&scan);
+  }
+  ASSERT_GE(complete.size(), 3u);
+  for (std::size_t i = 1; i < complete.size(); ++i) {
+    const double period_ms = (complete[i]->sensor_start_time_ns - complete[i - 1]->sensor_start_time_ns) / 1e6;
+    EXPECT_NEAR(period_ms, 100.0, 1.0);  // 600 rpm; the gap's length is estimated to ~1%
+  }
+}
+
 TEST(VelodyneRealdata, Hdl32eTimingAndPositionPackets) {
   ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-hdl32e");
   const Decoded decoded = decode_capture(dir, VelodyneModel::hdl32e, "HDL32.yaml", 0.0F);

@@ -6,14 +6,16 @@
 
 namespace adit::drivers {
 namespace {
-// A scan is armed for the next cut once its firings reach the far half of the
-// revolution (but not the last few degrees before the cut), and the cut is a
-// firing within the first quarter after the cut azimuth: firings that jitter
-// back across the cut (rot corrections, dual returns) cannot cut twice, and
-// jitter anywhere else cannot cut at all.
+// A scan is cut where the firing azimuth moves forward past the cut azimuth.
+// Forward moves of up to kMaxForwardDeg count (a lost cut packet, or a sensor
+// limited to a field of view that jumps over the cut inside a packet); larger
+// ones are jitter backwards (rot corrections, dual returns). A scan is armed
+// for its cut only once its firings reach the far half of the revolution (but
+// not the last few degrees before the cut), so jitter across the cut cannot
+// cut twice.
 constexpr float kArmFromDeg = 180.0F;
 constexpr float kArmToDeg = 350.0F;
-constexpr float kCutWithinDeg = 90.0F;
+constexpr float kMaxForwardDeg = 300.0F;
 }  // namespace
 
 ScanAssembler::ScanAssembler(const ScanAssemblerConfig& config) : config_(config) {
@@ -46,6 +48,9 @@ ScanAssembler::Verdict ScanAssembler::classify(const DecodedPacket& packet) {
       }
     } else {
       const std::int64_t dt = packet.sensor_time_ns - last_time_ns_;
+      // The next packet is due one period after the last one, or right after its last firing
+      // when that came later (a field-of-view gap inside the packet).
+      const std::int64_t due = std::max(last_time_ns_ + config_.packet_period_ns, last_firing_ns_);
       if (dt == 0) {
         verdict = Verdict::duplicate;
       } else if (dt < 0) {
@@ -57,8 +62,13 @@ ScanAssembler::Verdict ScanAssembler::classify(const DecodedPacket& packet) {
           resync = true;
         }
       } else if (config_.packet_period_ns > 0) {
-        const std::int64_t periods = (dt + config_.packet_period_ns / 2) / config_.packet_period_ns;
-        gap = periods > 1 ? static_cast<std::uint64_t>(periods - 1) : 0;
+        // Half a period of tolerance, plus 2% of a field-of-view gap, whose length the decoder
+        // could only estimate from the rotation rate.
+        const std::int64_t period = config_.packet_period_ns;
+        const std::int64_t span = last_firing_ns_ - last_time_ns_;
+        const std::int64_t tolerance = period / 2 + (span > period ? span / 50 : 0);
+        const std::int64_t late_by = packet.sensor_time_ns - due;
+        gap = late_by > tolerance ? static_cast<std::uint64_t>(1 + (late_by - tolerance) / period) : 0;
       }
     }
     if (gap > kMaxCountedGap) {
@@ -82,6 +92,7 @@ ScanAssembler::Verdict ScanAssembler::classify(const DecodedPacket& packet) {
   have_last_ = true;
   last_sequence_ = sequence;
   last_time_ns_ = packet.sensor_time_ns;
+  last_firing_ns_ = packet.points.empty() ? packet.sensor_time_ns : packet.points.back().sensor_time_ns;
   return verdict;
 }
 
@@ -95,8 +106,12 @@ LidarScan* ScanAssembler::add(const DecodedPacket& packet, std::int64_t sensor_t
   for (const DecodedPoint& point : packet.points) {
     const LidarScan& scan = scans_[building_];
     const float rel = relative_azimuth(point.azimuth_deg);
+    const float forward = have_rel_ ? std::fmod(rel - last_rel_ + 360.0F, 360.0F) : 0.0F;
+    const bool passed_cut = have_rel_ && forward < kMaxForwardDeg && last_rel_ + forward >= 360.0F;
+    have_rel_ = true;
+    last_rel_ = rel;
     if (!scan.points.empty() && finished == nullptr) {
-      const bool crossed = armed_ && rel < kCutWithinDeg;
+      const bool crossed = armed_ && passed_cut;
       const bool overdue = config_.scan_period_ns > 0 &&
                            point.sensor_time_ns - scan.sensor_start_time_ns > config_.scan_period_ns * 3 / 2;
       if (crossed || overdue) {
@@ -151,6 +166,7 @@ LidarScan* ScanAssembler::flush() {
   if (scans_[building_].points.empty()) return nullptr;
   LidarScan* done = finish(false);
   have_last_ = false;
+  have_rel_ = false;
   return done;
 }
 

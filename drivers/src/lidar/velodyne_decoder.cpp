@@ -281,20 +281,31 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
   // such a gap, so the firings after it are interpolated with the usual
   // advance and timed after the gap at the current rotation rate.
   std::array<int, kBlocks> advance{};
-  int usual = 0;
+  int smallest = 0;
   for (std::size_t k = 0; k + 1 < groups; ++k) {
     advance[k] = (azimuth[(k + 1) * step] - azimuth[k * step] + kAzimuthSteps) % kAzimuthSteps;
-    if (advance[k] > 0 && (usual == 0 || advance[k] < usual)) usual = advance[k];
+    if (advance[k] > 0 && (smallest == 0 || advance[k] < smallest)) smallest = advance[k];
   }
+  const int gap_above = std::max(4 * smallest, kGapCentideg);
+  // The usual advance: the mean of those that are not gaps (0.01° per group).
+  int regular_sum = 0;
+  int regular_count = 0;
+  for (std::size_t k = 0; k + 1 < groups; ++k) {
+    if (advance[k] <= gap_above) {
+      regular_sum += advance[k];
+      ++regular_count;
+    }
+  }
+  const double usual = regular_count > 0 ? static_cast<double>(regular_sum) / regular_count : 0.0;
   std::array<std::int64_t, kBlocks> group_time{};
   std::int64_t gap_ns = 0;
   for (std::size_t k = 0; k < groups; ++k) {
     group_time[k] = packet_ns + static_cast<std::int64_t>(k) * group_ns_ + gap_ns;
     if (k + 1 == groups) {
       advance[k] = k > 0 ? advance[k - 1] : 0;  // the last group: the previous advance
-    } else if (usual > 0 && advance[k] > std::max(4 * usual, kGapCentideg)) {
-      gap_ns += static_cast<std::int64_t>(advance[k] - usual) * group_ns_ / usual;
-      advance[k] = usual;
+    } else if (usual > 0.0 && advance[k] > gap_above) {
+      gap_ns += std::llround((advance[k] - usual) * group_ns_ / usual);
+      advance[k] = static_cast<int>(std::lround(usual));
       ++fov_gaps_;
     }
   }

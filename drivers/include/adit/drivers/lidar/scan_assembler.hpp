@@ -74,6 +74,9 @@ class ScanAssembler {
   bool have_last_ = false;
   std::uint64_t last_sequence_ = 0;
   std::int64_t last_time_ns_ = 0;
+  std::int64_t last_firing_ns_ = 0;  // of the last accepted packet
+  bool have_rel_ = false;
+  float last_rel_ = 0.0F;            // azimuth of the last firing, relative to the cut
   std::int64_t sensor_to_host_ns_ = 0;
 };
 
