@@ -12,5 +12,6 @@ void register_config_commands(CLI::App& app, int& status);
 void register_lidar_commands(CLI::App& app, int& status);
 void register_can_commands(CLI::App& app, int& status);
 void register_calibrate_wheels_commands(CLI::App& app, int& status);
+void register_sim_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     adit::tools::register_lidar_commands(app, status);
     adit::tools::register_can_commands(app, status);
     adit::tools::register_calibrate_wheels_commands(app, status);
+    adit::tools::register_sim_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {

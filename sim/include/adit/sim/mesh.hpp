@@ -1,0 +1,31 @@
+#pragma once
+// A scene as a triangle soup with a reflectivity per triangle (0-100 diffuse,
+// as the Velodyne manual's calibrated reflectivity scale, §6.3).
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace adit::sim {
+
+struct TriangleMesh {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::uint8_t> reflectivity;  // per triangle
+
+  // Two triangles a-b-c, a-c-d.
+  void add_quad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3f& d,
+                std::uint8_t reflect);
+  void append(const TriangleMesh& other);
+};
+
+// Binary little-endian PLY: vertices (float x, y, z) and faces (uchar count, uint indices).
+// Point-cloud tools read the vertices, mesh tools the faces. Throws adit::InputError on I/O failure.
+void write_ply(const std::filesystem::path& file, const TriangleMesh& mesh);
+// Binary little-endian PLY with vertices only.
+void write_ply_points(const std::filesystem::path& file, const std::vector<Eigen::Vector3f>& points);
+
+}  // namespace adit::sim
