@@ -5,14 +5,13 @@
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
-#include "adit/drivers/lidar/velodyne_encoder.hpp"
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/robot_path.hpp"
 #include "adit/sim/session_config.hpp"
+#include "adit/sim/spinning_lidar.hpp"
 #include "adit/sim/targets.hpp"
 #include "adit/sim/truth.hpp"
-#include "adit/sim/velodyne_sim.hpp"
 #include "adit/sim/wheel_encoders.hpp"
 
 namespace adit::sim {
@@ -39,8 +38,7 @@ Eigen::Isometry3d robot_extrinsics() {
 void validate(const SimOptions& o) {
   require(o.scene == "mine" || o.scene == "drift", "--scene", "unknown scene '" + o.scene + "' (mine, drift)");
   require(o.platform == "robot", "--platform", "unknown platform '" + o.platform + "' (robot)");
-  const auto model = drivers::velodyne_model_from_name(o.sensor);
-  require(model == drivers::VelodyneModel::vlp16, "--sensor", "unsupported sensor '" + o.sensor + "' (VLP-16)");
+  make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
   require(std::isfinite(o.duration_s) && o.duration_s >= robot_min_duration_s() && o.duration_s <= 7200.0,
           "--duration", "must be between " + std::to_string(robot_min_duration_s()) + " and 7200 s");
   require(!o.out.empty(), "--out", "an output folder is required");
@@ -87,12 +85,11 @@ SimSummary run_simulation(const SimOptions& o) {
   const RayCaster caster(scene.mesh);
   const std::vector<Target> targets = place_targets(scene, caster, o.targets);
 
-  const auto model = *drivers::velodyne_model_from_name(o.sensor);
-  const drivers::VelodyneCalibration calibration = drivers::velodyne_nominal_calibration(model);
+  const SpinningSensor sensor = make_spinning_sensor(o.sensor);
   {
-    std::ofstream out(o.out / "VLP16.yaml", std::ios::trunc);
-    out << drivers::format_velodyne_calibration(calibration);
-    if (!out) throw InputError((o.out / "VLP16.yaml").string(), "", "could not write the calibration");
+    std::ofstream out(o.out / sensor.calibration_file, std::ios::trunc);
+    out << sensor.calibration_text;
+    if (!out) throw InputError((o.out / sensor.calibration_file).string(), "", "could not write the calibration");
   }
   LidarSimOptions lidar;
   lidar.effects.range_sigma_m = o.noise_m;
@@ -105,7 +102,7 @@ SimSummary run_simulation(const SimOptions& o) {
   lidar.extrinsics = robot_extrinsics();
   lidar.threads = o.threads;
   drivers::PcapWriter pcap(o.out / "lidar.pcap");
-  const LidarSimStats stats = simulate_velodyne(model, calibration, body, caster, scene.mesh, targets, lidar, pcap);
+  const LidarSimStats stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, lidar, pcap);
   pcap.flush();
 
   WheelOptions wheels;
@@ -122,7 +119,7 @@ SimSummary run_simulation(const SimOptions& o) {
   write_tum(o.out / "truth_sensor.tum", body, lidar.extrinsics, o.start_time_ns);
   write_ply(o.out / "scene.ply", scene.mesh);
   write_targets_csv(o.out / "targets.csv", targets);
-  write_session_config(o.out / "session.yaml", o, wheels, lidar.extrinsics);
+  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels, lidar.extrinsics);
 
   SimSummary summary;
   summary.packets = stats.packets;

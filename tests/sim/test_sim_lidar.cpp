@@ -6,13 +6,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 #include <vector>
 
-#include "adit/drivers/lidar/velodyne.hpp"
+#include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/pcap_reader.hpp"
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/robot_path.hpp"
 #include "adit/sim/scene.hpp"
+#include "adit/sim/spinning_lidar.hpp"
 #include "sim_session.hpp"
 
 namespace adit::sim {
@@ -53,22 +56,28 @@ Residuals check_capture(const SimOptions& o) {
   Eigen::Isometry3d extrinsics = Eigen::Isometry3d::Identity();
   extrinsics.translation() = Eigen::Vector3d(0.20, 0.0, 0.45);
 
-  drivers::VelodyneDecoder decoder(drivers::VelodyneModel::vlp16,
-                                   drivers::load_velodyne_calibration(o.out / "VLP16.yaml"));
+  const SpinningSensor sensor = make_spinning_sensor(o.sensor);
   drivers::PcapReader reader(o.out / "lidar.pcap");
-  const std::int64_t period = drivers::velodyne_packet_period_ns(drivers::VelodyneModel::vlp16,
-                                                                  drivers::VelodyneReturnMode::strongest);
+  const std::int64_t period = sensor.packet_period_ns;
   drivers::UdpDatagram d;
   std::int64_t previous_capture = 0;
+  std::unique_ptr<drivers::LidarDecoder> decoder;
   while (reader.next(d)) {
-    EXPECT_EQ(d.payload.size(), drivers::kVelodyneDataPacketSize);
-    EXPECT_EQ(d.dst_port, drivers::kVelodyneDataPort);
-    // The sensor's packet rate: one packet per 12 firing sequences of 110.592 µs (±1 µs capture resolution).
+    if (!decoder) {  // the registry recognises the packets, as the tools do with a field capture
+      const auto detected = drivers::detect_lidar(d.payload, d.dst_port);
+      EXPECT_NE(detected.family, nullptr);
+      if (detected.family == nullptr) return out;
+      EXPECT_EQ(detected.model, sensor.model);
+      decoder = detected.family->make_decoder(detected.model, o.out / sensor.calibration_file);
+    }
+    EXPECT_EQ(d.payload.size(), sensor.packet_size);
+    EXPECT_EQ(d.dst_port, sensor.port);
+    // The sensor's packet rate (±1 µs capture resolution).
     if (out.packets > 0) {
       EXPECT_NEAR(d.capture_time_ns - previous_capture, period, 1000);
     }
     previous_capture = d.capture_time_ns;
-    const auto packet = decoder.decode(d.payload, d.capture_time_ns);
+    const auto packet = decoder->decode(d.payload, d.capture_time_ns);
     EXPECT_EQ(packet.status, drivers::PacketStatus::ok);
     // The packet's time is its first firing on the common clock (µs timestamp).
     const std::int64_t first_firing = o.start_time_ns + static_cast<std::int64_t>(out.packets) * period;
@@ -104,13 +113,17 @@ Residuals check_capture(const SimOptions& o) {
   return out;
 }
 
-TEST(SimLidar, NoiselessPointsLieOnTheSurfaces) {
-  SimOptions o = test::short_session("noiseless");
+class SimLidar : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SimLidar, NoiselessPointsLieOnTheSurfaces) {
+  SimOptions o = test::short_session("noiseless-" + GetParam());
+  o.sensor = GetParam();
   o.noise_m = 0.0;
   o.wheels = false;
   run_simulation(o);
   const Residuals r = check_capture(o);
-  const auto expected = static_cast<std::size_t>(o.duration_s * 1e9 / 1'327'104);
+  // 753.5 packets/s for the VLP-16 (1.327104 ms), 750.75/s for the RS-16 (1.332 ms).
+  const auto expected = static_cast<std::size_t>(o.duration_s * 1e9 / (o.sensor == "VLP-16" ? 1'327'104 : 1'332'000));
   EXPECT_EQ(r.packets, expected);
   ASSERT_GT(r.points, r.packets * 300);  // inside a drift nearly every beam returns
   // 2 mm range unit, 0.01° azimuth quantisation and the laser's vertical offset: millimetres.
@@ -119,8 +132,9 @@ TEST(SimLidar, NoiselessPointsLieOnTheSurfaces) {
   EXPECT_GT(r.bright, 0u);  // the retro-reflective targets are seen
 }
 
-TEST(SimLidar, RangeNoiseIsTheConfiguredSigma) {
-  SimOptions o = test::short_session("noisy");
+TEST_P(SimLidar, RangeNoiseIsTheConfiguredSigma) {
+  SimOptions o = test::short_session("noisy-" + GetParam());
+  o.sensor = GetParam();
   o.noise_m = 0.03;
   o.wheels = false;
   run_simulation(o);
@@ -130,6 +144,9 @@ TEST(SimLidar, RangeNoiseIsTheConfiguredSigma) {
   EXPECT_GT(Residuals::fraction_within(r.r, 5 * 0.03), 0.999);
   EXPECT_GT(Residuals::fraction_within(r.normal, 5 * 0.03), 0.999);
 }
+
+INSTANTIATE_TEST_SUITE_P(Sensors, SimLidar, ::testing::Values("VLP-16", "RS-16"),
+                         [](const auto& info) { return info.param == "VLP-16" ? std::string("VLP16") : std::string("RS16"); });
 
 }  // namespace
 }  // namespace adit::sim

@@ -2,7 +2,7 @@
 // One simulated survey session: options in, a folder of files out, laid out
 // like a field recording plus its ground truth:
 //   lidar.pcap        the sensor's UDP packets       can.log          wheel TPDOs (candump -L)
-//   VLP16.yaml        the sensor's calibration       session.yaml     an adit config that replays it
+//   VLP16.yaml/RS16.csv the calibration       session.yaml     an adit config that replays it
 //   truth_body.tum    body trajectory (TUM)          truth_sensor.tum sensor trajectory (TUM)
 //   truth_wheels.csv  wheel angles per CAN frame     scene.ply        the surfaces (binary PLY mesh)
 //   targets.csv       surveyed wall targets (id,x,y,z)
@@ -16,7 +16,7 @@ namespace adit::sim {
 struct SimOptions {
   std::string scene = "mine";      // mine | drift
   std::string platform = "robot";  // robot
-  std::string sensor = "VLP-16";   // VLP-16
+  std::string sensor = "VLP-16";   // VLP-16 | RS-16
   double duration_s = 60.0;
   std::uint64_t seed = 1;
   std::filesystem::path out;

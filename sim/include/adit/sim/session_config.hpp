@@ -5,6 +5,7 @@
 // radius differs, as on a real robot). Paths are relative to the file.
 
 #include <filesystem>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -14,7 +15,8 @@
 namespace adit::sim {
 
 // Throws adit::InputError when the file cannot be written.
-void write_session_config(const std::filesystem::path& file, const SimOptions& options, const WheelOptions& wheels,
+void write_session_config(const std::filesystem::path& file, const SimOptions& options,
+                          const std::string& calibration_file, const WheelOptions& wheels,
                           const Eigen::Isometry3d& extrinsics);
 
 }  // namespace adit::sim
