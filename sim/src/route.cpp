@@ -4,7 +4,7 @@
 
 namespace adit::sim {
 
-double Route::length() const { return points.size() < 2 ? 0.0 : kStep * static_cast<double>(points.size() - (closed ? 0 : 1)); }
+double Route::length() const { return points.size() < 2 ? 0.0 : step * static_cast<double>(points.size() - (closed ? 0 : 1)); }
 
 Route smooth_route(const std::vector<Eigen::Vector2d>& polyline, bool closed, double max_piece_m) {
   std::vector<Eigen::Vector2d> p;
@@ -30,24 +30,27 @@ Route smooth_route(const std::vector<Eigen::Vector2d>& polyline, bool closed, do
     if (!closed) q.push_back(p.back());
     p = std::move(q);
   }
-  // Resample by arc length.
+  // Resample by arc length, at a step that divides the whole length evenly
+  // (a loop's last sample is then one step from its first: no jump at the seam).
   Route route;
   route.closed = closed;
   if (closed) p.push_back(p.front());
-  double carried = 0.0;  // arc length from the last emitted sample to the current vertex
-  route.points.push_back(p.front());
-  for (std::size_t i = 0; i + 1 < p.size(); ++i) {
-    const Eigen::Vector2d d = p[i + 1] - p[i];
-    const double len = d.norm();
-    double s = Route::kStep - carried;
-    while (s <= len) {
-      route.points.push_back(p[i] + d * (s / len));
-      s += Route::kStep;
+  double total = 0.0;
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) total += (p[i + 1] - p[i]).norm();
+  const auto steps = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(total / Route::kStep)));
+  route.step = total / static_cast<double>(steps);
+  route.points.reserve(steps + 1);
+  std::size_t segment = 0;
+  double segment_start = 0.0;  // arc length at p[segment]
+  for (std::size_t k = 0; k < (closed ? steps : steps + 1); ++k) {
+    const double s = std::min(static_cast<double>(k) * route.step, total);
+    while (segment + 2 < p.size() && segment_start + (p[segment + 1] - p[segment]).norm() < s) {
+      segment_start += (p[segment + 1] - p[segment]).norm();
+      ++segment;
     }
-    carried = len - (s - Route::kStep);
-  }
-  if (closed && route.points.size() > 1 && (route.points.back() - route.points.front()).norm() < 0.5 * Route::kStep) {
-    route.points.pop_back();
+    const Eigen::Vector2d d = p[segment + 1] - p[segment];
+    const double len = d.norm();
+    route.points.push_back(len > 0 ? Eigen::Vector2d(p[segment] + d * std::min((s - segment_start) / len, 1.0)) : p[segment]);
   }
   return route;
 }

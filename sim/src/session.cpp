@@ -7,6 +7,7 @@
 #include "adit/common/log.hpp"
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/sim/ray_caster.hpp"
+#include "adit/sim/drone_path.hpp"
 #include "adit/sim/robot_path.hpp"
 #include "adit/sim/session_config.hpp"
 #include "adit/sim/spinning_lidar.hpp"
@@ -21,26 +22,49 @@ void require(bool ok, const std::string& key, const std::string& reason) {
   if (!ok) throw InputError("adit sim", key, reason);
 }
 
-Scene make_scene(const SimOptions& o) {
+// Where the sensor sits: on the robot as in the VLP-16 robot template; on top of the drone.
+Eigen::Isometry3d sensor_extrinsics(const std::string& platform) {
+  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
+  e.translation() = platform == "drone" ? Eigen::Vector3d(0.0, 0.0, 0.12) : Eigen::Vector3d(0.20, 0.0, 0.45);
+  return e;
+}
+
+bool is_drone(const SimOptions& o) { return o.platform == "drone"; }
+
+}  // namespace
+
+Scene simulated_scene(const SimOptions& o) {
   if (o.scene == "drift") return make_drift(o.seed);
   return make_mine(o.seed);
 }
 
-// Where the sensor sits on the robot (as in the VLP-16 robot template).
-Eigen::Isometry3d robot_extrinsics() {
-  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.translation() = Eigen::Vector3d(0.20, 0.0, 0.45);
-  return e;
-}
+Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extrinsics(o.platform); }
 
-}  // namespace
+Trajectory simulated_path(const Scene& scene, const SimOptions& o) {
+  if (is_drone(o)) {
+    DronePathOptions d;
+    d.duration_s = o.duration_s;
+    d.speed_mps = o.speed_mps;
+    d.lateral_offset_m = o.lateral_offset_m;
+    d.seed = o.seed;
+    return drone_path(scene, d);
+  }
+  RobotPathOptions r;
+  r.duration_s = o.duration_s;
+  r.speed_mps = o.speed_mps;
+  r.lateral_offset_m = o.lateral_offset_m;
+  r.seed = o.seed;
+  return robot_path(scene, r);
+}
 
 void validate(const SimOptions& o) {
   require(o.scene == "mine" || o.scene == "drift", "--scene", "unknown scene '" + o.scene + "' (mine, drift)");
-  require(o.platform == "robot", "--platform", "unknown platform '" + o.platform + "' (robot)");
+  require(o.platform == "robot" || o.platform == "drone", "--platform",
+          "unknown platform '" + o.platform + "' (robot, drone)");
   make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
-  require(std::isfinite(o.duration_s) && o.duration_s >= robot_min_duration_s() && o.duration_s <= 7200.0,
-          "--duration", "must be between " + std::to_string(robot_min_duration_s()) + " and 7200 s");
+  const double shortest = is_drone(o) ? drone_min_duration_s() : robot_min_duration_s();
+  require(std::isfinite(o.duration_s) && o.duration_s >= shortest && o.duration_s <= 7200.0, "--duration",
+          "must be between " + std::to_string(shortest) + " and 7200 s for the " + o.platform);
   require(!o.out.empty(), "--out", "an output folder is required");
   require(std::isfinite(o.noise_m) && o.noise_m >= 0.0 && o.noise_m <= 1.0, "--noise-m", "must be in [0, 1] m");
   require(std::isfinite(o.dropout) && o.dropout >= 0.0 && o.dropout < 1.0, "--dropout", "must be in [0, 1)");
@@ -48,8 +72,9 @@ void validate(const SimOptions& o) {
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m && o.max_range_m <= 130.0, "--max-range-m",
           "must exceed --min-range-m and be at most 130 m (the VLP-16's 16-bit range field)");
   require(std::isfinite(o.rpm) && o.rpm >= 300.0 && o.rpm <= 1200.0, "--rpm", "the VLP-16 turns at 300-1200 rpm");
-  require(std::isfinite(o.speed_mps) && o.speed_mps > 0.0 && o.speed_mps <= RobotPathOptions::kMaxSpeed, "--speed",
-          "the robot drives at (0, 1.5] m/s");
+  const double fastest = is_drone(o) ? DronePathOptions::kMaxSpeed : RobotPathOptions::kMaxSpeed;
+  require(std::isfinite(o.speed_mps) && o.speed_mps > 0.0 && o.speed_mps <= fastest, "--speed",
+          "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s");
   require(std::isfinite(o.lateral_offset_m), "--lateral-offset-m", "must be a number");
   require(std::isfinite(o.wheel_radius_error) && std::abs(o.wheel_radius_error) <= 0.1, "--wheel-radius-error",
           "must be within ±0.1 (±10 %)");
@@ -62,18 +87,13 @@ void validate(const SimOptions& o) {
 
 SimSummary run_simulation(const SimOptions& o) {
   validate(o);
-  const Scene scene = make_scene(o);
-  RobotPathOptions path_options;
-  path_options.duration_s = o.duration_s;
-  path_options.speed_mps = o.speed_mps;
-  path_options.lateral_offset_m = o.lateral_offset_m;
-  path_options.seed = o.seed;
-  const Trajectory body = robot_path(scene, path_options);
-  // The robot (about 0.6 m wide) must stay clear of the walls all the way.
+  const Scene scene = simulated_scene(o);
+  const Trajectory body = simulated_path(scene, o);
+  // The platform (about 0.6 m wide) must stay clear of the walls, floor and roof all the way.
   double path_length = 0.0;
   for (std::size_t i = 0; i < body.samples().size(); ++i) {
     const Eigen::Vector3d& p = body.samples()[i].position;
-    if (scene.plan.distance(p.head<2>()) > -0.4) {
+    if (scene.plan.distance(p.head<2>()) > -0.4 || p.z() > scene.plan.roof(p.head<2>()) - 0.5) {
       throw InputError("adit sim", "--lateral-offset-m",
                        "the path leaves the " + scene.name + " at t = " + std::to_string(static_cast<double>(i) / Trajectory::kRate) +
                            " s (x " + std::to_string(p.x()) + ", y " + std::to_string(p.y()) + ")");
@@ -99,7 +119,7 @@ SimSummary run_simulation(const SimOptions& o) {
   lidar.rpm = o.rpm;
   lidar.seed = o.seed;
   lidar.start_time_ns = o.start_time_ns;
-  lidar.extrinsics = robot_extrinsics();
+  lidar.extrinsics = sensor_extrinsics(o.platform);
   lidar.threads = o.threads;
   drivers::PcapWriter pcap(o.out / "lidar.pcap");
   const LidarSimStats stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, lidar, pcap);
@@ -111,7 +131,7 @@ SimSummary run_simulation(const SimOptions& o) {
   wheels.time_offset_s = o.can_offset_s;
   wheels.start_time_ns = o.start_time_ns;
   wheels.seed = o.seed;
-  if (o.wheels) {
+  if (o.wheels && !is_drone(o)) {
     const WheelTruth truth = simulate_wheel_encoders(body, wheels, o.out / "can.log");
     write_wheel_truth(o.out / "truth_wheels.csv", truth, o.start_time_ns);
   }

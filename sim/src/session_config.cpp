@@ -25,7 +25,7 @@ void write_session_config(const std::filesystem::path& file, const SimOptions& o
       "  extrinsics:\n    xyz_m: [{}, {}, {}]\n    rpy_deg: [{}, {}, {}]\n\n",
       o.scene, o.platform, o.sensor, o.duration_s, o.seed, o.scene, o.seed, o.sensor, calibration_file, o.min_range_m, o.max_range_m,
       t.x(), t.y(), t.z(), rpy.x() + 0.0, rpy.y() + 0.0, rpy.z() + 0.0);  // + 0.0: no "-0"
-  if (o.wheels) {
+  if (o.wheels && o.platform == "robot") {
     text += fmt::format(
         "can:\n  enabled: true\n  source: candump\n  log: can.log\n  signals:\n"
         "    - {{name: left_wheel_position, id: {:#x}, start_bit: 0, length: 32, byte_order: intel, value_type: signed, unit: counts}}\n"

@@ -15,8 +15,8 @@ void register_sim_commands(CLI::App& app, int& status) {
       "sim", "Simulate a survey session: lidar.pcap, can.log, session.yaml and ground truth in --out");
   cmd->add_option("--scene", o->scene, "Scene: mine (drift loop, junctions, stope) or drift (straight, featureless 200 m)")
       ->capture_default_str();
-  cmd->add_option("--platform", o->platform, "Platform: robot (differential drive)")->capture_default_str();
-  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16")->capture_default_str();
+  cmd->add_option("--platform", o->platform, "Platform: robot (differential drive, wheel encoders on CAN) or drone (6-DoF multirotor)")->capture_default_str();
+  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16 or RS-16")->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Session length, seconds")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed: the same seed and options give byte-identical files")->capture_default_str();
   cmd->add_option("--out", *out, "Output folder (created)")->required();
@@ -25,7 +25,7 @@ void register_sim_commands(CLI::App& app, int& status) {
   cmd->add_option("--min-range-m", o->min_range_m, "Closest return the sensor reports, metres")->capture_default_str();
   cmd->add_option("--max-range-m", o->max_range_m, "Farthest return the sensor reports, metres")->capture_default_str();
   cmd->add_option("--rpm", o->rpm, "LiDAR head rotation, rpm")->capture_default_str();
-  cmd->add_option("--speed", o->speed_mps, "Robot cruise speed, m/s (at most 1.5)")->capture_default_str();
+  cmd->add_option("--speed", o->speed_mps, "Cruise speed, m/s (robot at most 1.5, drone 2)")->capture_default_str();
   cmd->add_option("--lateral-offset-m", o->lateral_offset_m, "Drive this far left (+) of the drift's centre line")
       ->capture_default_str();
   cmd->add_option("--wheel-radius-error", o->wheel_radius_error,

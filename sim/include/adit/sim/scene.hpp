@@ -15,8 +15,9 @@
 namespace adit::sim {
 
 struct Route {
-  std::vector<Eigen::Vector2d> points;  // evenly spaced (kRouteStep), smooth
-  bool closed = false;                  // a loop: the last point leads back to the first
+  std::vector<Eigen::Vector2d> points;  // evenly spaced by `step`, smooth
+  bool closed = false;                  // a loop: the last point leads back to the first (also `step` away)
+  double step = kStep;                  // about kStep, so that a loop closes evenly
   double length() const;
   static constexpr double kStep = 0.05;
 };
@@ -37,6 +38,6 @@ Scene make_drift(std::uint64_t seed);
 // A polyline split into pieces of at most `max_piece_m`, smoothed by Chaikin
 // corner cutting (Chaikin 1974; converges to the quadratic B-spline) and
 // resampled every Route::kStep.
-Route smooth_route(const std::vector<Eigen::Vector2d>& polyline, bool closed, double max_piece_m = 2.0);
+Route smooth_route(const std::vector<Eigen::Vector2d>& polyline, bool closed, double max_piece_m = 4.0);
 
 }  // namespace adit::sim

@@ -11,11 +11,16 @@
 #include <filesystem>
 #include <string>
 
+#include <Eigen/Geometry>
+
+#include "adit/sim/scene.hpp"
+#include "adit/sim/trajectory.hpp"
+
 namespace adit::sim {
 
 struct SimOptions {
   std::string scene = "mine";      // mine | drift
-  std::string platform = "robot";  // robot
+  std::string platform = "robot";  // robot | drone (no wheels, no can.log)
   std::string sensor = "VLP-16";   // VLP-16 | RS-16
   double duration_s = 60.0;
   std::uint64_t seed = 1;
@@ -46,6 +51,11 @@ struct SimSummary {
   std::size_t targets = 0;
   double path_length_m = 0.0;
 };
+
+// The scene and the body trajectory run_simulation uses (deterministic), for checks.
+Scene simulated_scene(const SimOptions& options);
+Trajectory simulated_path(const Scene& scene, const SimOptions& options);
+Eigen::Isometry3d simulated_extrinsics(const SimOptions& options);  // sensor in the body frame
 
 // Throws adit::InputError (key = the option) for impossible options, before any work.
 void validate(const SimOptions& options);
