@@ -3,7 +3,10 @@
 #include <fstream>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "adit/common/error.hpp"
+#include "adit/sim/hash_noise.hpp"
 
 namespace adit::sim {
 
@@ -14,6 +17,41 @@ void TriangleMesh::add_quad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, 
   triangles.push_back({i, i + 1, i + 2});
   triangles.push_back({i, i + 2, i + 3});
   reflectivity.insert(reflectivity.end(), 2, reflect);
+}
+
+void TriangleMesh::add_box(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, std::uint8_t reflect) {
+  const auto v = [&](int x, int y, int z) {
+    return Eigen::Vector3f(x ? hi.x() : lo.x(), y ? hi.y() : lo.y(), z ? hi.z() : lo.z());
+  };
+  add_quad(v(0, 0, 0), v(1, 0, 0), v(1, 1, 0), v(0, 1, 0), reflect);  // bottom
+  add_quad(v(0, 0, 1), v(0, 1, 1), v(1, 1, 1), v(1, 0, 1), reflect);  // top
+  add_quad(v(0, 0, 0), v(0, 0, 1), v(1, 0, 1), v(1, 0, 0), reflect);
+  add_quad(v(0, 1, 0), v(1, 1, 0), v(1, 1, 1), v(0, 1, 1), reflect);
+  add_quad(v(0, 0, 0), v(0, 1, 0), v(0, 1, 1), v(0, 0, 1), reflect);
+  add_quad(v(1, 0, 0), v(1, 0, 1), v(1, 1, 1), v(1, 1, 0), reflect);
+}
+
+std::vector<Eigen::Vector3f> sample_surface(const TriangleMesh& mesh, double per_m2, std::uint64_t seed) {
+  std::vector<Eigen::Vector3f> points;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3d a = mesh.vertices[mesh.triangles[t][0]].cast<double>();
+    const Eigen::Vector3d b = mesh.vertices[mesh.triangles[t][1]].cast<double>();
+    const Eigen::Vector3d c = mesh.vertices[mesh.triangles[t][2]].cast<double>();
+    const double expected = 0.5 * (b - a).cross(c - a).norm() * per_m2;
+    // Whole points, plus one more with the probability of the fraction.
+    auto n = static_cast<std::uint64_t>(expected);
+    if (uniform(seed, 0x4E756DULL, t) < expected - static_cast<double>(n)) ++n;
+    for (std::uint64_t k = 0; k < n; ++k) {
+      // Uniform on the triangle (Osada et al. 2002): reflect the unit square's upper half.
+      double u = uniform(seed, 0x5531ULL + t, 2 * k), v = uniform(seed, 0x5531ULL + t, 2 * k + 1);
+      if (u + v > 1.0) {
+        u = 1.0 - u;
+        v = 1.0 - v;
+      }
+      points.push_back((a + u * (b - a) + v * (c - a)).cast<float>());
+    }
+  }
+  return points;
 }
 
 void TriangleMesh::append(const TriangleMesh& other) {

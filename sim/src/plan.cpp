@@ -8,6 +8,15 @@
 
 namespace adit::sim {
 
+double Box2::distance(const Eigen::Vector2d& p) const {
+  // Signed distance to a box (Quilez's formulation): outside, the distance to the
+  // nearest point; inside, minus the distance to the nearest side.
+  const Eigen::Vector2d centre = 0.5 * (lo + hi);
+  const Eigen::Vector2d half = 0.5 * (hi - lo);
+  const Eigen::Vector2d q = (p - centre).cwiseAbs() - half;
+  return q.cwiseMax(0.0).norm() + std::min(std::max(q.x(), q.y()), 0.0);
+}
+
 double Plan::distance(const Eigen::Vector2d& p) const {
   double d = std::numeric_limits<double>::infinity();
   for (const Drift& s : drifts) {
@@ -16,6 +25,8 @@ double Plan::distance(const Eigen::Vector2d& p) const {
     d = std::min(d, (p - (s.a + t * ab)).norm() - 0.5 * s.width_m);
   }
   for (const Chamber& c : chambers) d = std::min(d, (p - c.centre).norm() - c.radius_m);
+  for (const Box2& r : rooms) d = std::min(d, r.distance(p));
+  for (const Box2& b : pillars) d = std::max(d, -b.distance(p));
   return d;
 }
 

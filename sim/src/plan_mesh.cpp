@@ -32,6 +32,10 @@ Grid distance_grid(const Plan& plan, double cell) {
     grow(s.b, s.width_m);
   }
   for (const Chamber& c : plan.chambers) grow(c.centre, c.radius_m + 1.0);
+  for (const Box2& r : plan.rooms) {
+    grow(r.lo, 0.5);
+    grow(r.hi, 0.5);
+  }
   Grid g;
   g.cell = cell;
   g.origin = (lo / cell).array().floor().matrix() * cell - Eigen::Vector2d(2.0, 2.0);
@@ -86,7 +90,8 @@ void add_wall(const Plan& plan, const Eigen::Vector2d& a, const Eigen::Vector2d&
 
 }  // namespace
 
-TriangleMesh plan_mesh(const Plan& plan, double cell_m) {
+TriangleMesh plan_mesh(const Plan& plan) {
+  const double cell_m = plan.cell_m;
   const Grid g = distance_grid(plan, cell_m);
   TriangleMesh mesh;
   const double margin = plan.roughness_m * 2.0 + cell_m;  // floor and roof reach past displaced walls

@@ -35,6 +35,7 @@ bool is_drone(const SimOptions& o) { return o.platform == "drone"; }
 
 Scene simulated_scene(const SimOptions& o) {
   if (o.scene == "drift") return make_drift(o.seed);
+  if (o.scene == "building") return make_building(o.seed);
   return make_mine(o.seed);
 }
 
@@ -58,7 +59,8 @@ Trajectory simulated_path(const Scene& scene, const SimOptions& o) {
 }
 
 void validate(const SimOptions& o) {
-  require(o.scene == "mine" || o.scene == "drift", "--scene", "unknown scene '" + o.scene + "' (mine, drift)");
+  require(o.scene == "mine" || o.scene == "drift" || o.scene == "building", "--scene",
+          "unknown scene '" + o.scene + "' (mine, drift, building)");
   require(o.platform == "robot" || o.platform == "drone", "--platform",
           "unknown platform '" + o.platform + "' (robot, drone)");
   make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
@@ -138,6 +140,7 @@ SimSummary run_simulation(const SimOptions& o) {
   write_tum(o.out / "truth_body.tum", body, Eigen::Isometry3d::Identity(), o.start_time_ns);
   write_tum(o.out / "truth_sensor.tum", body, lidar.extrinsics, o.start_time_ns);
   write_ply(o.out / "scene.ply", scene.mesh);
+  if (!scene.design.triangles.empty()) write_ply_points(o.out / "bim.ply", sample_surface(scene.design, 100.0, o.seed));
   write_targets_csv(o.out / "targets.csv", targets);
   write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels, lidar.extrinsics);
 

@@ -13,7 +13,7 @@ void register_sim_commands(CLI::App& app, int& status) {
   auto out = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "sim", "Simulate a survey session: lidar.pcap, can.log, session.yaml and ground truth in --out");
-  cmd->add_option("--scene", o->scene, "Scene: mine (drift loop, junctions, stope) or drift (straight, featureless 200 m)")
+  cmd->add_option("--scene", o->scene, "Scene: mine (drift loop, junctions, stope), drift (straight, featureless 200 m) or building (office floor; writes bim.ply)")
       ->capture_default_str();
   cmd->add_option("--platform", o->platform, "Platform: robot (differential drive, wheel encoders on CAN) or drone (6-DoF multirotor)")->capture_default_str();
   cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16 or RS-16")->capture_default_str();

@@ -11,6 +11,6 @@
 
 namespace adit::sim {
 
-TriangleMesh plan_mesh(const Plan& plan, double cell_m = 0.25);
+TriangleMesh plan_mesh(const Plan& plan);
 
 }  // namespace adit::sim

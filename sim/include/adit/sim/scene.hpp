@@ -27,6 +27,7 @@ struct Scene {
   Plan plan;
   TriangleMesh mesh;
   Route route;
+  TriangleMesh design;  // the "as designed" model (BIM) where the scene has one, else empty
 };
 
 // mine: a loop of drifts (perimeter ~250 m) with bends, a cross-cut (two more
@@ -34,6 +35,12 @@ struct Scene {
 Scene make_mine(std::uint64_t seed);
 // drift: one straight 200 m drift with smooth walls (no features along its axis).
 Scene make_drift(std::uint64_t seed);
+
+// building: an office floor, 3 m high: two corridors joined at both ends (a
+// ~100 m loop), rooms on both sides with doors, an open hall with pillars,
+// furniture. `design` is the floor as designed: no furniture, and one
+// partition 0.3 m from where it was built.
+Scene make_building(std::uint64_t seed);
 
 // A polyline split into pieces of at most `max_piece_m`, smoothed by Chaikin
 // corner cutting (Chaikin 1974; converges to the quadratic B-spline) and
