@@ -30,7 +30,8 @@ Return measure(const SensorEffects& e, std::uint64_t seed, std::uint64_t ray, co
   // Diffuse (Lambertian) surfaces look darker at grazing incidence.
   const double cos_incidence = std::abs(static_cast<double>(hit.normal.dot(direction)));
   r.reflectivity = static_cast<std::uint8_t>(
-      std::clamp(std::lround(mesh.reflectivity[hit.triangle] * (0.4 + 0.6 * cos_incidence)), 1L, 100L));
+      std::clamp(std::lround((hit.dynamic ? hit.reflectivity : mesh.reflectivity[hit.triangle]) * (0.4 + 0.6 * cos_incidence)),
+                 1L, 100L));
   return r;
 }
 

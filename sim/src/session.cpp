@@ -41,6 +41,8 @@ Scene simulated_scene(const SimOptions& o) {
 
 Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extrinsics(o.platform); }
 
+People simulated_people(const Scene& scene, const SimOptions& o) { return make_people(scene, o.people, o.seed); }
+
 Trajectory simulated_path(const Scene& scene, const SimOptions& o) {
   if (is_drone(o)) {
     DronePathOptions d;
@@ -84,6 +86,7 @@ void validate(const SimOptions& o) {
           "--slips-per-minute", "must be in [0, 60]");
   require(std::isfinite(o.can_offset_s) && std::abs(o.can_offset_s) <= 10.0, "--can-offset-s", "must be within ±10 s");
   require(o.targets >= 0 && o.targets <= 50, "--targets", "must be in [0, 50]");
+  require(o.people >= 0 && o.people <= 100, "--people", "must be in [0, 100]");
   require(o.threads >= 1 && o.threads <= 64, "--threads", "must be in [1, 64]");
 }
 
@@ -124,7 +127,8 @@ SimSummary run_simulation(const SimOptions& o) {
   lidar.extrinsics = sensor_extrinsics(o.platform);
   lidar.threads = o.threads;
   drivers::PcapWriter pcap(o.out / "lidar.pcap");
-  const LidarSimStats stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, lidar, pcap);
+  const People people = simulated_people(scene, o);
+  const LidarSimStats stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, people, lidar, pcap);
   pcap.flush();
 
   WheelOptions wheels;

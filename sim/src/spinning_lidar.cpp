@@ -25,7 +25,8 @@ SpinningSensor make_spinning_sensor(std::string_view model) {
 
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
-                                      const LidarSimOptions& o, drivers::PcapWriter& pcap) {
+                                      const People& people, const LidarSimOptions& o,
+                                      drivers::PcapWriter& pcap) {
   std::vector<BeamTrig> beams;
   for (const Beam& b : sensor.beams) {
     beams.push_back({std::cos(b.elevation_rad), std::sin(b.elevation_rad), b.azimuth_offset_rad, b.vert_offset_m,
@@ -57,7 +58,12 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
       const Eigen::Isometry3d pose = body.pose(t) * o.extrinsics;
       const Eigen::Vector3f origin = (pose * offset).cast<float>();
       const Eigen::Vector3f dir = (pose.linear() * direction).cast<float>();
-      const Hit hit = caster.intersect(origin, dir, 0.0F, static_cast<float>(o.effects.max_range_m + 1.0));
+      const auto far = static_cast<float>(o.effects.max_range_m + 1.0);
+      Hit hit = caster.intersect(origin, dir, 0.0F, far);
+      if (!people.empty()) {
+        const Hit person = people.intersect(origin, dir, 0.0F, hit.valid() ? hit.distance : far, t);
+        if (person.valid()) hit = person;
+      }
       const Return r = measure(o.effects, o.seed, k * kFirings + i, hit, origin, dir, mesh, targets);
       if (!r.valid || r.range_m > sensor.max_range_m) continue;
       packet.range_m[i] = r.range_m;

@@ -34,6 +34,8 @@ void register_sim_commands(CLI::App& app, int& status) {
   cmd->add_option("--slips-per-minute", o->slips_per_minute, "Wheel slip events per minute")->capture_default_str();
   cmd->add_option("--can-offset-s", o->can_offset_s, "CAN clock minus LiDAR clock, seconds")->capture_default_str();
   cmd->add_option("--targets", o->targets, "Surveyed wall targets to place")->capture_default_str();
+  cmd->add_option("--people", o->people, "People walking along the route (moving obstacles, not in scene.ply)")
+      ->capture_default_str();
   cmd->add_option("--threads", o->threads, "Ray-casting threads (outputs do not depend on it)")->capture_default_str();
   cmd->callback([o, out, &status] {
     o->out = *out;

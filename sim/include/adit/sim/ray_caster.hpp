@@ -18,6 +18,8 @@ struct Hit {
   float distance = std::numeric_limits<float>::infinity();  // along the unit direction
   std::uint32_t triangle = 0;
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // unit, not oriented
+  bool dynamic = false;           // a moving object (people.hpp), not the mesh: `triangle` is meaningless
+  std::uint8_t reflectivity = 0;  // for dynamic hits
   bool valid() const { return distance < std::numeric_limits<float>::infinity(); }
 };
 

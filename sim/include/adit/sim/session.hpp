@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/sim/people.hpp"
 #include "adit/sim/scene.hpp"
 #include "adit/sim/trajectory.hpp"
 
@@ -40,6 +41,7 @@ struct SimOptions {
   double slips_per_minute = 1.0;
   double can_offset_s = 0.0;  // CAN clock minus LiDAR clock
   int targets = 8;
+  int people = 0;  // walkers along the route (dynamic objects)
   std::int64_t start_time_ns = 1'767'225'600'000'000'000;  // 2026-01-01T00:00:00Z
   int threads = 2;
 };
@@ -56,6 +58,7 @@ struct SimSummary {
 Scene simulated_scene(const SimOptions& options);
 Trajectory simulated_path(const Scene& scene, const SimOptions& options);
 Eigen::Isometry3d simulated_extrinsics(const SimOptions& options);  // sensor in the body frame
+People simulated_people(const Scene& scene, const SimOptions& options);  // the scene must outlive them
 
 // Throws adit::InputError (key = the option) for impossible options, before any work.
 void validate(const SimOptions& options);

@@ -19,6 +19,7 @@
 
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/sim/mesh.hpp"
+#include "adit/sim/people.hpp"
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/sensor_effects.hpp"
 #include "adit/sim/targets.hpp"
@@ -88,6 +89,7 @@ struct LidarSimStats {
 
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
-                                      const LidarSimOptions& options, drivers::PcapWriter& pcap);
+                                      const People& people, const LidarSimOptions& options,
+                                      drivers::PcapWriter& pcap);
 
 }  // namespace adit::sim
