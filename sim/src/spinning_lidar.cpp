@@ -1,5 +1,6 @@
 #include "adit/sim/spinning_lidar.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -20,7 +21,9 @@ struct BeamTrig {  // Beam with its sines and cosines
 SpinningSensor make_spinning_sensor(std::string_view model) {
   if (model == "VLP-16") return velodyne_vlp16_sensor();
   if (model == "RS-16") return robosense_rs16_sensor();
-  throw InputError("adit sim", "--sensor", "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16)");
+  if (model == "PandarXT32") return hesai_xt32_sensor();
+  throw InputError("adit sim", "--sensor",
+                   "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32)");
 }
 
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
@@ -39,14 +42,17 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
   // One packet, a pure function of its index.
   const auto simulate_packet = [&](std::uint64_t k, SpinningPacket& packet, std::uint64_t& returns) {
     const std::int64_t packet_ns = static_cast<std::int64_t>(k) * sensor.packet_period_ns;
+    packet.index = k;
     packet.time_ns = o.start_time_ns + packet_ns;
-    for (std::size_t i = 0; i < kFirings; ++i) {
+    double block_head = 0.0;
+    for (std::size_t i = 0; i < sensor.blocks * kChannels; ++i) {
       const double t = static_cast<double>(packet_ns + sensor.firing_ns[i]) * 1e-9;
-      const double a = head(t);
       if (i % kChannels == 0) {
+        block_head = head(t);
         packet.azimuth[i / kChannels] =
-            static_cast<std::uint16_t>(std::lround(a * 18000.0 / std::numbers::pi) % 36000);
+            static_cast<std::uint16_t>(std::lround(block_head * 18000.0 / std::numbers::pi) % 36000);
       }
+      const double a = sensor.block_azimuth ? block_head : head(t);
       packet.range_m[i] = 0.0;
       packet.reflectivity[i] = 0;
       const BeamTrig& b = beams[sensor.beam[i]];
@@ -80,7 +86,8 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
   drivers::UdpEndpoints endpoints;
   endpoints.src_port = sensor.port;
   endpoints.dst_port = sensor.port;
-  const std::int64_t last_firing = sensor.firing_ns[kFirings - 1];
+  const std::int64_t last_firing =
+      *std::max_element(sensor.firing_ns.begin(), sensor.firing_ns.begin() + static_cast<std::ptrdiff_t>(sensor.blocks * kChannels));
   for (std::uint64_t first = 0; first < packets; first += kChunk) {
     const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, packets - first));
     {
@@ -100,7 +107,7 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
     }
     stats.packets += n;
   }
-  stats.rays = stats.packets * kFirings;
+  stats.rays = stats.packets * sensor.blocks * kChannels;
   for (const std::uint64_t r : returns) stats.returns += r;
   return stats;
 }

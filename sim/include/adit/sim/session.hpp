@@ -22,7 +22,7 @@ namespace adit::sim {
 struct SimOptions {
   std::string scene = "mine";      // mine | drift
   std::string platform = "robot";  // robot | drone (no wheels, no can.log)
-  std::string sensor = "VLP-16";   // VLP-16 | RS-16
+  std::string sensor = "VLP-16";   // VLP-16 | RS-16 | PandarXT32
   double duration_s = 60.0;
   std::uint64_t seed = 1;
   std::filesystem::path out;

@@ -27,7 +27,7 @@
 
 namespace adit::sim {
 
-inline constexpr std::size_t kBlocks = 12;     // every supported model: 12 blocks of 32 channels
+inline constexpr std::size_t kBlocks = 12;     // at most (Velodyne, RoboSense: 12; XT32: 8), of 32 channels
 inline constexpr std::size_t kChannels = 32;
 inline constexpr std::size_t kFirings = kBlocks * kChannels;
 
@@ -46,6 +46,7 @@ struct Beam {
 };
 
 struct SpinningPacket {
+  std::uint64_t index = 0;                    // packets since the start
   std::int64_t time_ns = 0;                   // Unix time of the packet's first firing
   std::array<std::uint16_t, kBlocks> azimuth{};  // 0.01° at each block's first firing
   std::array<double, kFirings> range_m{};     // 0: no return
@@ -57,6 +58,10 @@ struct SpinningSensor {
   std::uint16_t port = 0;                  // UDP destination port of data packets
   std::size_t packet_size = 0;
   std::int64_t packet_period_ns = 0;
+  std::size_t blocks = kBlocks;            // per packet
+  // Every channel of a block cast at the block's azimuth, as the model's point
+  // formula has it (Hesai); otherwise each at the head's azimuth at its firing.
+  bool block_azimuth = false;
   std::array<std::int64_t, kFirings> firing_ns{};  // after the packet's first firing, block-major
   std::array<std::uint16_t, kFirings> beam{};      // which Beam fires in each slot
   std::vector<Beam> beams;
@@ -66,10 +71,11 @@ struct SpinningSensor {
   std::string calibration_text;
 };
 
-// "VLP-16" or "RS-16" (names as the drivers accept them); throws adit::InputError (key --sensor) otherwise.
+// "VLP-16", "RS-16" or "PandarXT32" (names as the drivers accept them); throws adit::InputError (key --sensor) otherwise.
 SpinningSensor make_spinning_sensor(std::string_view model);
 SpinningSensor velodyne_vlp16_sensor();
 SpinningSensor robosense_rs16_sensor();
+SpinningSensor hesai_xt32_sensor();
 
 struct LidarSimOptions {
   SensorEffects effects;
