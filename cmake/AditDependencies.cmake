@@ -8,6 +8,8 @@ find_package(fmt REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
+# Ray casting for the simulator (Debian libembree-dev); the target is `embree`.
+find_package(embree 3 REQUIRED)
 # MD5 for the Ouster digest (libssl-dev): a vetted implementation beats our own.
 find_package(OpenSSL 3 REQUIRED COMPONENTS Crypto)
 find_package(PkgConfig REQUIRED)

@@ -20,5 +20,6 @@ void register_calibrate_wheels_commands(CLI::App& app, int& status);
 void register_client_commands(CLI::App& app, int& status);
 
 void register_download_commands(CLI::App& app, int& status);
+void register_sim_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

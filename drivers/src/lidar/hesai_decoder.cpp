@@ -84,15 +84,9 @@ HesaiDecoder::HesaiDecoder(HesaiModel model, const HesaiAngleCorrection& angles)
       table.resize(blocks * lasers);
       std::int32_t earliest = std::numeric_limits<std::int32_t>::max();
       for (std::size_t b = 0; b < blocks; ++b) {
-        const std::size_t k = (spec_.block_from_last ? blocks - 1 - b : b) / r;
-        const auto block_ns = spec_.block_base_ns + static_cast<std::int32_t>(std::lround(spec_.block_step_ns * k));
         for (std::size_t c = 0; c < lasers; ++c) {
-          const auto& loop_table = spec_.channel_loop[spec_.two_loops() ? loop : 0];
-          const std::int32_t channel_ns =
-              loop_table.empty() ? spec_.channel_base_ns + spec_.channel_step_ns * static_cast<std::int32_t>(c % spec_.channel_modulo)
-                                 : loop_table[c];
-          table[b * lasers + c] = block_ns + channel_ns;
-          earliest = std::min(earliest, block_ns + channel_ns);
+          table[b * lasers + c] = hesai_firing_ns(spec_.model, r, loop, b, c);
+          earliest = std::min(earliest, table[b * lasers + c]);
         }
       }
       earliest_ns_[r - 1][loop] = earliest;

@@ -157,5 +157,18 @@ std::int64_t hesai_packet_period_ns(HesaiModel model, std::span<const std::uint8
   return static_cast<std::int64_t>(std::llround(s.blocks / returns * std::abs(s.block_step_ns)));
 }
 std::uint16_t hesai_laser_count(HesaiModel model) { return hesai_spec(model).lasers; }
+std::uint16_t hesai_block_count(HesaiModel model) { return hesai_spec(model).blocks; }
+
+std::int32_t hesai_firing_ns(HesaiModel model, std::size_t returns, std::size_t loop, std::size_t block,
+                             std::size_t channel) {
+  const Spec& s = hesai_spec(model);
+  const std::size_t k = (s.block_from_last ? s.blocks - 1 - block : block) / returns;
+  const auto block_ns = s.block_base_ns + static_cast<std::int32_t>(std::lround(s.block_step_ns * static_cast<double>(k)));
+  const auto& table = s.channel_loop[s.two_loops() ? loop : 0];
+  const std::int32_t channel_ns =
+      table.empty() ? s.channel_base_ns + s.channel_step_ns * static_cast<std::int32_t>(channel % s.channel_modulo)
+                    : table[channel];
+  return block_ns + channel_ns;
+}
 
 }  // namespace adit::drivers

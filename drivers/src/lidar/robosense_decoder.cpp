@@ -97,6 +97,11 @@ std::optional<RoboSenseModel> robosense_model_from_name(std::string_view name) {
 
 std::string_view robosense_model_name(RoboSenseModel model) { return spec_of(model).name; }
 
+std::span<const float, 32> robosense_firing_us(RoboSenseModel model) { return spec_of(model).firing_us; }
+float robosense_sequence_us(RoboSenseModel model) { return spec_of(model).sequence_us; }
+double robosense_lens_offset_m(RoboSenseModel model) { return spec_of(model).lens_offset_m; }
+std::span<const std::uint8_t> robosense_magic(RoboSenseModel model) { return spec_of(model).magic; }
+
 std::optional<RoboSenseModel> robosense_model_from_packet(std::span<const std::uint8_t> p) {
   if (p.size() != kPacketBytes) return std::nullopt;
   for (const auto model : {RoboSenseModel::rs16, RoboSenseModel::helios16p}) {

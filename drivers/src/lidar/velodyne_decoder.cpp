@@ -138,6 +138,15 @@ std::int64_t velodyne_packet_period_ns(VelodyneModel model, VelodyneReturnMode m
 
 std::size_t velodyne_lasers(VelodyneModel model) { return spec(model).lasers; }
 
+VelodyneFiring velodyne_firing(VelodyneModel model, std::size_t block_in_group, std::size_t channel) {
+  const auto [laser, time_ns] = slot_timing(model, block_in_group, channel);
+  return {laser, time_ns};
+}
+std::uint32_t velodyne_group_ns(VelodyneModel model) { return spec(model).group_ns; }
+std::size_t velodyne_blocks_per_group(VelodyneModel model) { return spec(model).blocks_per_group; }
+float velodyne_distance_resolution_m(VelodyneModel model) { return spec(model).distance_resolution_m; }
+std::uint8_t velodyne_product_id(VelodyneModel model) { return spec(model).product_id; }
+
 VelodyneDecoder::VelodyneDecoder(VelodyneModel model, VelodyneCalibration calibration, VelodyneDecoderConfig config)
     : model_(model), calibration_(std::move(calibration)), config_(config) {
   const ModelSpec& m = spec(model);

@@ -43,6 +43,12 @@ std::optional<HesaiModel> hesai_model_from_packet(std::span<const std::uint8_t> 
 // Time between data packets of `model` in the return mode the packet's tail states; 0 if unreadable.
 std::int64_t hesai_packet_period_ns(HesaiModel model, std::span<const std::uint8_t> payload);
 std::uint16_t hesai_laser_count(HesaiModel model);
+std::uint16_t hesai_block_count(HesaiModel model);
+// The firing time of (block, channel) relative to the packet's timestamp, ns, for
+// packets with `returns` returns per firing, in firing loop `loop` (QT128: 0 or 1).
+// From the manuals' "Laser Firing Time"; the decoder and the simulator share it.
+std::int32_t hesai_firing_ns(HesaiModel model, std::size_t returns, std::size_t loop, std::size_t block,
+                             std::size_t channel);
 
 // Per-channel angle corrections from the unit's angle-correction CSV, in
 // packet channel order (row i is channel i of every block).

@@ -32,6 +32,15 @@ std::string_view robosense_model_name(RoboSenseModel model);
 // The model whose MSOP data packet this is (magic and size), nullopt otherwise (DIFOP included).
 std::optional<RoboSenseModel> robosense_model_from_packet(std::span<const std::uint8_t> payload);
 
+inline constexpr std::size_t kRoboSenseMsopSize = 1248;
+// The models' firing timing (user manuals' tables), shared by the decoder and
+// the simulator's encoder: channel c (0..31) of a single-return block fires
+// firing_us[c] after the block starts (laser c % 16); blocks are two sequences.
+std::span<const float, 32> robosense_firing_us(RoboSenseModel model);
+float robosense_sequence_us(RoboSenseModel model);
+double robosense_lens_offset_m(RoboSenseModel model);  // RX: receiving lens ahead of the axis
+std::span<const std::uint8_t> robosense_magic(RoboSenseModel model);
+
 // Per-laser angles in laser order (16 rows), degrees.
 struct RoboSenseAngles {
   std::vector<float> elevation_deg;

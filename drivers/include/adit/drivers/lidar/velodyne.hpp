@@ -42,6 +42,19 @@ std::optional<VelodyneReturnMode> velodyne_return_mode_from_packet(std::span<con
 std::int64_t velodyne_packet_period_ns(VelodyneModel model, VelodyneReturnMode mode);
 std::size_t velodyne_lasers(VelodyneModel model);
 
+// The firing-timing table of the manuals, shared by the decoder and the
+// simulator's encoder: channel `channel` of block `block_in_group` of a firing
+// group holds laser `laser`, which fires `time_ns` after the group starts.
+struct VelodyneFiring {
+  std::uint16_t laser = 0;
+  std::uint32_t time_ns = 0;
+};
+VelodyneFiring velodyne_firing(VelodyneModel model, std::size_t block_in_group, std::size_t channel);
+std::uint32_t velodyne_group_ns(VelodyneModel model);        // one firing group to the next
+std::size_t velodyne_blocks_per_group(VelodyneModel model);  // blocks sharing one azimuth
+float velodyne_distance_resolution_m(VelodyneModel model);
+std::uint8_t velodyne_product_id(VelodyneModel model);
+
 inline constexpr std::size_t kVelodyneDataPacketSize = 1206;
 inline constexpr std::size_t kVelodynePositionPacketSize = 512;
 inline constexpr std::uint16_t kVelodyneDataPort = 2368;

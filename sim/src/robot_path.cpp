@@ -1,0 +1,60 @@
+#include "adit/sim/robot_path.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "adit/sim/hash_noise.hpp"
+#include "adit/sim/route_schedule.hpp"
+
+namespace adit::sim {
+namespace {
+ScheduleOptions schedule_options(const RobotPathOptions& o) {
+  ScheduleOptions s;
+  s.duration_s = o.duration_s;
+  s.speed_mps = o.speed_mps;
+  s.turn_rate_rps = RobotPathOptions::kTurnRate;
+  s.ramp_s = RobotPathOptions::kRamp;
+  return s;
+}
+}  // namespace
+
+double robot_min_duration_s() { return min_schedule_duration_s(schedule_options(RobotPathOptions{})); }
+
+Trajectory robot_path(const Scene& scene, const RobotPathOptions& o) {
+  const Route& route = scene.route;
+  const RouteSchedule schedule = route_schedule(route, schedule_options(o));
+  const std::vector<double>& arc = schedule.arc;
+  const std::vector<double>& turn_fraction = schedule.turn_fraction;
+  std::vector<BodySample> samples(arc.size());
+  for (std::size_t i = 0; i < arc.size(); ++i) {
+    const RoutePoint r = route_at(route, arc[i]);
+    const Eigen::Vector2d left(-std::sin(r.heading), std::cos(r.heading));
+    const Eigen::Vector2d xy = r.position + left * o.lateral_offset_m;
+    const double yaw = r.heading + std::numbers::pi * turn_fraction[i];
+    // Bumps: the rough floor under the wheels tilts the body (~1 m wavelengths).
+    const double travelled = arc[i] + 1000.0 * turn_fraction[i];
+    const double deg = std::numbers::pi / 180.0;
+    const double roll = o.bump_deg * deg * value_noise3(o.seed ^ 0x526F6C6CULL, travelled / 1.3, 0.5, 0.5);
+    const double pitch = o.bump_deg * deg * value_noise3(o.seed ^ 0x50697463ULL, travelled / 0.9, 0.5, 0.5);
+    const double z = o.body_height_m + 0.01 * value_noise3(o.seed ^ 0x5AULL, travelled / 0.7, 0.5, 0.5);
+    BodySample& b = samples[i];
+    b.position = Eigen::Vector3d(xy.x(), xy.y(), z);
+    b.orientation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+  }
+  // Wheel inputs: forward speed and yaw rate by central differences.
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, samples.size() - 1);
+    if (a == b) continue;
+    const double dt = static_cast<double>(b - a) / Trajectory::kRate;
+    const Eigen::Vector3d forward = samples[i].orientation * Eigen::Vector3d::UnitX();
+    samples[i].speed_mps = (samples[b].position - samples[a].position).dot(forward) / dt;
+    const Eigen::Vector3d fa = samples[a].orientation * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d fb = samples[b].orientation * Eigen::Vector3d::UnitX();
+    samples[i].yaw_rate_rps = std::remainder(std::atan2(fb.y(), fb.x()) - std::atan2(fa.y(), fa.x()), 2 * std::numbers::pi) / dt;
+  }
+  return Trajectory(std::move(samples));
+}
+
+}  // namespace adit::sim

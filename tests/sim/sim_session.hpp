@@ -1,0 +1,21 @@
+#pragma once
+// A short simulated session shared by the simulator tests, generated once per
+// test binary into the build tree.
+
+#include <filesystem>
+#include <string>
+
+#include "adit/sim/session.hpp"
+
+namespace adit::sim::test {
+
+inline SimOptions short_session(const std::string& name) {
+  SimOptions o;
+  o.scene = "mine";
+  o.duration_s = 10.0;
+  o.seed = 7;
+  o.out = std::filesystem::path(ADIT_BINARY_DIR) / "test-sessions" / name;
+  return o;
+}
+
+}  // namespace adit::sim::test

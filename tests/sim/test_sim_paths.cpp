@@ -1,0 +1,103 @@
+// The platforms move as the issue asks: the robot within 1.5 m/s with a
+// bumpy ride, the drone within 2 m/s and 90°/s of yaw, hovering and climbing;
+// both end near where they started and stay inside the scene.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "adit/sim/session.hpp"
+
+namespace adit::sim {
+namespace {
+
+struct Motion {
+  double top_speed = 0, top_yaw_rate = 0, top_tilt = 0, min_z = 1e9, max_z = -1e9, closest_wall = -1e9, length = 0;
+  Eigen::Vector3d start, end;
+};
+
+Motion measure(const SimOptions& o) {
+  const Scene scene = simulated_scene(o);
+  const Trajectory path = simulated_path(scene, o);
+  const auto& s = path.samples();
+  Motion m;
+  m.start = s.front().position;
+  m.end = s.back().position;
+  const double dt = 1.0 / Trajectory::kRate;
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    const Eigen::Vector3d step = s[i].position - s[i - 1].position;
+    m.length += step.norm();
+    // Velocity over 50 ms (the samples' linear interpolation makes 5 ms steps noisy in angle only).
+    if (i >= 10) m.top_speed = std::max(m.top_speed, (s[i].position - s[i - 10].position).norm() / (10 * dt));
+    const Eigen::Vector3d f0 = s[i - 1].orientation * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d f1 = s[i].orientation * Eigen::Vector3d::UnitX();
+    const double dyaw = std::remainder(std::atan2(f1.y(), f1.x()) - std::atan2(f0.y(), f0.x()), 2 * std::numbers::pi);
+    m.top_yaw_rate = std::max(m.top_yaw_rate, std::abs(dyaw) / dt);
+    const Eigen::Vector3d up = s[i].orientation * Eigen::Vector3d::UnitZ();
+    m.top_tilt = std::max(m.top_tilt, std::acos(std::clamp(up.z(), -1.0, 1.0)));
+    m.min_z = std::min(m.min_z, s[i].position.z());
+    m.max_z = std::max(m.max_z, s[i].position.z());
+    m.closest_wall = std::max(m.closest_wall, scene.plan.distance(s[i].position.head<2>()));
+  }
+  return m;
+}
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+TEST(SimPaths, RobotDrivesOutAndBackWithinItsLimits) {
+  SimOptions o;
+  o.duration_s = 60;
+  o.speed_mps = 1.5;
+  const Motion m = measure(o);
+  EXPECT_LE(m.top_speed, 1.5 * 1.02);
+  EXPECT_GT(m.top_speed, 1.3);
+  EXPECT_GT(m.top_tilt, 0.3 * kDeg);  // bumps roll and pitch the body
+  EXPECT_LT(m.top_tilt, 3.0 * kDeg);
+  EXPECT_LT((m.end - m.start).head<2>().norm(), 0.05);  // back where it started
+  EXPECT_GT(m.length, 60.0);
+  EXPECT_LT(m.closest_wall, -0.4);
+}
+
+TEST(SimPaths, RobotDrivesWholeLapsWhenThereIsTime) {
+  SimOptions o;
+  o.duration_s = 300;
+  o.speed_mps = 1.5;
+  const Motion m = measure(o);
+  const double loop = simulated_scene(o).route.length();
+  EXPECT_GT(loop, 100.0);
+  EXPECT_LT(loop, 500.0);
+  EXPECT_NEAR(m.length, loop * std::floor(1.5 * 299 / loop), 0.02 * loop);
+  EXPECT_LT((m.end - m.start).head<2>().norm(), 0.3);
+}
+
+TEST(SimPaths, DroneHoversClimbsAndTurnsWithinItsLimits) {
+  for (const double duration : {40.0, 400.0}) {  // out and back; whole laps
+    SimOptions o;
+    o.platform = "drone";
+    o.duration_s = duration;
+    o.speed_mps = 2.0;
+    const Motion m = measure(o);
+    EXPECT_LE(m.top_speed, 2.0 * 1.05) << duration;
+    if (duration < 100) {
+      EXPECT_GT(m.top_speed, 1.8);  // laps: slower, to end where it started
+    }
+    EXPECT_LE(m.top_yaw_rate, 90.0 * kDeg) << duration;
+    EXPECT_GT(m.top_yaw_rate, 20.0 * kDeg) << duration;
+    EXPECT_LT(m.min_z, 0.4) << duration;  // took off from the floor
+    EXPECT_GT(m.max_z, 2.3) << duration;  // and rose and sank in flight
+    EXPECT_GT(m.top_tilt, 1.0 * kDeg) << duration;
+    EXPECT_LT(m.top_tilt, 15.0 * kDeg) << duration;
+    EXPECT_LT((m.end - m.start).head<2>().norm(), 0.5) << duration;
+    EXPECT_LT(m.closest_wall, -0.4) << duration;
+  }
+  // Hovering: still between the climb and moving off.
+  SimOptions o;
+  o.platform = "drone";
+  o.duration_s = 40;
+  const Scene scene = simulated_scene(o);
+  const Trajectory path = simulated_path(scene, o);
+  EXPECT_LT((path.pose(5.9).translation() - path.pose(4.1).translation()).norm(), 1e-3);
+}
+
+}  // namespace
+}  // namespace adit::sim
