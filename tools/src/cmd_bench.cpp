@@ -32,6 +32,7 @@ struct BenchOptions {
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
   float max_range_m = 100.0F;
   float map_voxel_m = 0.5F;
+  double degeneracy_threshold = slam::RegistrationConfig{}.degeneracy_threshold;
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -98,6 +99,7 @@ int bench_odometry(const BenchOptions& o) {
   config.max_range_m = o.max_range_m;
   config.map_voxel_m = o.map_voxel_m;
   config.registration_voxel_m = 1.5F * o.map_voxel_m;
+  config.registration.degeneracy_threshold = o.degeneracy_threshold;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
   const double rss_before = resident_mb();
   slam::Odometry odometry(config);
@@ -176,6 +178,8 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
   odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
   odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");
+  odometry->add_option("--degeneracy-threshold", o->degeneracy_threshold,
+                       "Normalised Hessian eigenvalue below which a direction counts as unconstrained");
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");

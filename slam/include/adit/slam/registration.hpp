@@ -28,7 +28,12 @@ struct RegistrationConfig {
   int max_iterations = 30;
   double convergence_norm = 1e-4;       // settle when the update is below this (m, rad)
   double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
-  double degeneracy_threshold = 0.03;   // normalised eigenvalue below which a direction is degenerate
+  // Normalised eigenvalue below which a direction is degenerate: 0.003 means
+  // fewer than ~0.3% of the residuals watch it. Measured on a simulated rough
+  // mine drift (end-to-end 0.55% of path at 0.003; 37% at 0.01, where weak but
+  // real along-axis information was thrown away), while a plain tunnel's axis
+  // stays far below it.
+  double degeneracy_threshold = 0.003;
   int min_plane_correspondences = 100;  // fewer: degeneracy is judged on all residuals
 };
 
