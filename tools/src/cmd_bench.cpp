@@ -12,7 +12,10 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
+#include "adit/slam/align.hpp"
+#include "adit/slam/ape.hpp"
 #include "adit/slam/associate.hpp"
+#include "adit/slam/stats.hpp"
 #include "adit/slam/kitti_drift.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/trajectory.hpp"
@@ -70,6 +73,14 @@ void print_drift(const std::string& label, const slam::Trajectory& truth, const 
   if (a.pairs.size() < 2) {
     fmt::print("{}: no poses associated with the ground truth within 20 ms\n", label);
     return;
+  }
+  // APE after an SE(3) fit as well: a drift figure alone can look good for an
+  // estimate that went wrong and came back (or never moved on an out-and-back path).
+  if (const auto fit = slam::align_trajectory(a.ref, a.est, slam::Alignment::se3)) {
+    std::vector<slam::Pose> aligned;
+    for (const auto& pose : a.est) aligned.push_back(fit->apply(pose));
+    const slam::Stats ape = slam::compute_stats(slam::absolute_pose_errors(a.ref, aligned).translation);
+    fmt::print("{}: APE (SE(3)-aligned) rmse {:.3f} m, max {:.3f} m over {} poses\n", label, ape.rmse, ape.max, ape.count);
   }
   if (const auto kitti = slam::kitti_drift(a.ref, a.est)) {
     fmt::print("{}: drift {:.3f} % and {:.4f} deg/100 m (KITTI, {} segments of 100-800 m)\n", label,
