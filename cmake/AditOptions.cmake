@@ -67,3 +67,13 @@ function(adit_executable)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS})
   adit_target_defaults(${ARG_NAME})
 endfunction()
+
+# LCM's C++ header (lcm-cpp-impl.hpp) calls its subscription objects through a
+# C callback in a way UBSan's vptr check rejects; the check is dropped for the
+# files that include that header, and only for them:
+#   adit_without_vptr_check(file.cpp ...)
+function(adit_without_vptr_check)
+  if(ADIT_SANITIZE_ADDRESS)
+    set_source_files_properties(${ARGN} DIRECTORY ${CMAKE_SOURCE_DIR} PROPERTIES COMPILE_OPTIONS "-fno-sanitize=vptr")
+  endif()
+endfunction()
