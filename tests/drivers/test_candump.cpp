@@ -85,7 +85,8 @@ TEST(Candump, FormatThenParseIsIdentityForEveryKind) {
   std::vector<can::Frame> frames;
   for (const char* line : {"(46408.584930) can0 0AA#25B525B525A0258D", "(0.000001) can1 1FFFFFFF#", "(7.250000) can0 7FF#R",
                            "(7.250001) can0 123#R8", "(9.000000) can129 456##1DEADBEEF", "(9.000001) can0 20000004#0004000000000000",
-                           "(10.000000) can0 123#1122334455667788_F"}) {
+                           "(10.000000) can0 123#1122334455667788_F",
+                           "(10.500000) can0 7FF#R8_F"}) {  // remote with a raw DLC: found by fuzz_candump
     const can::Frame f = parse_ok(line);
     EXPECT_EQ(can::to_candump_line(f), line);  // canonical text survives read + write
     can::Frame back;

@@ -182,10 +182,12 @@ std::size_t format_candump_line(const Frame& f, std::span<char> out) {
   if (!f.remote) {
     const std::size_t n = std::min<std::size_t>(f.length, f.fd ? kMaxFdLength : kMaxClassicLength);
     for (std::size_t i = 0; i < n; ++i) put_hex(f.data[i], 2);
-    if (!f.fd && n == 8 && f.len8_dlc > 8) {
-      *p++ = '_';
-      *p++ = kHex[f.len8_dlc & 0xF];
-    }
+  }
+  // The raw DLC 9..F of an 8-byte classic frame, remote ones included (as
+  // can-utils' sprint_canframe writes "R8_F"); found by fuzz_candump.
+  if (!f.fd && f.length == 8 && f.len8_dlc > 8) {
+    *p++ = '_';
+    *p++ = kHex[f.len8_dlc & 0xF];
   }
   return static_cast<std::size_t>(p - out.data());
 }
