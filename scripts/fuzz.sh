@@ -8,6 +8,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${1:?usage: scripts/fuzz.sh BUILD_DIR [SECONDS]}
 seconds=${2:-15}
+# A fixed libFuzzer seed makes CI reproducible: the same mutations every run.
+# Set ADIT_FUZZ_SEED=0 (random) or another number to explore further by hand.
+fuzz_seed=${ADIT_FUZZ_SEED:-1}
 shared=${ADIT_SHARED_DATA:-../shared/data}
 mkdir -p fuzz-artifacts
 
@@ -34,7 +37,7 @@ for target in "${targets[@]}"; do
     done < "$seeds_file"
   fi
   echo "fuzz: $name for ${seconds}s with $(ls "$corpus" | wc -l) seeds"
-  "$target" -max_total_time="$seconds" -rss_limit_mb=2048 -artifact_prefix=fuzz-artifacts/"$name"- \
+  "$target" -seed="$fuzz_seed" -max_total_time="$seconds" -rss_limit_mb=2048 -artifact_prefix=fuzz-artifacts/"$name"- \
     -print_final_stats=1 "$corpus" 2>&1 | tail -n 12
   rm -rf "$corpus"
 done
