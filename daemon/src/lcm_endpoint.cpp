@@ -19,6 +19,7 @@
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
 #include "adit/protocol/command_gate.hpp"
+#include "adit/protocol/utime.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_chunk_t.hpp"
 #include "adit/tile_index_t.hpp"
@@ -30,10 +31,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using protocol::Channel;
 
-std::int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using protocol::now_utime;
 
 TilePublisherOptions publisher_options(const EndpointOptions& o) {
   return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed};

@@ -1,4 +1,5 @@
 #include "adit/daemon/tile_publisher.hpp"
+#include "adit/protocol/utime.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,10 +15,7 @@ constexpr std::size_t kIndexEntriesPerPart = 2000;
 // (212 992 bytes on Linux) holds little more.
 constexpr double kBurstBytes = 2.0 * protocol::kChunkPayloadBytes;
 
-std::int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using protocol::now_utime;
 
 }  // namespace
 

@@ -11,26 +11,13 @@
 
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/drivers/udp.hpp"
+#include "run_program.hpp"
 #include "shared_data.hpp"
 
 namespace {
 
-struct CommandRun {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandRun adit(const std::string& arguments) {
-  const std::string command = (adit::test::binary_dir() / "bin" / "adit").string() + " " + arguments + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  while (const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) run.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using adit::test::CommandRun;
+CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
 
 TEST(CmdLidar, PcapInfoDescribesTheCapture) {
   ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-vlp16-dual");

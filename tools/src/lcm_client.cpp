@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "adit/protocol/utime.hpp"
 #include "adit/command_t.hpp"
 #include "adit/common/error.hpp"
 #include "adit/protocol/channels.hpp"
@@ -22,10 +23,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using protocol::Channel;
 
-std::int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using protocol::now_utime;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
