@@ -1,0 +1,80 @@
+#pragma once
+// The global map of a session: registered scans accumulated in fixed-size
+// cubic tiles (default 20 m), each a voxel grid (default 5 cm) that keeps the
+// first point to land in each voxel. Keeping a measured point rather than a
+// centroid is KISS-ICP's rule (Vizzo et al. 2023, §III-B): nothing is
+// invented, and a surveyor's point is one the sensor saw. Tiles record
+// whether they changed, so a publisher sends only what is new.
+//
+// Coordinates: tile (i, j, k) covers [i·s, (i+1)·s) × … in the map frame, the
+// same convention as protocol::tile_of. Inside a tile the voxel grid starts at
+// the tile's corner, so no voxel straddles two tiles.
+
+#include <compare>
+#include <cstdint>
+#include <map>
+#include <set>
+#include <span>
+#include <unordered_set>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace adit::slam {
+
+struct TileCoord {
+  std::int32_t x = 0;
+  std::int32_t y = 0;
+  std::int32_t z = 0;
+  auto operator<=>(const TileCoord&) const = default;
+};
+
+struct MapSample {
+  Eigen::Vector3f position = Eigen::Vector3f::Zero();  // map frame, m
+  float intensity = 0.0F;
+  double time_s = 0.0;  // when the sensor measured it (the scan's stamp)
+};
+
+struct TiledMapConfig {
+  float tile_size_m = 20.0F;
+  float voxel_m = 0.05F;
+};
+
+// "" when usable, else why not: positive sizes, at most 1600 voxels per tile
+// edge (so a voxel's index inside its tile fits 32 bits).
+std::string tiled_map_config_problem(const TiledMapConfig& config);
+
+class TiledVoxelMap {
+ public:
+  // `config` must be usable (see tiled_map_config_problem); throws std::invalid_argument otherwise.
+  explicit TiledVoxelMap(const TiledMapConfig& config);
+
+  // Adds points given in the map frame (intensities: one per point or empty);
+  // returns how many landed in empty voxels and were kept. Non-finite points are skipped.
+  std::size_t add(std::span<const Eigen::Vector3f> points, std::span<const float> intensities, double time_s);
+
+  // The tiles that gained points since the previous call, in coordinate order.
+  std::vector<TileCoord> take_changed();
+
+  // The points of one tile (empty when the tile does not exist).
+  std::span<const MapSample> tile(const TileCoord& coord) const;
+  std::vector<TileCoord> tile_coords() const;
+  std::size_t size() const { return size_; }
+  std::size_t tile_count() const { return tiles_.size(); }
+  const TiledMapConfig& config() const { return config_; }
+
+  TileCoord tile_of(const Eigen::Vector3f& p) const;
+
+ private:
+  struct Tile {
+    std::unordered_set<std::uint32_t> occupied;  // voxel index inside the tile
+    std::vector<MapSample> points;
+  };
+  TiledMapConfig config_;
+  std::int32_t voxels_per_edge_;
+  std::map<TileCoord, Tile> tiles_;
+  std::set<TileCoord> changed_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace adit::slam

@@ -1,0 +1,85 @@
+#include "adit/slam/tiled_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace adit::slam {
+
+std::string tiled_map_config_problem(const TiledMapConfig& config) {
+  if (!(config.tile_size_m > 0.0F) || !std::isfinite(config.tile_size_m)) return "tile size must be positive";
+  if (!(config.voxel_m > 0.0F) || !std::isfinite(config.voxel_m)) return "voxel size must be positive";
+  if (config.voxel_m > config.tile_size_m) return "voxel size must not exceed the tile size";
+  if (std::ceil(config.tile_size_m / config.voxel_m) > 1600.0F)
+    return "tile size / voxel size must be at most 1600 (voxel indices are 32-bit)";
+  return "";
+}
+
+TiledVoxelMap::TiledVoxelMap(const TiledMapConfig& config)
+    : config_(config), voxels_per_edge_(static_cast<std::int32_t>(std::ceil(config.tile_size_m / config.voxel_m))) {
+  if (const std::string problem = tiled_map_config_problem(config); !problem.empty())
+    throw std::invalid_argument("tiled map: " + problem);
+}
+
+TileCoord TiledVoxelMap::tile_of(const Eigen::Vector3f& p) const {
+  const float inv = 1.0F / config_.tile_size_m;
+  return {static_cast<std::int32_t>(std::floor(p.x() * inv)), static_cast<std::int32_t>(std::floor(p.y() * inv)),
+          static_cast<std::int32_t>(std::floor(p.z() * inv))};
+}
+
+std::size_t TiledVoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const float> intensities,
+                               double time_s) {
+  const bool has_intensity = intensities.size() == points.size();
+  const float inv_voxel = 1.0F / config_.voxel_m;
+  const std::int32_t n = voxels_per_edge_;
+  // Consecutive points mostly share a tile: look the tile up only when it changes.
+  Tile* tile = nullptr;
+  TileCoord current{};
+  Eigen::Vector3f origin = Eigen::Vector3f::Zero();
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;
+    const TileCoord coord = tile_of(p);
+    if (tile == nullptr || coord != current) {
+      tile = &tiles_[coord];
+      current = coord;
+      origin = Eigen::Vector3f(static_cast<float>(coord.x), static_cast<float>(coord.y), static_cast<float>(coord.z)) *
+               config_.tile_size_m;
+    }
+    const auto index_along = [&](float offset) {
+      return std::clamp(static_cast<std::int32_t>(std::floor(offset * inv_voxel)), 0, n - 1);
+    };
+    const Eigen::Vector3f local = p - origin;
+    const auto voxel = static_cast<std::uint32_t>((index_along(local.x()) * n + index_along(local.y())) * n +
+                                                  index_along(local.z()));
+    if (!tile->occupied.insert(voxel).second) continue;
+    tile->points.push_back({p, has_intensity ? intensities[i] : 0.0F, time_s});
+    changed_.insert(coord);
+    ++kept;
+  }
+  size_ += kept;
+  return kept;
+}
+
+std::vector<TileCoord> TiledVoxelMap::take_changed() {
+  std::vector<TileCoord> out(changed_.begin(), changed_.end());
+  changed_.clear();
+  return out;
+}
+
+std::span<const MapSample> TiledVoxelMap::tile(const TileCoord& coord) const {
+  const auto it = tiles_.find(coord);
+  if (it == tiles_.end()) return {};
+  return it->second.points;
+}
+
+std::vector<TileCoord> TiledVoxelMap::tile_coords() const {
+  std::vector<TileCoord> out;
+  out.reserve(tiles_.size());
+  for (const auto& [coord, tile] : tiles_) out.push_back(coord);
+  return out;
+}
+
+}  // namespace adit::slam
