@@ -55,6 +55,9 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
       fail("wheel_odometry.right_signal", "wheel_odometry.enabled", "required when wheel odometry is enabled");
   }
 
+  if (c.map.tile_size_m / c.map.voxel_m > 1600.0)
+    fail("map.voxel_m", "map.tile_size_m", "at most 1600 voxels per tile edge: raise map.voxel_m or lower map.tile_size_m");
+
   if (c.gpio.enabled) {
     const std::pair<const char*, const GpioLine*> lines[] = {
         {"gpio.button", &c.gpio.button}, {"gpio.status_led", &c.gpio.status_led}, {"gpio.lidar_power", &c.gpio.lidar_power}};

@@ -97,6 +97,20 @@ void YamlReader::convert(const YAML::Node& node, std::string& out, int line, con
   fail(line, path, fmt::format("expected one of: {}; got '{}'", allowed, out));
 }
 
+void YamlReader::convert(const YAML::Node& node, std::vector<std::string>& out, int line, const std::string& path,
+                         const OneOf& one_of) const {
+  if (!node.IsSequence()) fail(line, path, "expected a list, e.g. [ply, las]");
+  out.clear();
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const std::string element_path = fmt::format("{}[{}]", path, i);
+    std::string name;
+    convert(node[i], name, line_of(node[i]), element_path, one_of);
+    if (std::find(out.begin(), out.end(), name) != out.end())
+      fail(line_of(node[i]), element_path, fmt::format("'{}' is listed twice", name));
+    out.push_back(std::move(name));
+  }
+}
+
 void YamlReader::convert(const YAML::Node& node, bool& out, int line, const std::string& path) const {
   // YAML 1.2 core schema booleans only: yes/no/on/off are strings there, and
   // accepting them silently is how "norway problems" start.

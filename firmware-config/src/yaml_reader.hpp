@@ -120,6 +120,10 @@ class YamlReader {
     for (std::size_t i = 0; i < 3; ++i) convert(node[i], out[i], line, path, range);
   }
 
+  // A list of names, each one of `one_of`, none twice.
+  void convert(const YAML::Node& node, std::vector<std::string>& out, int line, const std::string& path,
+               const OneOf& one_of) const;
+
   template <typename E>
   void convert(const YAML::Node& node, E& out, int line, const std::string& path, const Names<E>& names) const {
     const std::string text = scalar(node, line, path, "a name");

@@ -2,8 +2,11 @@
 // The schema visitor that writes the effective configuration back as YAML
 // (`adit config show`). Internal to adit_config.
 
+#include <string>
 #include <string_view>
+#include <vector>
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "adit/config/schema.hpp"
@@ -51,6 +54,16 @@ class YamlWriter {
   template <typename N, typename Check>
   void emit(const std::array<N, 3>& value, const Check&) {
     out_ << YAML::Flow << YAML::BeginSeq << value[0] << value[1] << value[2] << YAML::EndSeq;
+  }
+  // Shortest text that reads back to the same double (0.05, not 0.050000000000000003).
+  template <typename Check>
+  void emit(const double& value, const Check&) {
+    out_ << fmt::format("{}", value);
+  }
+  void emit(const std::vector<std::string>& value, const OneOf&) {
+    out_ << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& item : value) out_ << item;
+    out_ << YAML::EndSeq;
   }
   template <typename E>
   void emit(const E& value, const Names<E>& names) {

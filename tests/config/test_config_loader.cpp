@@ -157,6 +157,24 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(fifo.key(), "threads.odometry.priority");
 }
 
+TEST(ConfigLoader, SessionExportsAreAListOfKnownFormatsEachOnce) {
+  EXPECT_EQ(parse(std::string(kMinimal) + "session:\n  exports: [pcd]\n").session.exports,
+            std::vector<std::string>{"pcd"});
+  const InputError unknown = parse_error(std::string(kMinimal) + "session:\n  exports: [ply, xyz]\n");
+  EXPECT_EQ(unknown.key(), "session.exports[1]");
+  EXPECT_EQ(unknown.reason(), "expected one of: ply, pcd, las; got 'xyz'");
+  const InputError twice = parse_error(std::string(kMinimal) + "session:\n  exports: [las, las]\n");
+  EXPECT_EQ(twice.reason(), "'las' is listed twice");
+  EXPECT_EQ(parse_error(std::string(kMinimal) + "session:\n  exports: ply\n").reason(),
+            "expected a list, e.g. [ply, las]");
+}
+
+TEST(ConfigLoader, MapVoxelsPerTileAreBounded) {
+  const InputError e = parse_error(std::string(kMinimal) + "map:\n  tile_size_m: 50\n  voxel_m: 0.02\n");
+  EXPECT_EQ(e.key(), "map.voxel_m");
+  EXPECT_NO_THROW(parse(std::string(kMinimal) + "map:\n  tile_size_m: 50\n  voxel_m: 0.05\n"));
+}
+
 TEST(ConfigLoader, GpioLinesNeedExactlyOneOfOffsetOrName) {
   const std::string base = std::string(kMinimal) + "gpio:\n  enabled: true\n  button:\n    offset: 3\n"
                                                    "  status_led:\n    name: LED\n";

@@ -115,6 +115,24 @@ struct GpioSection {
   int debounce_ms = 30;
 };
 
+// The session's global map (slam/tiled_map.hpp), its tiles on the tablet
+// link (docs/PROTOCOL.md) and its keyframes (slam/keyframes.hpp).
+struct MapSection {
+  double tile_size_m = 20.0;
+  double voxel_m = 0.05;                 // one point kept per voxel
+  double publish_period_s = 1.0;         // changed tiles go out at most this often
+  double keyframe_distance_m = 1.0;
+  double keyframe_angle_deg = 10.0;
+  double keyframe_voxel_m = 0.2;         // a keyframe's scan is downsampled to this
+};
+
+// Sessions: what is kept in the session folder and how a session begins.
+struct SessionSection {
+  bool autostart = false;                // start mapping at launch (payloads without a tablet)
+  bool record_lidar = false;             // write the raw LiDAR packets to <session>/lidar.pcap
+  std::vector<std::string> exports{"ply", "las"};  // map files written when a session stops
+};
+
 struct LcmSection {
   std::string url = "udpm://239.255.76.67:7667?ttl=1";
 };
@@ -142,6 +160,8 @@ struct Config {
   CanSection can;
   WheelOdometrySection wheel_odometry;
   GpioSection gpio;
+  MapSection map;
+  SessionSection session;
   LcmSection lcm;
   ThreadsSection threads;
 };

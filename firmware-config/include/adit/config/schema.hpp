@@ -161,6 +161,25 @@ void describe(V& v, GpioSection& s) {
   v.optional("debounce_ms", s.debounce_ms, Range<int>{0, 1000});
 }
 
+inline constexpr std::array<std::string_view, 3> kMapFormats{"ply", "pcd", "las"};
+
+template <typename V>
+void describe(V& v, MapSection& s) {
+  v.optional("tile_size_m", s.tile_size_m, Range<double>{1.0, 60.0});  // 1 mm quanta fit uint16
+  v.optional("voxel_m", s.voxel_m, Range<double>{0.01, 1.0});
+  v.optional("publish_period_s", s.publish_period_s, Range<double>{0.1, 60.0});
+  v.optional("keyframe_distance_m", s.keyframe_distance_m, Range<double>{0.1, 100.0});
+  v.optional("keyframe_angle_deg", s.keyframe_angle_deg, Range<double>{1.0, 180.0});
+  v.optional("keyframe_voxel_m", s.keyframe_voxel_m, Range<double>{0.05, 2.0});
+}
+
+template <typename V>
+void describe(V& v, SessionSection& s) {
+  v.optional("autostart", s.autostart);
+  v.optional("record_lidar", s.record_lidar);
+  v.optional("exports", s.exports, OneOf{kMapFormats});
+}
+
 template <typename V>
 void describe(V& v, LcmSection& s) {
   v.optional("url", s.url);
@@ -190,6 +209,8 @@ void describe(V& v, Config& c) {
   v.section("can", c.can);
   v.section("wheel_odometry", c.wheel_odometry);
   v.section("gpio", c.gpio);
+  v.section("map", c.map);
+  v.section("session", c.session);
   v.section("lcm", c.lcm);
   v.section("threads", c.threads);
 }
