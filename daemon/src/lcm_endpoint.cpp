@@ -323,6 +323,16 @@ void LcmEndpoint::button_pressed() {
                                                                                         : protocol::SessionEvent::stop);
 }
 
+void LcmEndpoint::start_session() {
+  const std::lock_guard lock(impl_->events_mutex);
+  impl_->events.push_back(protocol::SessionEvent::start);
+}
+
+void LcmEndpoint::stop_session() {
+  const std::lock_guard lock(impl_->events_mutex);
+  impl_->events.push_back(protocol::SessionEvent::stop);
+}
+
 protocol::SessionState LcmEndpoint::state() const { return impl_->published_state.load(); }
 
 const EndpointCounters& LcmEndpoint::counters() const { return impl_->counters; }

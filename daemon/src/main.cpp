@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     bool check_only = false;
     bool print_config = false;
     std::string log_level;
+    adit::daemon::RunOptions run_options;
     app.add_option("-c,--config", config_file, "Payload configuration (YAML), see firmware-config/")
         ->capture_default_str();
     app.add_flag("-t,--check-config", check_only,
@@ -31,6 +32,9 @@ int main(int argc, char** argv) {
                  "Print the effective configuration (every key, defaults filled in) and exit");
     app.add_option("--log-level", log_level, "Override log.level: trace, debug, info, warn, error, off")
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+    app.add_flag("--once", run_options.once,
+                 "Start a session at once and exit when it ends (the recording runs out, STOP, or a signal); "
+                 "its files are in <state_dir>/sessions/<id>/");
     app.set_version_flag("--version", "aditd 0.1.0");
     try {
       app.parse(argc, argv);
@@ -52,6 +56,6 @@ int main(int argc, char** argv) {
     }
     const auto level = log_level.empty() ? config.log.level : *adit::log::parse_level(log_level);
     adit::log::init("aditd", level);
-    return adit::daemon::run(config, config_file);
+    return adit::daemon::run(config, config_file, run_options);
   });
 }

@@ -7,6 +7,9 @@
 #include <mutex>
 #include <optional>
 
+#include <pthread.h>
+#include <time.h>
+
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
@@ -17,7 +20,9 @@
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_directory.hpp"
 #include "adit/drivers/pcap_replay.hpp"
+#include "adit/drivers/pcap_writer.hpp"
 #include "adit/drivers/udp.hpp"
+#include "adit/slam/lie.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -26,10 +31,13 @@ constexpr std::size_t kMaxDatagram = 65'536;
 constexpr std::size_t kPacketSlots = 512;   // ~0.4 s of the busiest sensor (Ouster, 1280 packets/s)
 constexpr std::size_t kScanSlots = 4;
 constexpr std::size_t kPoseSlots = 8;
+constexpr std::size_t kMapSlots = 4;
 constexpr std::size_t kTimingCapacity = 1 << 20;  // scans kept for statistics (29 h at 10 Hz)
 
 struct Packet {
   std::int64_t host_time_ns = 0;     // capture or kernel time (the sensor clock's reference)
+  std::uint32_t src_ip = 0;          // for the raw recording
+  std::uint16_t src_port = 0;
   std::int64_t received_mono_ns = 0; // when the receiver handed it on (latency)
   std::uint32_t size = 0;
   std::array<std::uint8_t, kMaxDatagram> data{};
@@ -46,6 +54,17 @@ struct PoseSlot {
   std::int64_t pose_mono_ns = 0;
 };
 
+// A registered scan for the mapping thread: body-frame points as measured
+// (not deskewed: mapping deskews with the corrected motion), with the pose.
+struct MapSlot {
+  std::int64_t stamp_ns = 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  bool valid = false;
+  std::vector<Eigen::Vector3f> points;
+  std::vector<float> times_s;
+  std::vector<float> intensities;
+};
+
 // The sensor's pose in the body frame, from the configuration.
 Eigen::Isometry3f extrinsic_of(const config::Transform& t) {
   constexpr float kDeg = static_cast<float>(M_PI / 180.0);
@@ -60,6 +79,25 @@ Eigen::Isometry3f extrinsic_of(const config::Transform& t) {
 
 void wait_a_little() { std::this_thread::sleep_for(std::chrono::microseconds(200)); }
 
+std::int64_t realtime_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_REALTIME, &t);
+  return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
+}
+
+double thread_cpu_s(std::thread& thread) {
+  clockid_t clock{};
+  timespec t{};
+  if (!thread.joinable() || pthread_getcpuclockid(thread.native_handle(), &clock) != 0 ||
+      clock_gettime(clock, &t) != 0)
+    return 0.0;
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+slam::TiledMapConfig map_config_of(const config::MapSection& m) {
+  return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m)};
+}
+
 }  // namespace
 
 struct Pipeline::Impl {
@@ -68,7 +106,9 @@ struct Pipeline::Impl {
         options(o),
         overflow(c.lidar.source == config::LidarSource::udp ? Overflow::drop_oldest : Overflow::wait),
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
-        extrinsic(extrinsic_of(c.lidar.extrinsics)) {
+        extrinsic(extrinsic_of(c.lidar.extrinsics)),
+        map(map_config_of(c.map)),
+        keyframe_selector({c.map.keyframe_distance_m, c.map.keyframe_angle_deg}) {
     options.odometry.min_range_m = static_cast<float>(c.lidar.min_range_m);
     options.odometry.max_range_m = static_cast<float>(c.lidar.max_range_m);
     const double speed = options.replay_speed >= 0.0 ? options.replay_speed : c.lidar.replay_speed;
@@ -108,6 +148,27 @@ struct Pipeline::Impl {
       return slot;
     });
     odometry.emplace(options.odometry);
+    if (options.mapping) {
+      map_slots.emplace(kMapSlots, overflow, [max_points] {
+        MapSlot slot;
+        slot.points.reserve(max_points);
+        slot.times_s.reserve(max_points);
+        slot.intensities.reserve(max_points);
+        return slot;
+      });
+      map_points.reserve(max_points);
+      map_times.reserve(max_points);
+      map_intensities.reserve(max_points);
+      map_deskewed.reserve(max_points);
+      keyframe_points.reserve(max_points);
+      keyframe_downsampler.emplace(max_points);
+    }
+    if (!options.record_file.empty()) {
+      if (c.lidar.source != config::LidarSource::udp && !pcap)
+        throw InputError(options.record_file.string(), "session.record_lidar", "only packet sources can be recorded");
+      std::filesystem::create_directories(options.record_file.parent_path());
+      recorder.emplace(options.record_file);
+    }
     body_points.reserve(options.odometry.max_scan_points);
     body_times.reserve(options.odometry.max_scan_points);
     timings.odometry_ms.reserve(kTimingCapacity);
@@ -137,7 +198,8 @@ struct Pipeline::Impl {
   void receiver_loop() {
     settle_thread("adit-receiver", config.threads.receiver);
     if (scan_directory) return scan_directory_loop();
-    const auto push = [this](std::span<const std::uint8_t> payload, std::int64_t time_ns) {
+    const auto push = [this](std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip,
+                             std::uint16_t src_port) {
       Packet* packet = nullptr;
       while ((packet = packets.acquire()) == nullptr) {  // replay: wait for assembly
         if (stop.load(std::memory_order_relaxed)) return;
@@ -145,29 +207,45 @@ struct Pipeline::Impl {
         wait_a_little();
       }
       packet->host_time_ns = time_ns;
+      packet->src_ip = src_ip;
+      packet->src_port = src_port;
       packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
       std::memcpy(packet->data.data(), payload.data(), packet->size);
       packet->received_mono_ns = monotonic_ns();
+      stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+      if (recorder) {
+        // Buffered file output on the receiver: a copy and no allocation per packet.
+        const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, data_port};
+        if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload))
+          stats.recorded_datagrams.fetch_add(1, std::memory_order_relaxed);
+      }
       packets.publish(packet);
     };
     if (pcap) {
       drivers::UdpDatagram d;
-      while (!stop.load(std::memory_order_relaxed) && pcap->next(d)) {
+      while (!stop.load(std::memory_order_relaxed) && !source_stop.load(std::memory_order_relaxed) && pcap->next(d)) {
         receiver_beat.beat();
         stats.datagrams.fetch_add(1, std::memory_order_relaxed);
         if (d.dst_port != data_port) {
           stats.foreign_datagrams.fetch_add(1, std::memory_order_relaxed);
           continue;
         }
-        push(d.payload, d.capture_time_ns);
+        push(d.payload, d.capture_time_ns, d.src_ip, d.src_port);
       }
     } else {
-      while (!stop.load(std::memory_order_relaxed)) {
+      while (!stop.load(std::memory_order_relaxed) && !source_stop.load(std::memory_order_relaxed)) {
         receiver_beat.beat();
         for (const drivers::ReceivedDatagram& d : udp->receive(100)) {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
-          push(d.payload, d.kernel_time_ns);
+          push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port);
         }
+      }
+    }
+    if (recorder) {
+      try {
+        recorder->flush();
+      } catch (const InputError& e) {
+        log::error("{}: {}", e.where(), e.reason());
       }
     }
     source_done.store(true, std::memory_order_release);
@@ -177,7 +255,8 @@ struct Pipeline::Impl {
   void scan_directory_loop() {
     drivers::LidarScan scan;
     scan.points.reserve(options.odometry.max_scan_points);
-    while (!stop.load(std::memory_order_relaxed) && scan_directory->next(scan)) {
+    while (!stop.load(std::memory_order_relaxed) && !source_stop.load(std::memory_order_relaxed) &&
+           scan_directory->next(scan)) {
       receiver_beat.beat();
       current_packet_mono_ns = monotonic_ns();
       hand_on(scan);
@@ -245,11 +324,100 @@ struct Pipeline::Impl {
         out->pose_mono_ns = monotonic_ns();
         poses->publish(out);
       }
+      if (map_slots && result.valid) hand_to_mapping(slot->scan, result);
       scans->release(slot);
     }
     stats.dropped_scans.store(scans->dropped());
     odometry_done.store(true, std::memory_order_release);
     odometry_beat.finished.store(true);
+  }
+
+  // Odometry thread: copies (no allocation: the slot's buffers are reserved).
+  void hand_to_mapping(const drivers::LidarScan& scan, const slam::OdometryResult& result) {
+    MapSlot* m = nullptr;
+    while ((m = map_slots->acquire()) == nullptr && !stop.load(std::memory_order_relaxed)) {
+      odometry_beat.beat();
+      wait_a_little();
+    }
+    if (m == nullptr) return;
+    m->stamp_ns = result.stamp_ns;
+    m->pose = result.pose;
+    m->valid = result.valid;
+    m->points.assign(body_points.begin(), body_points.end());
+    m->times_s.assign(body_times.begin(), body_times.end());
+    m->intensities.clear();
+    for (const drivers::LidarPoint& p : scan.points) m->intensities.push_back(p.intensity);
+    map_slots->publish(m);
+  }
+
+  // Mapping thread: deskew with the motion between this pose and the previous
+  // one (the corrected motion, not the prediction odometry deskewed with),
+  // then add to the tiled map; keyframes; changed tiles to the sink.
+  void mapping_loop() {
+    settle_thread("adit-mapping", config.threads.mapping);
+    const auto period_ns = static_cast<std::int64_t>(config.map.publish_period_s * 1e9);
+    std::int64_t last_flush_ns = monotonic_ns();
+    while (!stop.load(std::memory_order_relaxed)) {
+      mapping_beat.beat();
+      const std::int64_t now = monotonic_ns();
+      if (now - last_flush_ns >= period_ns) {
+        flush_tiles();
+        last_flush_ns = now;
+      }
+      MapSlot* slot = map_slots->take();
+      if (slot == nullptr) {
+        if (odometry_done.load(std::memory_order_acquire) && map_slots->depth() == 0) break;
+        wait_a_little();
+        continue;
+      }
+      map_scan(*slot);
+      map_slots->release(slot);
+    }
+    flush_tiles();
+    stats.dropped_map_scans.store(map_slots->dropped());
+    mapping_beat.finished.store(true);
+  }
+
+  void map_scan(const MapSlot& slot) {
+    slam::Vector6d velocity = slam::Vector6d::Zero();
+    const double dt = 1e-9 * static_cast<double>(slot.stamp_ns - previous_map_stamp_ns);
+    if (previous_map_stamp_ns != 0 && dt > 0.0 && dt <= options.odometry.max_scan_gap_s)
+      velocity = slam::log_se3(previous_map_pose.inverse() * slot.pose) / dt;
+    previous_map_stamp_ns = slot.stamp_ns;
+    previous_map_pose = slot.pose;
+
+    map_points.clear();
+    map_times.clear();
+    map_intensities.clear();
+    const float min2 = options.odometry.min_range_m * options.odometry.min_range_m;
+    const float max2 = options.odometry.max_range_m * options.odometry.max_range_m;
+    const bool timed = slot.times_s.size() == slot.points.size();
+    for (std::size_t i = 0; i < slot.points.size(); ++i) {
+      const float r2 = slot.points[i].squaredNorm();
+      if (!std::isfinite(r2) || r2 < min2 || r2 > max2) continue;
+      map_points.push_back(slot.points[i]);
+      map_times.push_back(timed ? slot.times_s[i] : 0.0F);
+      map_intensities.push_back(i < slot.intensities.size() ? slot.intensities[i] : 0.0F);
+    }
+    map_deskewed.resize(map_points.size());
+    map_deskewer.deskew(map_points, map_times, velocity, map_deskewed);
+    if (keyframe_selector.take(slot.pose)) {
+      keyframe_downsampler->downsample(map_deskewed, static_cast<float>(config.map.keyframe_voxel_m), keyframe_points);
+      keyframe_list.push_back({slot.stamp_ns, slot.pose, keyframe_points});
+      stats.keyframes.store(keyframe_list.size(), std::memory_order_relaxed);
+    }
+    const Eigen::Isometry3f pose = slot.pose.cast<float>();
+    for (Eigen::Vector3f& p : map_deskewed) p = pose * p;
+    map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
+    stats.mapped_scans.fetch_add(1, std::memory_order_relaxed);
+    stats.map_points.store(map.size(), std::memory_order_relaxed);
+    stats.map_tiles.store(map.tile_count(), std::memory_order_relaxed);
+  }
+
+  void flush_tiles() {
+    const std::vector<slam::TileCoord> changed = map.take_changed();
+    if (!options.sinks.tile) return;
+    for (const slam::TileCoord& coord : changed) options.sinks.tile(coord, map.tile(coord));
   }
 
   void output_loop() {
@@ -268,6 +436,7 @@ struct Pipeline::Impl {
       if (r.status == slam::OdometryStatus::degenerate) stats.degenerate_poses.fetch_add(1, std::memory_order_relaxed);
       if (timings.latency_ms.size() < kTimingCapacity)
         timings.latency_ms.push_back(1e-6 * static_cast<double>(slot->pose_mono_ns - slot->last_packet_mono_ns));
+      if (options.sinks.pose) options.sinks.pose(r);
       if (trajectory && r.valid) {
         const Eigen::Quaterniond q(r.pose.linear());
         const Eigen::Vector3d& t = r.pose.translation();
@@ -301,6 +470,21 @@ struct Pipeline::Impl {
   std::optional<Handoff<PoseSlot>> poses{std::in_place, kPoseSlots, Overflow::wait, [] { return PoseSlot{}; }};
   std::optional<slam::Odometry> odometry;
   Eigen::Isometry3f extrinsic;
+  std::optional<drivers::PcapWriter> recorder;
+  std::optional<Handoff<MapSlot>> map_slots;
+  // Mapping thread only:
+  slam::TiledVoxelMap map;
+  slam::KeyframeSelector keyframe_selector;
+  std::vector<slam::Keyframe> keyframe_list;
+  std::optional<slam::VoxelDownsampler> keyframe_downsampler;
+  slam::Deskewer map_deskewer;
+  std::vector<Eigen::Vector3f> map_points;
+  std::vector<float> map_times;
+  std::vector<float> map_intensities;
+  std::vector<Eigen::Vector3f> map_deskewed;
+  std::vector<Eigen::Vector3f> keyframe_points;
+  std::int64_t previous_map_stamp_ns = 0;
+  Eigen::Isometry3d previous_map_pose = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3f> body_points;
   std::vector<float> body_times;
   std::int64_t current_packet_mono_ns = 0;  // assembly thread only
@@ -317,7 +501,9 @@ struct Pipeline::Impl {
   Heartbeat assembly_beat{"assembly"};
   Heartbeat odometry_beat{"odometry"};
   Heartbeat output_beat{"output"};
+  Heartbeat mapping_beat{"mapping"};
   std::atomic<bool> stop{false};
+  std::atomic<bool> source_stop{false};
   std::atomic<bool> source_done{false};
   std::atomic<bool> assembly_done{false};
   std::atomic<bool> odometry_done{false};
@@ -342,6 +528,7 @@ void Pipeline::start() {
     i.warnings.insert(i.warnings.end(), w.begin(), w.end());
   }
   i.started_ns = monotonic_ns();
+  if (i.map_slots) i.threads.emplace_back([&i] { i.mapping_loop(); });
   i.threads.emplace_back([&i] { i.output_loop(); });
   i.threads.emplace_back([&i] { i.odometry_loop(); });
   i.threads.emplace_back([&i] { i.assembly_loop(); });
@@ -349,6 +536,7 @@ void Pipeline::start() {
 }
 
 void Pipeline::request_stop() { impl_->stop.store(true, std::memory_order_release); }
+void Pipeline::end_source() { impl_->source_stop.store(true, std::memory_order_release); }
 
 void Pipeline::join() {
   Impl& i = *impl_;
@@ -361,7 +549,10 @@ void Pipeline::join() {
   }
 }
 
-bool Pipeline::drained() const { return impl_->output_beat.finished.load(std::memory_order_acquire); }
+bool Pipeline::drained() const {
+  return impl_->output_beat.finished.load(std::memory_order_acquire) &&
+         (!impl_->map_slots || impl_->mapping_beat.finished.load(std::memory_order_acquire));
+}
 
 double quantile(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
@@ -373,8 +564,29 @@ double quantile(std::vector<double> values, double q) {
 const PipelineStats& Pipeline::stats() const { return impl_->stats; }
 const PipelineTimings& Pipeline::timings() const { return impl_->timings; }
 std::vector<const Heartbeat*> Pipeline::heartbeats() const {
-  return {&impl_->receiver_beat, &impl_->assembly_beat, &impl_->odometry_beat, &impl_->output_beat};
+  std::vector<const Heartbeat*> beats{&impl_->receiver_beat, &impl_->assembly_beat, &impl_->odometry_beat,
+                                      &impl_->output_beat};
+  if (impl_->map_slots) beats.push_back(&impl_->mapping_beat);
+  return beats;
 }
+
+std::vector<StageLoad> Pipeline::loads() const {
+  Impl& i = *impl_;
+  std::vector<StageLoad> out;
+  if (i.threads.empty()) return out;
+  // Threads were started in this order: [mapping,] output, odometry, assembly, receiver.
+  const std::size_t first = i.map_slots ? 1 : 0;
+  const auto cpu = [&](std::size_t k) { return k < i.threads.size() ? thread_cpu_s(i.threads[k]) : 0.0; };
+  out.push_back({"receiver", cpu(first + 3), 0, 0});
+  out.push_back({"assembly", cpu(first + 2), i.packets.depth(), i.packets.capacity()});
+  out.push_back({"odometry", cpu(first + 1), i.scans->depth(), i.scans->capacity()});
+  out.push_back({"output", cpu(first), i.poses->depth(), i.poses->capacity()});
+  if (i.map_slots) out.push_back({"mapping", cpu(0), i.map_slots->depth(), i.map_slots->capacity()});
+  return out;
+}
+
+const slam::TiledVoxelMap& Pipeline::map() const { return impl_->map; }
+const std::vector<slam::Keyframe>& Pipeline::keyframes() const { return impl_->keyframe_list; }
 std::vector<std::string> Pipeline::warnings() const {
   const std::lock_guard lock(impl_->warnings_mutex);
   return impl_->warnings;

@@ -3,13 +3,14 @@
 #include <signal.h>
 
 #include <chrono>
-#include <ctime>
+#include <memory>
 
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
-#include "adit/daemon/pipeline.hpp"
+#include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/daemon/sessions.hpp"
 #include "adit/daemon/supervisor.hpp"
 
 namespace adit::daemon {
@@ -24,28 +25,28 @@ std::string_view source_name(config::LidarSource source) {
   return "?";
 }
 
-std::string session_name() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  return fmt::format("{:04}{:02}{:02}T{:02}{:02}{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour,
-                     utc.tm_min, utc.tm_sec);
+EndpointOptions endpoint_options(const config::Config& c) {
+  EndpointOptions o;
+  o.lcm_url = c.lcm.url;
+  o.payload_id = c.payload.id;
+  o.tiles.tile_size_m = c.map.tile_size_m;
+  o.tile_period_s = c.map.publish_period_s;
+  return o;
 }
 
-std::string status_line(const PipelineStats& s) {
-  return fmt::format("scans {} poses {} invalid {} degenerate {} dropped packets {} scans {}", s.scans.load(),
-                     s.poses.load(), s.invalid_poses.load(), s.degenerate_poses.load(), s.dropped_packets.load(),
-                     s.dropped_scans.load());
+std::string status_line(protocol::SessionState state, const StatusSample& s, const EndpointCounters& c) {
+  std::string line = fmt::format("{}", protocol::state_name(state));
+  for (const SensorHealth& h : s.sensors) line += fmt::format("; {} {:.0f} packets/s", h.name, h.packet_rate_hz);
+  line += fmt::format("; poses {} published", c.poses_published.load());
+  if (!s.fault.empty()) line += "; " + s.fault;
+  return line;
 }
 
 }  // namespace
 
-int run(const config::Config& config, const std::filesystem::path& config_file) {
+int run(const config::Config& config, const std::filesystem::path& config_file, const RunOptions& options) {
   log::info("configuration {}: payload '{}', lidar {} from {}", config_file.string(), config.payload.id,
             config.lidar.model, source_name(config.lidar.source));
-  const std::filesystem::path session = std::filesystem::path(config.payload.state_dir) / "sessions" / session_name();
-  PipelineOptions options;
-  options.trajectory_file = session / "trajectory.tum";
 
   // SIGINT/SIGTERM are taken synchronously by this thread (sigtimedwait); the
   // workers inherit the blocked mask, so no handler runs on a hot path.
@@ -55,48 +56,92 @@ int run(const config::Config& config, const std::filesystem::path& config_file) 
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  Pipeline pipeline(config, options);
-  pipeline.start();
-  for (const std::string& warning : pipeline.warnings()) log::warn("{}", warning);
+  // Sessions hand poses and tiles to the endpoint; the endpoint's commands
+  // drive the sessions. The endpoint outlives no session: it is reset only
+  // after stop_and_wait().
+  LcmEndpoint* endpoint_ptr = nullptr;
+  Sessions::Outputs outputs;
+  outputs.pose = [&endpoint_ptr](const PoseSample& p) { endpoint_ptr->publish_pose(p); };
+  outputs.tile = [&endpoint_ptr](TileUpdate&& t) { endpoint_ptr->publish_tile(std::move(t)); };
+  outputs.ended = [&endpoint_ptr](const std::string&) { endpoint_ptr->session_stopped(); };
+  Sessions sessions(config, std::move(outputs));
+
+  SessionHooks hooks;
+  hooks.start = [&sessions] { return sessions.start(); };
+  hooks.stop = [&sessions] { sessions.request_stop(); };
+  hooks.sessions = [&sessions] { return sessions.list(); };
+  hooks.export_map = [&sessions, &config](const std::string& id, const std::vector<std::string>&) {
+    // Exports are written when a session stops; EXPORT says where they are.
+    const std::filesystem::path dir = sessions.folder(id);
+    if (id.empty() || !std::filesystem::is_directory(dir)) throw std::runtime_error("no session '" + id + "'");
+    std::string files;
+    for (const std::string& format : config.session.exports)
+      if (std::filesystem::exists(dir / ("map." + format))) files += (dir / ("map." + format)).string() + "\n";
+    if (files.empty()) throw std::runtime_error("session '" + id + "' has no map files yet");
+    return files;
+  };
+  auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));
+  endpoint_ptr = endpoint.get();
+  log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);
+
+  if (options.once || config.session.autostart) endpoint->start_session();
 
   const auto watchdog_ns = systemd_watchdog_ns();
-  const std::int64_t check_ns = watchdog_ns ? *watchdog_ns / 2 : 1'000'000'000;
+  const std::int64_t tick_ns = 50'000'000;
+  const std::int64_t pet_ns = watchdog_ns ? *watchdog_ns / 2 : 1'000'000'000;
   const std::int64_t stall_ns = std::max<std::int64_t>(2'000'000'000, watchdog_ns.value_or(0) / 2);
-  notify_ready(fmt::format("mapping: lidar {} from {}", config.lidar.model, source_name(config.lidar.source)));
-  log::info("session {}: mapping", session.string());
+  const std::int64_t status_ns = 500'000'000;  // 2 Hz, as docs/PROTOCOL.md promises
+  notify_ready(fmt::format("idle: lidar {} from {}", config.lidar.model, source_name(config.lidar.source)));
 
   bool reported_stall = false;
-  while (!pipeline.drained()) {
-    const timespec timeout{static_cast<time_t>(check_ns / 1'000'000'000), static_cast<long>(check_ns % 1'000'000'000)};
+  bool seen_session = false;
+  std::int64_t last_status_ns = 0;
+  std::int64_t last_pet_ns = 0;
+  while (true) {
+    const timespec timeout{0, static_cast<long>(tick_ns)};
     const int signal = sigtimedwait(&signals, nullptr, &timeout);
     if (signal == SIGINT || signal == SIGTERM) {
       log::info("signal {}: stopping", signal);
-      pipeline.request_stop();
       break;
     }
-    const auto beats = pipeline.heartbeats();
-    const SupervisorVerdict verdict = check_heartbeats(beats, monotonic_ns(), stall_ns);
-    if (verdict.healthy) {
-      notify_watchdog();
-      notify_status(status_line(pipeline.stats()));
-      reported_stall = false;
-    } else if (!reported_stall) {
-      // No WATCHDOG=1 from here on: systemd restarts us after WatchdogSec.
-      log::error("stalled worker(s): {}; no longer feeding the watchdog", verdict.stalled);
-      notify_status("stalled: " + verdict.stalled);
-      reported_stall = true;
+    if (sessions.poll()) {
+      log::info("the recording has ended: stopping the session");
+      endpoint->stop_session();
+    }
+    for (const std::string& warning : sessions.take_warnings()) log::warn("{}", warning);
+    if (const std::exception_ptr failure = sessions.take_start_failure(); failure && options.once) {
+      notify_stopping();
+      std::rethrow_exception(failure);  // named InputError: exit 2, as for a bad configuration
+    }
+    const bool running = sessions.running() || endpoint->state() != protocol::SessionState::idle;
+    seen_session = seen_session || running;
+    if (options.once && seen_session && !running) break;
+
+    const std::int64_t now = monotonic_ns();
+    if (now - last_status_ns >= status_ns) {
+      last_status_ns = now;
+      StatusSample status = sessions.status_sample();
+      const std::string line = status_line(endpoint->state(), status, endpoint->counters());
+      endpoint->publish_status(std::move(status));
+      if (!reported_stall) notify_status(line);
+    }
+    if (now - last_pet_ns >= pet_ns) {
+      last_pet_ns = now;
+      const SupervisorVerdict verdict = check_heartbeats(sessions.heartbeats(), now, stall_ns);
+      if (verdict.healthy) {
+        notify_watchdog();
+        reported_stall = false;
+      } else if (!reported_stall) {
+        // No WATCHDOG=1 from here on: systemd restarts us after WatchdogSec.
+        log::error("stalled worker(s): {}; no longer feeding the watchdog", verdict.stalled);
+        notify_status("stalled: " + verdict.stalled);
+        reported_stall = true;
+      }
     }
   }
   notify_stopping();
-  pipeline.join();
-
-  const PipelineStats& s = pipeline.stats();
-  const PipelineTimings& t = pipeline.timings();
-  log::info("{}", status_line(s));
-  log::info("odometry per scan: median {:.2f} ms, p99 {:.2f} ms; pose latency p99 {:.2f} ms; {:.1f} s of data in {:.1f} s",
-            quantile(t.odometry_ms, 0.5), quantile(t.odometry_ms, 0.99), quantile(t.latency_ms, 0.99), t.sensor_span_s,
-            t.duration_s);
-  log::info("trajectory: {}", options.trajectory_file.string());
+  sessions.stop_and_wait();  // the running session's files are written before we go
+  endpoint.reset();
   return kExitOk;
 }
 

@@ -120,6 +120,10 @@ class LcmEndpoint {
   void session_stopped();
   // The GPIO button: starts when idle, stops when mapping.
   void button_pressed();
+  // The daemon's own start (session.autostart) and stop (a replay ran out):
+  // the same transitions as the tablet's commands, without an ack.
+  void start_session();
+  void stop_session();
 
   protocol::SessionState state() const;
   const EndpointCounters& counters() const;

@@ -3,14 +3,21 @@
 // preallocated lock-free hand-offs (handoff.hpp):
 //
 //   receiver ─packets→ assembly ─scans→ odometry ─poses→ output
+//                                                 └─scans+poses→ mapping
 //
 // The receiver reads UDP (live: a full hand-off drops the oldest packet) or a
-// pcap / scan directory (replay: it waits, nothing is lost). Assembly decodes
-// and cuts scans; odometry runs slam::Odometry; output writes the trajectory
-// and keeps statistics (mapping and publishing attach here). After start-up no
-// stage allocates per packet or per scan. `adit replay` runs the same class.
+// pcap / scan directory (replay: it waits, nothing is lost), and can record
+// the raw packets. Assembly decodes and cuts scans; odometry runs
+// slam::Odometry; output writes the trajectory, keeps statistics and hands
+// each pose to the pose sink; mapping deskews each registered scan with the
+// corrected motion, adds it to the session's tiled map, keeps keyframes and
+// hands changed tiles to the tile sink at most once per period. After
+// start-up no stage before mapping allocates per packet or per scan (the map
+// grows by nature). `adit replay` runs the same class.
 
 #include <atomic>
+#include <functional>
+#include <span>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -20,14 +27,28 @@
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/heartbeat.hpp"
+#include "adit/slam/keyframes.hpp"
 #include "adit/slam/odometry.hpp"
+#include "adit/slam/tiled_map.hpp"
 
 namespace adit::daemon {
 
+// Where results leave the pipeline. Each runs on one pipeline thread and must
+// be quick and not throw; empty = not wanted.
+struct PipelineSinks {
+  // Output thread, once per scan (valid or not).
+  std::function<void(const slam::OdometryResult&)> pose;
+  // Mapping thread: the whole current content of a tile that changed.
+  std::function<void(const slam::TileCoord&, std::span<const slam::MapSample>)> tile;
+};
+
 struct PipelineOptions {
   std::filesystem::path trajectory_file;  // TUM, written as poses arrive; empty = none
+  std::filesystem::path record_file;      // raw LiDAR packets as pcap; empty = none
   double replay_speed = -1.0;             // pcap/scan_dir: overrides lidar.replay_speed when ≥ 0
   slam::OdometryConfig odometry;          // range limits come from the lidar section
+  bool mapping = true;                    // run the mapping thread (config `map` section)
+  PipelineSinks sinks;
 };
 
 // Statistics, readable while running (atomics) and complete after join().
@@ -42,6 +63,21 @@ struct PipelineStats {
   std::atomic<std::uint64_t> invalid_poses{0};
   std::atomic<std::uint64_t> degenerate_poses{0};
   std::atomic<std::uint64_t> bad_packets{0};
+  std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
+  std::atomic<std::uint64_t> recorded_datagrams{0};
+  std::atomic<std::uint64_t> mapped_scans{0};
+  std::atomic<std::uint64_t> dropped_map_scans{0};      // live: mapping fell behind
+  std::atomic<std::uint64_t> map_points{0};
+  std::atomic<std::uint64_t> map_tiles{0};
+  std::atomic<std::uint64_t> keyframes{0};
+};
+
+// A stage's queue and its thread's CPU time, for the status message.
+struct StageLoad {
+  std::string name;
+  double cpu_s = 0.0;         // CPU time of the stage's thread so far
+  std::size_t queue_depth = 0;  // items waiting for the stage
+  std::size_t queue_capacity = 0;
 };
 
 // The q-quantile (0..1) of `values` by nearest rank; 0 when empty.
@@ -65,7 +101,11 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   void start();
+  // Stops at once: queued packets and scans are dropped.
   void request_stop();
+  // Stops reading the source; what was read is still processed, so drained()
+  // becomes true once every stage has caught up (the end of a session).
+  void end_source();
   // Waits until a replay source is exhausted and every stage has drained, or
   // until request_stop(); then joins the threads.
   void join();
@@ -76,6 +116,11 @@ class Pipeline {
   const PipelineTimings& timings() const;  // after join()
   std::vector<const Heartbeat*> heartbeats() const;
   std::vector<std::string> warnings() const;  // thread settings that could not be applied
+  std::vector<StageLoad> loads() const;         // while running
+
+  // The session's map and keyframes: complete after join(), not to be read before.
+  const slam::TiledVoxelMap& map() const;
+  const std::vector<slam::Keyframe>& keyframes() const;
 
  private:
   struct Impl;

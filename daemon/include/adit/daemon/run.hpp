@@ -7,7 +7,13 @@
 
 namespace adit::daemon {
 
+struct RunOptions {
+  // Start a session at launch and exit once it has ended (its recording ran
+  // out, a STOP came, or a signal): replays from scripts and tests.
+  bool once = false;
+};
+
 // Runs aditd with `config` until it is told to stop; returns the exit status.
-int run(const config::Config& config, const std::filesystem::path& config_file);
+int run(const config::Config& config, const std::filesystem::path& config_file, const RunOptions& options = {});
 
 }  // namespace adit::daemon

@@ -1,0 +1,99 @@
+#pragma once
+// Mapping sessions: IDLE → MAPPING → STOPPING → IDLE (docs/PROTOCOL.md).
+//
+// start() makes the session folder in <state_dir>/sessions/<id>/ and starts a
+// pipeline that writes the trajectory as it goes, records the raw packets when
+// configured, and hands poses and map tiles to the tablet endpoint. A stop
+// (asked for, or the end of a replayed recording) ends the source, lets every
+// stage drain, and then, on a thread of its own so that the supervisor keeps
+// petting the watchdog, writes the session's files:
+//   trajectory.tum   body poses in the map frame (TUM), written live
+//   map.ply|pcd|las  the map (session.exports), from the same tiles the tablet gets
+//   tiles/<id>.adt   each tile's encoded blob (protocol/tile_codec.hpp), for downloads later
+//   keyframes.tum    keyframe poses (their scans stay in memory for loop closure)
+//   summary.json     counts, timings, files; config.yaml the effective configuration
+//   lidar.pcap       raw packets, when session.record_lidar is true
+
+#include <atomic>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/heartbeat.hpp"
+#include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/daemon/pipeline.hpp"
+
+namespace adit::daemon {
+
+// Converts an odometry result to the pose the tablet gets (flags: pose_t.FLAG_*).
+PoseSample pose_sample_of(const slam::OdometryResult& result);
+
+class Sessions {
+ public:
+  // `publish_pose`/`publish_tile` may be empty (no endpoint); `ended` runs on
+  // the finishing thread once a session's files are written.
+  struct Outputs {
+    std::function<void(const PoseSample&)> pose;
+    std::function<void(TileUpdate&&)> tile;
+    std::function<void(const std::string& session)> ended;
+  };
+
+  Sessions(const config::Config& config, Outputs outputs);
+  ~Sessions();
+  Sessions(const Sessions&) = delete;
+  Sessions& operator=(const Sessions&) = delete;
+
+  // Starts a session and returns its id. Throws adit::InputError (a bad
+  // source: named) or std::runtime_error when it cannot; nothing is left running then.
+  std::string start();
+  // Asks the running session to stop; poll() does the work.
+  void request_stop();
+  // Main thread, a few times a second: begins finishing a session that was
+  // asked to stop or whose replay has ended; reaps a finished one. Returns
+  // true when the running session's source ended by itself (the caller moves
+  // the state machine to STOPPING).
+  bool poll();
+  // Blocks until no session runs and every file is written (shutdown).
+  void stop_and_wait();
+
+  bool running() const;  // a pipeline exists (mapping or being finished)
+  std::vector<std::string> list() const;  // sessions on disk, oldest first
+  std::filesystem::path folder(const std::string& id) const;
+  // What the status message says about the running session (empty when idle).
+  StatusSample status_sample();
+  // Heartbeats of the running session's threads (empty when idle).
+  std::vector<const Heartbeat*> heartbeats() const;
+  std::vector<std::string> take_warnings();
+  // Why the last start() failed (once), or null: aditd --once exits with it.
+  std::exception_ptr take_start_failure();
+
+ private:
+  std::string start_locked();
+  void finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::filesystem::path dir);
+
+  config::Config config_;
+  Outputs outputs_;
+  std::filesystem::path root_;
+  mutable std::mutex mutex_;  // control only: start, stop, poll; never a pipeline thread
+  std::unique_ptr<Pipeline> pipeline_;
+  std::string id_;
+  std::filesystem::path dir_;
+  std::atomic<bool> stop_requested_{false};
+  std::thread finisher_;
+  std::atomic<bool> finishing_{false};
+  std::vector<std::string> warnings_;
+  std::exception_ptr start_failure_;
+  // Status: packet rate and thread load from differences between samples.
+  std::int64_t last_sample_ns_ = 0;
+  std::uint64_t last_datagrams_ = 0;
+  std::vector<double> last_cpu_s_;
+};
+
+}  // namespace adit::daemon

@@ -1,0 +1,294 @@
+#include "adit/daemon/sessions.hpp"
+
+#include <sys/statvfs.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/config/load.hpp"
+#include "adit/protocol/map_export.hpp"
+#include "adit/protocol/tile_codec.hpp"
+#include "adit/protocol/utime.hpp"
+
+namespace adit::daemon {
+namespace {
+
+// pose_t.FLAG_*: kept here as numbers so this file needs no LCM header.
+constexpr std::int32_t kFlagValid = 1;
+constexpr std::int32_t kFlagDegenerate = 2;
+constexpr std::int32_t kFlagHeld = 4;
+
+std::string utc_id() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  return fmt::format("{:04}{:02}{:02}T{:02}{:02}{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour,
+                     utc.tm_min, utc.tm_sec);
+}
+
+protocol::TileParams tile_params_of(const config::MapSection& m) {
+  protocol::TileParams p;
+  p.tile_size_m = m.tile_size_m;
+  return p;
+}
+
+std::vector<protocol::MapPoint> map_points_of(std::span<const slam::MapSample> samples) {
+  std::vector<protocol::MapPoint> out;
+  out.reserve(samples.size());
+  for (const slam::MapSample& s : samples)
+    out.push_back({s.position.x(), s.position.y(), s.position.z(), s.intensity, s.time_s});
+  return out;
+}
+
+void write_tum_line(std::FILE* f, std::int64_t stamp_ns, const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d& t = pose.translation();
+  fmt::print(f, "{:.9f} {:.6f} {:.6f} {:.6f} {:.9f} {:.9f} {:.9f} {:.9f}\n", 1e-9 * static_cast<double>(stamp_ns), t.x(),
+             t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+}
+
+std::int64_t disk_free_bytes(const std::filesystem::path& dir) {
+  struct statvfs s {};
+  if (statvfs(dir.c_str(), &s) != 0) return -1;
+  return static_cast<std::int64_t>(s.f_bavail) * static_cast<std::int64_t>(s.f_frsize);
+}
+
+}  // namespace
+
+PoseSample pose_sample_of(const slam::OdometryResult& r) {
+  PoseSample p;
+  p.utime = r.stamp_ns / 1000;
+  const Eigen::Vector3d& t = r.pose.translation();
+  p.position = {t.x(), t.y(), t.z()};
+  const Eigen::Quaterniond q(r.pose.linear());
+  p.orientation = {q.w(), q.x(), q.y(), q.z()};
+  // Row-major; the odometry's tangent order [v; ω] is (x, y, z, roll, pitch,
+  // yaw) to first order, which is what pose_t documents.
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) p.covariance[static_cast<std::size_t>(6 * i + j)] = r.covariance(i, j);
+  p.flags = (r.valid ? kFlagValid : 0) | (r.status == slam::OdometryStatus::degenerate ? kFlagDegenerate : 0) |
+            (r.status == slam::OdometryStatus::too_few_points ? kFlagHeld : 0);
+  return p;
+}
+
+Sessions::Sessions(const config::Config& config, Outputs outputs)
+    : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {}
+
+Sessions::~Sessions() { stop_and_wait(); }
+
+std::string Sessions::start() {
+  const std::lock_guard lock(mutex_);
+  try {
+    return start_locked();
+  } catch (...) {
+    start_failure_ = std::current_exception();
+    throw;
+  }
+}
+
+std::exception_ptr Sessions::take_start_failure() {
+  const std::lock_guard lock(mutex_);
+  return std::exchange(start_failure_, nullptr);
+}
+
+std::string Sessions::start_locked() {
+  if (pipeline_ || finishing_) throw std::runtime_error("a session is still running or being written");
+  std::string id = utc_id();
+  for (int n = 2; std::filesystem::exists(root_ / id); ++n) id = fmt::format("{}-{}", utc_id(), n);
+  const std::filesystem::path dir = root_ / id;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string(), "payload.state_dir", "cannot create the session folder: " + ec.message());
+
+  PipelineOptions options;
+  options.trajectory_file = dir / "trajectory.tum";
+  if (config_.session.record_lidar) options.record_file = dir / "lidar.pcap";
+  if (outputs_.pose) {
+    options.sinks.pose = [pose = outputs_.pose](const slam::OdometryResult& r) { pose(pose_sample_of(r)); };
+  }
+  if (outputs_.tile) {
+    options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
+      tile(TileUpdate{protocol::now_utime(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
+    };
+  }
+  std::unique_ptr<Pipeline> pipeline;
+  try {
+    pipeline = std::make_unique<Pipeline>(config_, options);
+  } catch (...) {
+    std::filesystem::remove_all(dir, ec);  // nothing was recorded: leave no empty session behind
+    throw;
+  }
+  pipeline->start();
+  for (std::string& w : pipeline->warnings()) warnings_.push_back(std::move(w));
+  {
+    std::ofstream(dir / "config.yaml") << config::to_yaml(config_);
+  }
+  pipeline_ = std::move(pipeline);
+  id_ = id;
+  dir_ = dir;
+  stop_requested_ = false;
+  last_sample_ns_ = 0;
+  log::info("session {}: mapping, files in {}", id, dir.string());
+  return id;
+}
+
+void Sessions::request_stop() { stop_requested_ = true; }
+
+bool Sessions::poll() {
+  const std::lock_guard lock(mutex_);
+  if (finisher_.joinable() && !finishing_) finisher_.join();
+  if (!pipeline_ || finisher_.joinable()) return false;
+  if (stop_requested_) {
+    pipeline_->end_source();
+    finishing_ = true;
+    finisher_ = std::thread([this, p = std::move(pipeline_), id = id_, dir = dir_]() mutable {
+      finish(std::move(p), std::move(id), std::move(dir));
+    });
+    return false;
+  }
+  return pipeline_->drained();  // a replay ran out: the caller asks for the stop
+}
+
+void Sessions::stop_and_wait() {
+  request_stop();
+  while (true) {
+    poll();
+    {
+      const std::lock_guard lock(mutex_);
+      if (!pipeline_ && !finishing_) {
+        if (finisher_.joinable()) finisher_.join();
+        return;
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::filesystem::path dir) {
+  pipeline->join();  // end_source() was called: every stage drains first
+  const PipelineStats& s = pipeline->stats();
+  const PipelineTimings& t = pipeline->timings();
+  const slam::TiledVoxelMap& map = pipeline->map();
+  nlohmann::json files = nlohmann::json::array({"trajectory.tum", "config.yaml"});
+  try {
+    // The map files, from the tiles.
+    std::vector<protocol::MapPoint> all;
+    all.reserve(map.size());
+    const protocol::TileParams params = tile_params_of(config_.map);
+    std::filesystem::create_directories(dir / "tiles");
+    for (const slam::TileCoord& c : map.tile_coords()) {
+      const std::vector<protocol::MapPoint> points = map_points_of(map.tile(c));
+      const protocol::TileKey key{c.x, c.y, c.z};
+      const std::vector<std::uint8_t> blob = protocol::encode_tile(key, points, params);
+      std::ofstream(dir / "tiles" / fmt::format("{}.adt", protocol::tile_id(key)), std::ios::binary)
+          .write(reinterpret_cast<const char*>(blob.data()), static_cast<std::streamsize>(blob.size()));
+      all.insert(all.end(), points.begin(), points.end());
+    }
+    files.push_back("tiles/");
+    for (const std::string& name : config_.session.exports) {
+      const std::filesystem::path file = dir / ("map." + name);
+      protocol::write_map(file, *protocol::parse_map_format(name), all);
+      files.push_back(file.filename().string());
+    }
+    if (std::FILE* f = std::fopen((dir / "keyframes.tum").c_str(), "w")) {
+      for (const slam::Keyframe& k : pipeline->keyframes()) write_tum_line(f, k.stamp_ns, k.pose);
+      std::fclose(f);
+      files.push_back("keyframes.tum");
+    }
+    if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
+    const nlohmann::json summary = {
+        {"session", id},
+        {"lidar", {{"model", config_.lidar.model}, {"datagrams", s.datagrams.load()},
+                   {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
+                   {"recorded_datagrams", s.recorded_datagrams.load()}}},
+        {"scans", {{"total", s.scans.load()}, {"incomplete", s.incomplete_scans.load()},
+                   {"dropped", s.dropped_scans.load()}}},
+        {"poses", {{"total", s.poses.load()}, {"invalid", s.invalid_poses.load()},
+                   {"degenerate", s.degenerate_poses.load()}}},
+        {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
+                 {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
+                 {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()}}},
+        {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},
+                    {"odometry_ms_p99", quantile(t.odometry_ms, 0.99)},
+                    {"latency_ms_p99", quantile(t.latency_ms, 0.99)},
+                    {"sensor_span_s", t.sensor_span_s}, {"duration_s", t.duration_s}}},
+        {"files", files}};
+    std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
+    log::info("session {}: stopped; {} poses, {} map points in {} tiles; files in {}", id, s.poses.load(), map.size(),
+              map.tile_count(), dir.string());
+  } catch (const std::exception& e) {
+    // The trajectory is on disk already; say what is missing and carry on.
+    log::error("session {}: writing its files failed: {}", id, e.what());
+  }
+  pipeline.reset();
+  if (outputs_.ended) outputs_.ended(id);
+  finishing_ = false;
+}
+
+bool Sessions::running() const {
+  const std::lock_guard lock(mutex_);
+  return pipeline_ != nullptr || finishing_;
+}
+
+std::vector<std::string> Sessions::list() const {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(root_, ec))
+    if (entry.is_directory()) out.push_back(entry.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::filesystem::path Sessions::folder(const std::string& id) const { return root_ / id; }
+
+StatusSample Sessions::status_sample() {
+  StatusSample sample;
+  sample.utime = protocol::now_utime();
+  sample.disk_free_bytes = disk_free_bytes(std::filesystem::exists(root_) ? root_ : std::filesystem::path(config_.payload.state_dir));
+  const std::lock_guard lock(mutex_);
+  if (!pipeline_) return sample;
+  const PipelineStats& s = pipeline_->stats();
+  const std::int64_t now = monotonic_ns();
+  const double dt = last_sample_ns_ == 0 ? 0.0 : 1e-9 * static_cast<double>(now - last_sample_ns_);
+  const std::uint64_t datagrams = s.datagrams.load();
+  SensorHealth lidar;
+  lidar.name = "lidar " + config_.lidar.model;
+  lidar.packet_rate_hz = dt > 0 ? static_cast<float>(static_cast<double>(datagrams - last_datagrams_) / dt) : 0.0F;
+  lidar.packets_dropped = static_cast<std::int64_t>(s.dropped_packets.load() + s.bad_packets.load());
+  lidar.last_seen_utime = s.last_packet_realtime_ns.load() / 1000;
+  sample.sensors.push_back(lidar);
+  const std::vector<StageLoad> loads = pipeline_->loads();
+  last_cpu_s_.resize(loads.size(), 0.0);
+  for (std::size_t i = 0; i < loads.size(); ++i) {
+    const double load = dt > 0 ? (loads[i].cpu_s - last_cpu_s_[i]) / dt : 0.0;
+    last_cpu_s_[i] = loads[i].cpu_s;
+    sample.threads.push_back({loads[i].name, static_cast<float>(load), static_cast<std::int32_t>(loads[i].queue_depth),
+                              static_cast<std::int32_t>(loads[i].queue_capacity)});
+  }
+  last_sample_ns_ = now;
+  last_datagrams_ = datagrams;
+  if (pipeline_->drained()) sample.fault = "the recording has ended";
+  else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
+    sample.fault = fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
+                               s.dropped_scans.load());
+  return sample;
+}
+
+std::vector<const Heartbeat*> Sessions::heartbeats() const {
+  const std::lock_guard lock(mutex_);
+  return pipeline_ ? pipeline_->heartbeats() : std::vector<const Heartbeat*>{};
+}
+
+std::vector<std::string> Sessions::take_warnings() {
+  const std::lock_guard lock(mutex_);
+  return std::exchange(warnings_, {});
+}
+
+}  // namespace adit::daemon
