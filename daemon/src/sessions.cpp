@@ -134,6 +134,7 @@ std::string Sessions::start_locked() {
   id_ = id;
   dir_ = dir;
   stop_requested_ = false;
+  end_reported_ = false;
   last_sample_ns_ = 0;
   log::info("session {}: mapping, files in {}", id, dir.string());
   return id;
@@ -153,7 +154,9 @@ bool Sessions::poll() {
     });
     return false;
   }
-  return pipeline_->drained();  // a replay ran out: the caller asks for the stop
+  if (end_reported_ || !pipeline_->drained()) return false;
+  end_reported_ = true;  // a replay ran out: the caller asks for the stop, once
+  return true;
 }
 
 void Sessions::stop_and_wait() {

@@ -86,6 +86,7 @@ class Sessions {
   std::string id_;
   std::filesystem::path dir_;
   std::atomic<bool> stop_requested_{false};
+  bool end_reported_ = false;  // poll() said the source ended (once per session)
   std::thread finisher_;
   std::atomic<bool> finishing_{false};
   std::vector<std::string> warnings_;
