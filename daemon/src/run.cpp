@@ -4,12 +4,14 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/daemon/payload_panel.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "adit/daemon/supervisor.hpp"
 
@@ -40,6 +42,16 @@ std::string status_line(protocol::SessionState state, const StatusSample& s, con
   line += fmt::format("; poses {} published", c.poses_published.load());
   if (!s.fault.empty()) line += "; " + s.fault;
   return line;
+}
+
+drivers::gpio::PayloadState panel_state(protocol::SessionState state, bool fault) {
+  if (fault) return drivers::gpio::PayloadState::fault;
+  switch (state) {
+    case protocol::SessionState::idle: return drivers::gpio::PayloadState::idle;
+    case protocol::SessionState::mapping: return drivers::gpio::PayloadState::mapping;
+    case protocol::SessionState::stopping: return drivers::gpio::PayloadState::starting;  // steady: busy writing
+  }
+  return drivers::gpio::PayloadState::fault;
 }
 
 }  // namespace
@@ -84,6 +96,16 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   endpoint_ptr = endpoint.get();
   log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);
 
+  // The button, LED and LiDAR power, when the payload has them.
+  PayloadGpio gpio;
+  std::optional<PayloadPanel> panel;
+  if (config.gpio.enabled) {
+    gpio = open_payload_gpio(config.gpio);
+    panel.emplace(*gpio.button, *gpio.led, *gpio.power, std::chrono::milliseconds(config.gpio.debounce_ms),
+                  std::chrono::nanoseconds(monotonic_ns()));
+    log::info("GPIO: button, status LED and LiDAR power on {}", config.gpio.chip);
+  }
+
   if (options.once || config.session.autostart) endpoint->start_session();
 
   const auto watchdog_ns = systemd_watchdog_ns();
@@ -118,6 +140,10 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     if (options.once && seen_session && !running) break;
 
     const std::int64_t now = monotonic_ns();
+    if (panel && panel->tick(std::chrono::nanoseconds(now), panel_state(endpoint->state(), reported_stall))) {
+      log::info("button pressed");
+      endpoint->button_pressed();
+    }
     if (now - last_status_ns >= status_ns) {
       last_status_ns = now;
       StatusSample status = sessions.status_sample();
@@ -142,6 +168,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   notify_stopping();
   sessions.stop_and_wait();  // the running session's files are written before we go
   endpoint.reset();
+  if (panel) panel->shutdown(std::chrono::nanoseconds(monotonic_ns()));
   return kExitOk;
 }
 

@@ -1,0 +1,206 @@
+// aditd end to end, as a crew uses it: aditd replays a simulated mine session
+// in real time; `adit start` starts mapping, poses arrive over real LCM UDP
+// multicast on loopback at scan rate, `adit stop` stops it, `adit download`
+// fetches the map as PLY, PCD and LAS, and `adit eval map` measures the
+// downloaded points against the simulation's true scene surfaces.
+
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <fcntl.h>
+#include <fstream>
+#include <regex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "adit/pose_t.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
+#include "map_readers.hpp"
+#include "pcl_load.hpp"
+#include "run_program.hpp"
+#include "shared_data.hpp"
+
+namespace adit::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A child process with its output in a log file, stopped with SIGTERM.
+class Daemon {
+ public:
+  Daemon(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, STDOUT_FILENO);
+      ::dup2(fd, STDERR_FILENO);
+      std::vector<char*> args;
+      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+      args.push_back(nullptr);
+      ::execv(args[0], args.data());
+      ::_exit(127);
+    }
+  }
+  ~Daemon() {
+    if (pid_ > 0) stop();
+  }
+  // SIGTERM, then the exit status (-1 if it did not exit within 30 s).
+  int stop() {
+    ::kill(pid_, SIGTERM);
+    int status = 0;
+    for (int i = 0; i < 300; ++i) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(100ms);
+    }
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+// Counts pose_t messages of one payload on its own LCM socket.
+class PoseCounter {
+ public:
+  PoseCounter(const std::string& url, const std::string& payload) : lcm_(url) {
+    lcm_.subscribe(protocol::channel_name(payload, protocol::Channel::pose), &PoseCounter::on_pose, this);
+    thread_ = std::thread([this] {
+      while (running_) lcm_.handleTimeout(50);
+    });
+  }
+  ~PoseCounter() {
+    running_ = false;
+    thread_.join();
+  }
+  std::size_t count() const { return count_; }
+  std::size_t valid() const { return valid_; }
+
+ private:
+  void on_pose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    pose_t pose;
+    if (!protocol::checked_decode(rbuf->data, rbuf->data_size, pose)) return;
+    ++count_;
+    if (pose.flags & pose_t::FLAG_VALID) ++valid_;
+  }
+  lcm::LCM lcm_;
+  std::atomic<bool> running_{true};
+  std::atomic<std::size_t> count_{0};
+  std::atomic<std::size_t> valid_{0};
+  std::thread thread_;
+};
+
+// A 12 s simulated drive through the mine, generated once per build tree.
+std::filesystem::path simulated_session() {
+  const std::filesystem::path dir = binary_dir() / "e2e-session";
+  if (!std::filesystem::exists(dir / "lidar.pcap")) {
+    const CommandRun sim = run_adit(fmt::format(
+        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
+    EXPECT_EQ(sim.status, 0) << sim.output;
+  }
+  return dir;
+}
+
+TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces) {
+  const std::filesystem::path session = simulated_session();
+  ASSERT_TRUE(std::filesystem::exists(session / "lidar.pcap"));
+  const std::filesystem::path work = binary_dir() / fmt::format("e2e-{}", ::getpid());
+  std::filesystem::remove_all(work);
+  std::filesystem::create_directories(work);
+  const std::string payload = fmt::format("e2e{}", ::getpid());
+  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 7) % 30000);
+  const std::filesystem::path config = work / "aditd.yaml";
+  std::ofstream(config) << fmt::format(
+      "payload:\n  id: {}\n  state_dir: {}\n"
+      "lidar:\n  model: VLP-16\n  source: pcap\n  pcap: {}\n  calibration: {}\n  replay_speed: 1.0\n"
+      "  min_range_m: 0.5\n  extrinsics:\n    xyz_m: [0.2, 0.0, 0.45]\n"
+      "session:\n  exports: [ply, pcd, las]\n"
+      "lcm:\n  url: {}\nthreads:\n  lock_memory: false\n",
+      payload, (work / "state").string(), (session / "lidar.pcap").string(), (session / "VLP16.yaml").string(), url);
+
+  Daemon aditd({(binary_dir() / "bin/aditd").string(), "--config", config.string()}, work / "aditd.log");
+  const std::string client = fmt::format("--payload {} --lcm-url '{}' --timeout 5", payload, url);
+  const CommandRun ping = run_adit("ping " + client);
+  ASSERT_EQ(ping.status, 0) << ping.output;
+
+  PoseCounter poses(url, payload);
+  const CommandRun start = run_adit("start " + client);
+  ASSERT_EQ(start.status, 0) << start.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(start.output, m, std::regex("session ([0-9TZ-]+)"))) << start.output;
+  const std::string id = m[1];
+
+  // Poses at scan rate (10 Hz) while the recording plays.
+  std::this_thread::sleep_for(1s);
+  const std::size_t before = poses.count();
+  std::this_thread::sleep_for(4s);
+  const double rate = static_cast<double>(poses.count() - before) / 4.0;
+  EXPECT_GE(rate, 8.0);
+  EXPECT_LE(rate, 12.0);
+  EXPECT_EQ(poses.valid(), poses.count());
+
+  const CommandRun stop = run_adit("stop " + client);
+  ASSERT_EQ(stop.status, 0) << stop.output;
+  // STOPPING until the session's files are written, then IDLE.
+  bool idle = false;
+  for (int i = 0; i < 60 && !idle; ++i) {
+    idle = run_adit("status " + client).output.find("state     IDLE") != std::string::npos;
+    if (!idle) std::this_thread::sleep_for(250ms);
+  }
+  ASSERT_TRUE(idle);
+
+  const std::filesystem::path folder = work / "state/sessions" / id;
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(folder / "summary.json"));
+  const std::size_t map_points = summary["map"]["points"];
+  ASSERT_GT(map_points, 10'000U);
+
+  for (const std::string format : {"ply", "pcd", "las"}) {
+    const std::filesystem::path out = work / ("download." + format);
+    const CommandRun download =
+        run_adit(fmt::format("download {} --format {} --out {} --quiet", client, format, out.string()));
+    ASSERT_EQ(download.status, 0) << download.output;
+    // The whole map, as the session folder holds it.
+    EXPECT_NE(download.output.find(fmt::format("{} points", map_points)), std::string::npos) << download.output;
+  }
+  EXPECT_EQ(read_las_checked(work / "download.las").size(), map_points);
+  if (have_pcl()) {
+    for (const std::string file : {"download.ply", "download.pcd"}) {
+      std::string error;
+      const auto loaded = pcl_point_count(work / file, error);
+      ASSERT_TRUE(loaded.has_value()) << error;
+      EXPECT_EQ(*loaded, map_points) << file;
+    }
+  } else {
+    ADD_FAILURE() << "PCL is not installed (scripts/install-deps.sh installs it): PLY/PCD not loaded in PCL";
+  }
+
+  // The downloaded map against the true scene, placed by the true pose at the first scan.
+  const CommandRun eval = run_adit(fmt::format(
+      "eval map --map {} --scene {} --ref {} --est {} --within 0.05 --json", (work / "download.ply").string(),
+      (session / "scene.ply").string(), (session / "truth_body.tum").string(),
+      (folder / "trajectory.tum").string()));
+  ASSERT_EQ(eval.status, 0) << eval.output;
+  const nlohmann::json accuracy = nlohmann::json::parse(eval.output.substr(eval.output.find('{')));
+  EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.95) << accuracy.dump();
+  RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
+
+  EXPECT_EQ(aditd.stop(), 0);
+  std::filesystem::remove_all(work);
+}
+
+}  // namespace
+}  // namespace adit::test
