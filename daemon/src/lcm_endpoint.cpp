@@ -33,8 +33,10 @@ using protocol::Channel;
 
 using protocol::now_utime;
 
-TilePublisherOptions publisher_options(const EndpointOptions& o) {
-  return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed};
+TilePublisherOptions publisher_options(const EndpointOptions& o,
+                                       std::function<std::string(const std::string&, TileStore&)> load) {
+  return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed,
+          std::move(load)};
 }
 
 }  // namespace
@@ -70,7 +72,11 @@ struct LcmEndpoint::Impl final : TileSink {
         statuses(options.queue_capacity),
         tiles(options.queue_capacity),
         gate(options.payload_id, options.command_window),
-        publisher(publisher_options(options), *this) {
+        publisher(publisher_options(options,
+                                    [this](const std::string& session, TileStore& into) {
+                                      return load_stored(session, into);
+                                    }),
+                  *this) {
     if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
       throw InputError("payload id", "payload_id", problem);
     if (const std::string problem = protocol::tile_params_problem(options.tiles); !problem.empty())
@@ -277,6 +283,13 @@ struct LcmEndpoint::Impl final : TileSink {
   }
 
   // --- tiles ----------------------------------------------------------------
+
+  std::string load_stored(const std::string& session, TileStore& into) {
+    if (machine.state() != protocol::SessionState::idle)
+      return fmt::format("mapping session '{}' is running: download other sessions after STOP", session_id);
+    if (!hooks.load_tiles) return fmt::format("session '{}' is not held by this daemon", session);
+    return hooks.load_tiles(session, into);
+  }
 
   void on_tile_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
     tile_request_t r;

@@ -92,6 +92,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     if (files.empty()) throw std::runtime_error("session '" + id + "' has no map files yet");
     return files;
   };
+  hooks.load_tiles = [&sessions](const std::string& id, TileStore& into) { return sessions.load_tiles(id, into); };
   auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));
   endpoint_ptr = endpoint.get();
   log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);

@@ -3,6 +3,9 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <iterator>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -250,6 +253,29 @@ std::vector<std::string> Sessions::list() const {
 }
 
 std::filesystem::path Sessions::folder(const std::string& id) const { return root_ / id; }
+
+std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
+  const bool plain = !id.empty() && id.size() <= 64 && id.front() != '.' &&
+                     std::all_of(id.begin(), id.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'; });
+  if (!plain) return fmt::format("'{}' is not a session name", id);
+  const std::filesystem::path tiles = folder(id) / "tiles";
+  std::error_code ec;
+  if (!std::filesystem::is_directory(tiles, ec)) return fmt::format("no stored tiles for session '{}'", id);
+  std::size_t bad = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(tiles, ec)) {
+    if (entry.path().extension() != ".adt") continue;
+    std::int64_t tile_id = 0;
+    const std::string stem = entry.path().stem().string();
+    const auto [end, err] = std::from_chars(stem.data(), stem.data() + stem.size(), tile_id);
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::vector<std::uint8_t> blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (err != std::errc{} || end != stem.data() + stem.size() ||
+        !into.insert_encoded(tile_id, std::move(blob), protocol::now_utime()))
+      ++bad;
+  }
+  if (bad > 0) log::warn("session {}: {} stored tile files are unreadable and were skipped", id, bad);
+  return "";
+}
 
 StatusSample Sessions::status_sample() {
   StatusSample sample;

@@ -40,10 +40,21 @@ void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapP
 
 void TilePublisher::answer(const tile_request_t& request) {
   if (!request.session_id.empty() && request.session_id != session_id_) {
-    // Only the current (or last) session's tiles are held in memory.
-    send_index({}, true, request.request_id,
-               fmt::format("session '{}' is not held by this daemon (it holds '{}')", request.session_id, session_id_));
-    return;
+    // The current (or last) session's tiles are in memory; others come from disk.
+    std::string problem = fmt::format("session '{}' is not held by this daemon (it holds '{}')", request.session_id,
+                                      session_id_);
+    if (options_.load_session) {
+      TileStore loaded(options_.tiles);
+      problem = options_.load_session(request.session_id, loaded);
+      if (problem.empty()) {
+        reset(request.session_id);
+        store_ = std::move(loaded);
+      }
+    }
+    if (!problem.empty()) {
+      send_index({}, true, request.request_id, problem);
+      return;
+    }
   }
   if (request.want_index) {
     std::vector<const EncodedTile*> all;

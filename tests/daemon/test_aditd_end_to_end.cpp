@@ -199,6 +199,22 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
 
   EXPECT_EQ(aditd.stop(), 0);
+
+  // A stored session, after a restart: served from its folder's tiles.
+  {
+    Daemon restarted({(binary_dir() / "bin/aditd").string(), "--config", config.string()}, work / "aditd2.log");
+    ASSERT_EQ(run_adit("ping " + client).status, 0);
+    const CommandRun stored = run_adit(fmt::format("download {} --session {} --format ply --out {} --quiet", client, id,
+                                                   (work / "stored.ply").string()));
+    ASSERT_EQ(stored.status, 0) << stored.output;
+    EXPECT_NE(stored.output.find(fmt::format("{} points", map_points)), std::string::npos) << stored.output;
+    const CommandRun unknown = run_adit(fmt::format("download {} --session 19700101T000000Z --format ply --out {} --quiet",
+                                                    client, (work / "none.ply").string()));
+    EXPECT_NE(unknown.status, 0);
+    EXPECT_NE(unknown.output.find("no stored tiles for session '19700101T000000Z'"), std::string::npos)
+        << unknown.output;
+    EXPECT_EQ(restarted.stop(), 0);
+  }
   std::filesystem::remove_all(work);
 }
 

@@ -31,7 +31,7 @@ std::vector<protocol::MapPoint> random_points(std::size_t n, unsigned seed) {
 struct TilePublisherTest : ::testing::Test {
   RecordingSink sink;
   Clock::time_point t0 = Clock::now();
-  TilePublisher publisher{{"rig1", {}, 1.0, 4.0e6, 0.0, 1}, sink};
+  TilePublisher publisher{{"rig1", {}, 1.0, 4.0e6, 0.0, 1, {}}, sink};
   // Ticks for `seconds` in 10 ms steps, sending everything that is queued.
   void run_for(Clock::time_point& now, double seconds) {
     for (int i = 0; i < static_cast<int>(seconds * 100); ++i) publisher.tick(now += 10ms);
@@ -114,7 +114,7 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
 
 TEST_F(TilePublisherTest, ChunksArePaced) {
   RecordingSink paced_sink;
-  TilePublisher paced({"rig1", {}, 1.0, 96000.0, 0.0, 1}, paced_sink);  // two chunks per second
+  TilePublisher paced({"rig1", {}, 1.0, 96000.0, 0.0, 1, {}}, paced_sink);  // two chunks per second
   paced.reset("s1");
   paced.update({0, 0, 0}, random_points(60000, 5), 1);  // ~480 kB: 10 chunks
   Clock::time_point now = t0;
@@ -123,6 +123,47 @@ TEST_F(TilePublisherTest, ChunksArePaced) {
   for (int i = 0; i < 20; ++i) paced.tick(now += 100ms);
   EXPECT_GE(paced_sink.chunks.size(), 5u);
   EXPECT_LE(paced_sink.chunks.size(), 6u);  // 2 + 2 s x 2 chunks/s
+}
+
+}  // namespace
+}  // namespace adit::daemon
+
+namespace adit::daemon {
+namespace {
+
+TEST(TilePublisherStored, AnotherSessionIsServedFromTheLoaderOrRefusedWithItsReason) {
+  RecordingSink sink;
+  const std::vector<std::uint8_t> blob = protocol::encode_tile({0, 0, 0}, random_points(500, 9), {});
+  std::vector<std::string> asked;
+  TilePublisherOptions options{"rig1", {}, 1.0, 4.0e6, 0.0, 1, {}};
+  options.load_session = [&](const std::string& session, TileStore& into) -> std::string {
+    asked.push_back(session);
+    if (session != "old") return "no stored tiles for session '" + session + "'";
+    EXPECT_TRUE(into.insert_encoded(protocol::tile_id({0, 0, 0}), blob, 1));
+    EXPECT_FALSE(into.insert_encoded(protocol::tile_id({1, 0, 0}), {1, 2, 3}, 1));  // not a tile
+    return "";
+  };
+  TilePublisher publisher(options, sink);
+  publisher.reset("current");
+
+  tile_request_t r{};
+  r.request_id = 5;
+  r.session_id = "nope";
+  r.want_index = true;
+  publisher.answer(r);
+  ASSERT_EQ(sink.indexes.size(), 1u);
+  EXPECT_EQ(sink.indexes[0].error, "no stored tiles for session 'nope'");
+  EXPECT_EQ(publisher.session_id(), "current");
+
+  r.session_id = "old";
+  publisher.answer(r);
+  ASSERT_EQ(sink.indexes.size(), 2u);
+  EXPECT_EQ(sink.indexes[1].error, "");
+  EXPECT_EQ(sink.indexes[1].session_id, "old");
+  EXPECT_EQ(sink.indexes[1].n_tiles, 1);
+  EXPECT_EQ(publisher.session_id(), "old");
+  EXPECT_EQ(publisher.store().total_points(), 500);
+  EXPECT_EQ(asked, (std::vector<std::string>{"nope", "old"}));
 }
 
 }  // namespace

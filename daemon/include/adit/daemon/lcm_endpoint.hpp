@@ -16,6 +16,7 @@
 #include "adit/protocol/map_point.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "adit/protocol/tile_codec.hpp"
+#include "adit/daemon/tile_store.hpp"
 
 namespace adit::daemon {
 
@@ -67,6 +68,9 @@ struct SessionHooks {
   std::function<std::vector<std::string>()> sessions;  // ids of sessions on disk
   // EXPORT: writes the exports of the session, returns what was written.
   std::function<std::string(const std::string& session, const std::vector<std::string>& args)> export_map;
+  // A download of a stored session (not the one in memory): fills `into`
+  // from its folder; returns "" or why not. Called only while IDLE.
+  std::function<std::string(const std::string& session, TileStore& into)> load_tiles;
 };
 
 struct EndpointOptions {

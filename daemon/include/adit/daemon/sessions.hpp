@@ -66,6 +66,9 @@ class Sessions {
   bool running() const;  // a pipeline exists (mapping or being finished)
   std::vector<std::string> list() const;  // sessions on disk, oldest first
   std::filesystem::path folder(const std::string& id) const;
+  // Fills `into` with a stored session's tiles (tiles/*.adt); "" or why not.
+  // `id` comes from the network: only a plain session name is accepted.
+  std::string load_tiles(const std::string& id, TileStore& into) const;
   // What the status message says about the running session (empty when idle).
   StatusSample status_sample();
   // Heartbeats of the running session's threads (empty when idle).

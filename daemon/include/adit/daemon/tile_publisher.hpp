@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <random>
 #include <set>
 #include <span>
@@ -34,6 +35,10 @@ struct TilePublisherOptions {
   double bytes_per_s = 4.0e6;   // chunk pacing
   double drop_fraction = 0;     // test hook: chunks silently not sent
   std::uint32_t drop_seed = 1;
+  // Fills `into` with a stored session's tiles when a client asks for a
+  // session other than the one held; returns "" or why it cannot (unknown
+  // session, busy mapping). Empty: only the held session is served.
+  std::function<std::string(const std::string& session, TileStore& into)> load_session;
 };
 
 struct TilePublisherCounts {

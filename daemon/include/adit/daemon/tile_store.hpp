@@ -27,6 +27,9 @@ class TileStore {
 
   // Replaces the content of tile `key`; returns the new version.
   const EncodedTile& update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
+  // Adds a tile encoded earlier (a stored session's tiles/<id>.adt), as version 1.
+  // False, and nothing added, when the blob's header is not a tile's.
+  bool insert_encoded(std::int64_t id, std::vector<std::uint8_t> blob, std::int64_t utime);
   const EncodedTile* find(std::int64_t id) const;
   const std::map<std::int64_t, EncodedTile>& tiles() const { return tiles_; }
   const protocol::TileParams& params() const { return params_; }
