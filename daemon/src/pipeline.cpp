@@ -163,20 +163,24 @@ struct Pipeline::Impl {
       keyframe_points.reserve(max_points);
       keyframe_downsampler.emplace(max_points);
     }
-    if (!options.record_file.empty()) {
-      if (c.lidar.source != config::LidarSource::udp && !pcap)
-        throw InputError(options.record_file.string(), "session.record_lidar", "only packet sources can be recorded");
-      std::filesystem::create_directories(options.record_file.parent_path());
-      recorder.emplace(options.record_file);
-    }
     body_points.reserve(options.odometry.max_scan_points);
     body_times.reserve(options.odometry.max_scan_points);
     timings.odometry_ms.reserve(kTimingCapacity);
     timings.latency_ms.reserve(kTimingCapacity);
-    if (!options.trajectory_file.empty()) {
-      std::filesystem::create_directories(options.trajectory_file.parent_path());
-      trajectory.reset(std::fopen(options.trajectory_file.c_str(), "w"));
-      if (!trajectory) throw InputError(options.trajectory_file.string(), "", "cannot write the trajectory");
+    open_files(options.trajectory_file, options.record_file);
+  }
+
+  void open_files(const std::filesystem::path& trajectory_file, const std::filesystem::path& record_file) {
+    if (!record_file.empty()) {
+      if (!udp && !pcap)
+        throw InputError(record_file.string(), "session.record_lidar", "only packet sources can be recorded");
+      std::filesystem::create_directories(record_file.parent_path());
+      recorder.emplace(record_file);
+    }
+    if (!trajectory_file.empty()) {
+      std::filesystem::create_directories(trajectory_file.parent_path());
+      trajectory.reset(std::fopen(trajectory_file.c_str(), "w"));
+      if (!trajectory) throw InputError(trajectory_file.string(), "", "cannot write the trajectory");
     }
   }
 
@@ -233,6 +237,10 @@ struct Pipeline::Impl {
         push(d.payload, d.capture_time_ns, d.src_ip, d.src_port);
       }
     } else {
+      // A pipeline built ahead of its session (Sessions keeps one ready) finds
+      // old packets in the socket's buffer: they belong to no session.
+      for (auto batch = udp->receive(0); !batch.empty(); batch = udp->receive(0))
+        stats.stale_datagrams.fetch_add(batch.size(), std::memory_order_relaxed);
       while (!stop.load(std::memory_order_relaxed) && !source_stop.load(std::memory_order_relaxed)) {
         receiver_beat.beat();
         for (const drivers::ReceivedDatagram& d : udp->receive(100)) {
@@ -521,8 +529,10 @@ Pipeline::~Pipeline() {
   join();
 }
 
-void Pipeline::start() {
+void Pipeline::start(const SessionFiles& files) {
   Impl& i = *impl_;
+  if (!i.threads.empty()) throw std::logic_error("Pipeline::start called twice");
+  i.open_files(files.trajectory_file, files.record_file);
   if (i.config.threads.lock_memory) {
     auto w = lock_memory();
     i.warnings.insert(i.warnings.end(), w.begin(), w.end());

@@ -2,6 +2,7 @@
 
 #include <signal.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -71,15 +72,35 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   // Sessions hand poses and tiles to the endpoint; the endpoint's commands
   // drive the sessions. The endpoint outlives no session: it is reset only
   // after stop_and_wait().
-  LcmEndpoint* endpoint_ptr = nullptr;
+  // Set once the endpoint exists; its thread may take a START a moment before.
+  std::atomic<LcmEndpoint*> endpoint_ptr{nullptr};
   Sessions::Outputs outputs;
-  outputs.pose = [&endpoint_ptr](const PoseSample& p) { endpoint_ptr->publish_pose(p); };
-  outputs.tile = [&endpoint_ptr](TileUpdate&& t) { endpoint_ptr->publish_tile(std::move(t)); };
-  outputs.ended = [&endpoint_ptr](const std::string&) { endpoint_ptr->session_stopped(); };
+  outputs.pose = [&endpoint_ptr](const PoseSample& p) {
+    if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_pose(p);
+  };
+  outputs.tile = [&endpoint_ptr](TileUpdate&& t) {
+    if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_tile(std::move(t));
+  };
+  // The tile stream's bandwidth per session, for the crew's link budget.
+  std::atomic<std::uint64_t> tile_bytes_at_start{0};
+  std::atomic<std::int64_t> session_start_ns{0};
+  outputs.ended = [&](const std::string& id) {
+    const double seconds = 1e-9 * static_cast<double>(monotonic_ns() - session_start_ns.load());
+    LcmEndpoint* e = endpoint_ptr.load();
+    const double bytes = static_cast<double>(e->counters().chunk_bytes_published.load() - tile_bytes_at_start.load());
+    log::info("session {}: tile stream {:.1f} kB/s ({:.1f} MB in {:.0f} s)", id, seconds > 0 ? bytes / seconds / 1e3 : 0.0,
+              bytes / 1e6, seconds);
+    e->session_stopped();
+  };
   Sessions sessions(config, std::move(outputs));
 
   SessionHooks hooks;
-  hooks.start = [&sessions] { return sessions.start(); };
+  hooks.start = [&] {
+    std::string id = sessions.start();
+    if (const LcmEndpoint* e = endpoint_ptr.load()) tile_bytes_at_start = e->counters().chunk_bytes_published.load();
+    session_start_ns = monotonic_ns();
+    return id;
+  };
   hooks.stop = [&sessions] { sessions.request_stop(); };
   hooks.sessions = [&sessions] { return sessions.list(); };
   hooks.export_map = [&sessions, &config](const std::string& id, const std::vector<std::string>&) {
@@ -94,7 +115,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   };
   hooks.load_tiles = [&sessions](const std::string& id, TileStore& into) { return sessions.load_tiles(id, into); };
   auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));
-  endpoint_ptr = endpoint.get();
+  endpoint_ptr.store(endpoint.get());
   log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);
 
   // The button, LED and LiDAR power, when the payload has them.

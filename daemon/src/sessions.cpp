@@ -82,7 +82,22 @@ PoseSample pose_sample_of(const slam::OdometryResult& r) {
 }
 
 Sessions::Sessions(const config::Config& config, Outputs outputs)
-    : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {}
+    : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {
+  standby_ = build_pipeline();
+}
+
+std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
+  PipelineOptions options;
+  if (outputs_.pose) {
+    options.sinks.pose = [pose = outputs_.pose](const slam::OdometryResult& r) { pose(pose_sample_of(r)); };
+  }
+  if (outputs_.tile) {
+    options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
+      tile(TileUpdate{protocol::now_utime(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
+    };
+  }
+  return std::make_unique<Pipeline>(config_, options);
+}
 
 Sessions::~Sessions() { stop_and_wait(); }
 
@@ -110,25 +125,17 @@ std::string Sessions::start_locked() {
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir.string(), "payload.state_dir", "cannot create the session folder: " + ec.message());
 
-  PipelineOptions options;
-  options.trajectory_file = dir / "trajectory.tum";
-  if (config_.session.record_lidar) options.record_file = dir / "lidar.pcap";
-  if (outputs_.pose) {
-    options.sinks.pose = [pose = outputs_.pose](const slam::OdometryResult& r) { pose(pose_sample_of(r)); };
-  }
-  if (outputs_.tile) {
-    options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
-      tile(TileUpdate{protocol::now_utime(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
-    };
-  }
-  std::unique_ptr<Pipeline> pipeline;
+  std::unique_ptr<Pipeline> pipeline = std::move(standby_);
+  SessionFiles files;
+  files.trajectory_file = dir / "trajectory.tum";
+  if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
   try {
-    pipeline = std::make_unique<Pipeline>(config_, options);
+    if (!pipeline) pipeline = build_pipeline();  // the last one could not be built ahead
+    pipeline->start(files);
   } catch (...) {
     std::filesystem::remove_all(dir, ec);  // nothing was recorded: leave no empty session behind
     throw;
   }
-  pipeline->start();
   for (std::string& w : pipeline->warnings()) warnings_.push_back(std::move(w));
   {
     std::ofstream(dir / "config.yaml") << config::to_yaml(config_);
@@ -234,6 +241,17 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     log::error("session {}: writing its files failed: {}", id, e.what());
   }
   pipeline.reset();
+  // The next session's pipeline, built now so that its START is quick.
+  std::unique_ptr<Pipeline> next;
+  try {
+    next = build_pipeline();
+  } catch (const std::exception& e) {
+    log::error("the next session's pipeline cannot be built: {}", e.what());
+  }
+  {
+    const std::lock_guard lock(mutex_);
+    standby_ = std::move(next);
+  }
   if (outputs_.ended) outputs_.ended(id);
   finishing_ = false;
 }

@@ -382,10 +382,19 @@ TEST(LcmEndpoint, AFailingStartHookIsRejectedAndLeavesTheStateIdle) {
 TEST(LcmEndpoint, DownloadOfASessionTheDaemonDoesNotHoldSaysSo) {
   Harness h;
   ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  // While mapping, the live session's tiles stay; another session must wait.
+  const auto busy = h.adit({"download", "--session", "s9", "--format", "ply", "--out", "/nonexistent/x.ply"}, 2);
+  EXPECT_EQ(busy.exit_status, 1);
+  EXPECT_NE(busy.err.find("download failed: mapping session 's1' is running: download other sessions after STOP"),
+            std::string::npos)
+      << busy.err;
+  // Idle, and no stored-session loader (the harness has none).
+  ASSERT_EQ(h.adit({"stop"}).exit_status, 0);
+  h.endpoint->session_stopped();
+  for (int i = 0; i < 100 && h.endpoint->state() != SessionState::idle; ++i) std::this_thread::sleep_for(10ms);
   const auto r = h.adit({"download", "--session", "s9", "--format", "ply", "--out", "/nonexistent/x.ply"}, 2);
   EXPECT_EQ(r.exit_status, 1);
-  EXPECT_NE(r.err.find("download failed: session 's9' is not held by this daemon (it holds 's1')"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("download failed: session 's9' is not held by this daemon"), std::string::npos) << r.err;
 }
 
 TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {

@@ -39,8 +39,8 @@ int run_command(const ClientOptions& options, const std::string& verb, bool prin
   if (print_detail) {
     fmt::print("{}", ack->detail);
   } else {
-    fmt::print("{}: {} (state {}{})\n", verb, ack->reason, state_text(ack->state),
-               ack->session_id.empty() ? "" : ", session " + ack->session_id);
+    fmt::print("{}: {} (state {}{}; answered in {:.0f} ms)\n", verb, ack->reason, state_text(ack->state),
+               ack->session_id.empty() ? "" : ", session " + ack->session_id, client.last_round_trip_ms());
   }
   return kExitOk;
 }

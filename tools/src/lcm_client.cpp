@@ -61,6 +61,8 @@ struct LcmClient::Impl {
   ClientOptions options;
   lcm::LCM lcm;
   std::mt19937_64 rng{std::random_device{}()};
+  Clock::time_point last_send{};
+  double last_round_trip_ms = 0.0;
 
   explicit Impl(ClientOptions o) : options(std::move(o)), lcm(options.lcm_url) {
     if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
@@ -81,6 +83,8 @@ struct LcmClient::Impl {
 LcmClient::LcmClient(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 LcmClient::~LcmClient() = default;
 
+double LcmClient::last_round_trip_ms() const { return impl_->last_round_trip_ms; }
+
 std::optional<command_ack_t> LcmClient::command(const std::string& verb, const std::vector<std::string>& args) {
   command_t c;
   c.schema = 1;
@@ -93,15 +97,18 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   std::optional<command_ack_t> answer;
   const Listen acks(impl_->lcm, impl_->channel(Channel::ack), [&](const lcm::ReceiveBuffer* rbuf) {
     auto ack = decode<command_ack_t>(rbuf);
-    if (ack && ack->request_id == c.request_id) answer = std::move(ack);
+    if (ack && ack->request_id == c.request_id && !answer) {
+      answer = std::move(ack);
+      impl_->last_round_trip_ms = 1e3 * seconds_since(impl_->last_send);
+    }
   });
   const auto start = Clock::now();
-  auto last_send = start - std::chrono::seconds(1);
+  impl_->last_send = start - std::chrono::seconds(1);
   while (!answer && seconds_since(start) < impl_->options.timeout_s) {
-    if (seconds_since(last_send) >= 0.25) {
+    if (seconds_since(impl_->last_send) >= 0.25) {
       c.utime = now_utime();
+      impl_->last_send = Clock::now();
       impl_->lcm.publish(impl_->channel(Channel::command), &c);
-      last_send = Clock::now();
     }
     impl_->handle_for(0.05);
   }

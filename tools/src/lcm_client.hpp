@@ -33,6 +33,9 @@ class LcmClient {
   // Sends `verb` and waits for its ack, resending with the same request id
   // every 250 ms (the daemon answers replays without executing them again).
   std::optional<command_ack_t> command(const std::string& verb, const std::vector<std::string>& args = {});
+  // Milliseconds from the last send of the last command() to its ack (the
+  // daemon's answer time plus the network's; a retry restarts the clock).
+  double last_round_trip_ms() const;
   std::optional<status_t> wait_status();
 
   // Calls `on_pose`/`on_status` for every message until `until` returns true.

@@ -55,6 +55,7 @@ struct PipelineOptions {
 struct PipelineStats {
   std::atomic<std::uint64_t> datagrams{0};         // received from the source
   std::atomic<std::uint64_t> foreign_datagrams{0}; // not on the data port
+  std::atomic<std::uint64_t> stale_datagrams{0};   // udp: in the socket before start(), discarded
   std::atomic<std::uint64_t> dropped_packets{0};   // live: dropped because assembly fell behind
   std::atomic<std::uint64_t> scans{0};
   std::atomic<std::uint64_t> dropped_scans{0};     // live: dropped because odometry fell behind
@@ -91,6 +92,13 @@ struct PipelineTimings {
   double sensor_span_s = 0.0;        // first to last scan stamp
 };
 
+// Files a session's pipeline writes, given at start() so that a pipeline can be
+// built (and its memory allocated) before its session begins.
+struct SessionFiles {
+  std::filesystem::path trajectory_file;  // TUM; empty = none (or PipelineOptions')
+  std::filesystem::path record_file;      // raw packets as pcap; empty = none
+};
+
 class Pipeline {
  public:
   // Opens the source and builds every stage; throws adit::InputError for bad
@@ -100,7 +108,9 @@ class Pipeline {
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
-  void start();
+  // Opens `files` (throws adit::InputError naming one that cannot be written)
+  // and starts the threads. Once per pipeline.
+  void start(const SessionFiles& files = {});
   // Stops at once: queued packets and scans are dropped.
   void request_stop();
   // Stops reading the source; what was read is still processed, so drained()

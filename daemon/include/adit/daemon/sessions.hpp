@@ -45,6 +45,9 @@ class Sessions {
     std::function<void(const std::string& session)> ended;
   };
 
+  // Builds the first session's pipeline at once, so that a START is answered
+  // within milliseconds and a bad source (a missing pcap, a busy port) stops
+  // aditd at launch: throws adit::InputError naming it.
   Sessions(const config::Config& config, Outputs outputs);
   ~Sessions();
   Sessions(const Sessions&) = delete;
@@ -79,6 +82,7 @@ class Sessions {
 
  private:
   std::string start_locked();
+  std::unique_ptr<Pipeline> build_pipeline() const;
   void finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::filesystem::path dir);
 
   config::Config config_;
@@ -86,6 +90,7 @@ class Sessions {
   std::filesystem::path root_;
   mutable std::mutex mutex_;  // control only: start, stop, poll; never a pipeline thread
   std::unique_ptr<Pipeline> pipeline_;
+  std::unique_ptr<Pipeline> standby_;  // built ahead of the next session (allocation takes ~0.2 s)
   std::string id_;
   std::filesystem::path dir_;
   std::atomic<bool> stop_requested_{false};
