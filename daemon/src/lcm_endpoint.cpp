@@ -13,7 +13,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/command_ack_t.hpp"
-#include "adit/daemon/spsc_queue.hpp"
+#include "adit/daemon/handoff.hpp"
 #include "adit/daemon/tile_publisher.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
@@ -33,6 +33,26 @@ using protocol::Channel;
 
 using protocol::now_utime;
 
+// The hand-offs carry items by swapping them with the pool's: the producer
+// gets the slot's old buffers back, so nothing is allocated once warm.
+template <typename T>
+bool hand_over(Handoff<T>& handoff, T& item) {
+  T* slot = handoff.acquire();
+  if (slot == nullptr) return false;  // full: the caller counts the drop
+  std::swap(*slot, item);
+  handoff.publish(slot);
+  return true;
+}
+
+template <typename T>
+bool take_from(Handoff<T>& handoff, T& out) {
+  T* slot = handoff.take();
+  if (slot == nullptr) return false;
+  std::swap(out, *slot);
+  handoff.release(slot);
+  return true;
+}
+
 TilePublisherOptions publisher_options(const EndpointOptions& o,
                                        std::function<std::string(const std::string&, TileStore&)> load) {
   return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed,
@@ -46,9 +66,9 @@ struct LcmEndpoint::Impl final : TileSink {
   SessionHooks hooks;
   lcm::LCM lcm;
   std::array<std::string, 7> channels;
-  SpscQueue<PoseSample> poses;
-  SpscQueue<StatusSample> statuses;
-  SpscQueue<TileUpdate> tiles;
+  Handoff<PoseSample> poses;
+  Handoff<StatusSample> statuses;
+  Handoff<TileUpdate> tiles;
   std::mutex events_mutex;  // control events are rare (button, end of flush)
   std::vector<protocol::SessionEvent> events;
   protocol::CommandGate gate;
@@ -68,9 +88,9 @@ struct LcmEndpoint::Impl final : TileSink {
       : options(std::move(o)),
         hooks(std::move(h)),
         lcm(options.lcm_url),
-        poses(options.queue_capacity),
-        statuses(options.queue_capacity),
-        tiles(options.queue_capacity),
+        poses(options.queue_capacity, Overflow::wait, [] { return PoseSample{}; }),
+        statuses(options.queue_capacity, Overflow::wait, [] { return StatusSample{}; }),
+        tiles(options.queue_capacity, Overflow::wait, [] { return TileUpdate{}; }),
         gate(options.payload_id, options.command_window),
         publisher(publisher_options(options,
                                     [this](const std::string& session, TileStore& into) {
@@ -117,7 +137,7 @@ struct LcmEndpoint::Impl final : TileSink {
       drain_poses();
       drain_status();
       TileUpdate t;
-      while (tiles.pop(t)) publisher.update(t.key, t.points, t.utime);
+      while (take_from(tiles, t)) publisher.update(t.key, t.points, t.utime);
       publisher.tick(Clock::now());
       const TilePublisherCounts& c = publisher.counts();
       counters.chunks_published = c.chunks_published;
@@ -245,7 +265,7 @@ struct LcmEndpoint::Impl final : TileSink {
 
   void drain_poses() {
     PoseSample p;
-    while (poses.pop(p)) {
+    while (take_from(poses, p)) {
       pose_msg.utime = p.utime;
       pose_msg.schema = 1;
       pose_msg.session_id = session_id;
@@ -261,7 +281,7 @@ struct LcmEndpoint::Impl final : TileSink {
 
   void drain_status() {
     StatusSample s;
-    while (statuses.pop(s)) {
+    while (take_from(statuses, s)) {
       status_t m;
       m.utime = s.utime;
       m.schema = 1;
@@ -308,19 +328,20 @@ LcmEndpoint::LcmEndpoint(EndpointOptions options, SessionHooks hooks)
 LcmEndpoint::~LcmEndpoint() = default;
 
 bool LcmEndpoint::publish_pose(const PoseSample& pose) {
-  if (impl_->poses.push(pose)) return true;
+  PoseSample copy = pose;
+  if (hand_over(impl_->poses, copy)) return true;
   ++impl_->counters.poses_dropped;
   return false;
 }
 
 bool LcmEndpoint::publish_status(StatusSample&& status) {
-  if (impl_->statuses.push(std::move(status))) return true;
+  if (hand_over(impl_->statuses, status)) return true;
   ++impl_->counters.status_dropped;
   return false;
 }
 
 bool LcmEndpoint::publish_tile(TileUpdate&& tile) {
-  if (impl_->tiles.push(std::move(tile))) return true;
+  if (hand_over(impl_->tiles, tile)) return true;
   ++impl_->counters.tiles_dropped;
   return false;
 }

@@ -187,6 +187,10 @@ struct Pipeline::Impl {
   // Assembly thread: a finished scan goes to odometry (swapped, not copied).
   void hand_on(drivers::LidarScan& scan) {
     stats.scans.fetch_add(1, std::memory_order_relaxed);
+    if (stream) {
+      if (const auto clock = stream->clock().estimate())
+        stats.clock_offset_ns.store(clock->offset_ns, std::memory_order_relaxed);
+    }
     if (!scan.stats.complete) stats.incomplete_scans.fetch_add(1, std::memory_order_relaxed);
     ScanSlot* slot = nullptr;
     while ((slot = scans->acquire()) == nullptr && !stop.load(std::memory_order_relaxed)) {

@@ -310,6 +310,7 @@ StatusSample Sessions::status_sample() {
   lidar.packet_rate_hz = dt > 0 ? static_cast<float>(static_cast<double>(datagrams - last_datagrams_) / dt) : 0.0F;
   lidar.packets_dropped = static_cast<std::int64_t>(s.dropped_packets.load() + s.bad_packets.load());
   lidar.last_seen_utime = s.last_packet_realtime_ns.load() / 1000;
+  lidar.time_offset_s = static_cast<float>(1e-9 * static_cast<double>(s.clock_offset_ns.load()));
   sample.sensors.push_back(lidar);
   const std::vector<StageLoad> loads = pipeline_->loads();
   last_cpu_s_.resize(loads.size(), 0.0);

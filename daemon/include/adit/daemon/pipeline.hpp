@@ -65,6 +65,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> degenerate_poses{0};
   std::atomic<std::uint64_t> bad_packets{0};
   std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
+  std::atomic<std::int64_t> clock_offset_ns{0};          // host − sensor clock, per scan (drivers/lidar/sensor_clock.hpp)
   std::atomic<std::uint64_t> recorded_datagrams{0};
   std::atomic<std::uint64_t> mapped_scans{0};
   std::atomic<std::uint64_t> dropped_map_scans{0};      // live: mapping fell behind
