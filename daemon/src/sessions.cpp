@@ -322,7 +322,11 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
+  const std::int64_t last_packet_ns = s.last_packet_realtime_ns.load();
+  const double silent_s = 1e-9 * static_cast<double>(protocol::now_utime() * 1000 - last_packet_ns);
   if (pipeline_->drained()) sample.fault = "the recording has ended";
+  else if (last_packet_ns == 0) sample.fault = "no LiDAR packets yet";
+  else if (silent_s > 1.0) sample.fault = fmt::format("no LiDAR packets for {:.0f} s", silent_s);
   else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
     sample.fault = fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
                                s.dropped_scans.load());
