@@ -402,7 +402,8 @@ struct Pipeline::Impl {
     map_times.clear();
     map_intensities.clear();
     const float min2 = options.odometry.min_range_m * options.odometry.min_range_m;
-    const float max2 = options.odometry.max_range_m * options.odometry.max_range_m;
+    const float max_range = std::min(options.odometry.max_range_m, static_cast<float>(config.map.max_range_m));
+    const float max2 = max_range * max_range;
     const bool timed = slot.times_s.size() == slot.points.size();
     for (std::size_t i = 0; i < slot.points.size(); ++i) {
       const float r2 = slot.points[i].squaredNorm();

@@ -54,13 +54,34 @@ std::size_t TiledVoxelMap::add(std::span<const Eigen::Vector3f> points, std::spa
     const Eigen::Vector3f local = p - origin;
     const auto voxel = static_cast<std::uint32_t>((index_along(local.x()) * n + index_along(local.y())) * n +
                                                   index_along(local.z()));
-    if (!tile->occupied.insert(voxel).second) continue;
+    if (!tile->occupied.insert(voxel)) continue;
     tile->points.push_back({p, has_intensity ? intensities[i] : 0.0F, time_s});
     changed_.insert(coord);
     ++kept;
   }
   size_ += kept;
   return kept;
+}
+
+bool TiledVoxelMap::VoxelSet::insert(std::uint32_t voxel) {
+  if (2 * (size_ + 1) > slots_.size()) grow();
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = (voxel * 2654435761U) & mask;; i = (i + 1) & mask) {
+    if (slots_[i] == voxel) return false;
+    if (slots_[i] == kEmpty) {
+      slots_[i] = voxel;
+      ++size_;
+      return true;
+    }
+  }
+}
+
+void TiledVoxelMap::VoxelSet::grow() {
+  std::vector<std::uint32_t> old = std::move(slots_);
+  slots_.assign(old.empty() ? 64 : 2 * old.size(), kEmpty);
+  size_ = 0;
+  for (const std::uint32_t v : old)
+    if (v != kEmpty) insert(v);
 }
 
 std::vector<TileCoord> TiledVoxelMap::take_changed() {
