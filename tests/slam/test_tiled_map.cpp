@@ -39,6 +39,18 @@ TEST(TiledVoxelMap, BinsPointsIntoTilesByFloorAndReportsChangesOnce) {
   EXPECT_TRUE(map.take_changed().empty());
 }
 
+TEST(TiledVoxelMap, KeepsEveryDistinctVoxelOnceThroughManyGrowths) {
+  TiledVoxelMap map({20.0F, 0.1F});
+  std::vector<Eigen::Vector3f> grid;  // 60 × 60 × 30 distinct voxel centres in one tile
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j)
+      for (int k = 0; k < 30; ++k) grid.emplace_back(0.05F + 0.1F * i, 0.05F + 0.1F * j, 0.05F + 0.1F * k);
+  EXPECT_EQ(map.add(grid, {}, 0.0), grid.size());
+  EXPECT_EQ(map.add(grid, {}, 1.0), 0U);  // every voxel is taken now
+  EXPECT_EQ(map.size(), grid.size());
+  EXPECT_EQ(map.tile({0, 0, 0}).size(), grid.size());
+}
+
 TEST(TiledVoxelMap, SkipsNonFinitePoints) {
   TiledVoxelMap map({20.0F, 0.05F});
   const float nan = std::numeric_limits<float>::quiet_NaN();
