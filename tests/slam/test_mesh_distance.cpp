@@ -86,8 +86,10 @@ TEST(MeshDistance, GridAgreesWithBruteForce) {
       const MeshDistance mesh(triangles, cap, cell);
       int exact = 0;
       int beyond = 0;
+      std::vector<Vector3d> queries;
       for (int i = 0; i < 600; ++i) {
         const Vector3d p = random_query(rng, triangles, cap);
+        queries.push_back(p);
         const double truth = brute_force_distance(triangles, p);
         if (std::abs(truth - cap) < 1e-9) continue;  // on the cap: either answer is right
         const double d = mesh.distance(p);
@@ -98,6 +100,13 @@ TEST(MeshDistance, GridAgreesWithBruteForce) {
           ++beyond;
           ASSERT_TRUE(std::isinf(d)) << "cell " << mesh.cell() << " cap " << cap << " got " << d << " truth " << truth;
         }
+      }
+      // The batch gives each point's own answer, in the input's order.
+      const std::vector<double> batch = mesh.distances(queries);
+      ASSERT_EQ(batch.size(), queries.size());
+      for (std::size_t i = 0; i < queries.size(); ++i) {
+        const double one = mesh.distance(queries[i]);
+        EXPECT_TRUE(batch[i] == one || (std::isinf(batch[i]) && std::isinf(one))) << i;
       }
       // Both branches were exercised.
       EXPECT_GT(exact, 100) << "cap " << cap;
@@ -119,10 +128,17 @@ TEST(MeshDistance, PointsOnTheSurfaceAreAtZero) {
 TEST(MeshDistance, EmptyMeshAndNonFinitePoints) {
   const MeshDistance empty({}, 1.0);
   EXPECT_TRUE(std::isinf(empty.distance(Vector3d::Zero())));
+  const std::vector<Vector3d> two{Vector3d::Zero(), Vector3d::Ones()};
+  EXPECT_TRUE(std::isinf(empty.distances(two).at(1)));
   const MeshDistance one({kUnit}, 1.0);
   EXPECT_NEAR(one.distance({0.2, 0.2, 0.5}), 0.5, 1e-15);
   EXPECT_TRUE(std::isnan(one.distance({std::numeric_limits<double>::quiet_NaN(), 0, 0})));
   EXPECT_TRUE(std::isinf(one.distance({100, 0, 0})));
+  const std::vector<Vector3d> mixed{{0.2, 0.2, 0.5}, {std::numeric_limits<double>::infinity(), 0, 0}, {0, 0, -0.25}};
+  const std::vector<double> d = one.distances(mixed);
+  EXPECT_NEAR(d[0], 0.5, 1e-15);
+  EXPECT_TRUE(std::isnan(d[1]));
+  EXPECT_NEAR(d[2], 0.25, 1e-15);
 }
 
 }  // namespace

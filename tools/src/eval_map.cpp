@@ -116,10 +116,10 @@ void run_eval_map(const MapEvalOptions& o) {
   if (map.empty()) throw InputError(o.map, "", "the map has no points");
   const Placement place = placement(o);
 
-  std::vector<double> distances;
-  distances.reserve(map.size());
-  for (const protocol::MapPoint& p : map)
-    distances.push_back(scene.distance(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z)));
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(map.size());
+  for (const protocol::MapPoint& p : map) points.push_back(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z));
+  std::vector<double> distances = scene.distances(points);
   const MapAccuracy a = summarize(distances, o.within);
   const double fraction = static_cast<double>(a.within) / static_cast<double>(a.points);
 
