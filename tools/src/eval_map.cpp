@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -99,6 +101,24 @@ MapAccuracy summarize(std::vector<double>& d, double within) {
   return a;
 }
 
+// The points in one contiguous slice per core; MeshDistance is read-only.
+std::vector<double> distances_in_parallel(const slam::MeshDistance& scene, std::span<const Eigen::Vector3d> points) {
+  const std::size_t slices =
+      std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, points.size() / 100'000));
+  std::vector<std::vector<double>> parts(slices);
+  {
+    std::vector<std::jthread> workers;
+    for (std::size_t k = 0; k < slices; ++k) {
+      const std::size_t begin = points.size() * k / slices, end = points.size() * (k + 1) / slices;
+      workers.emplace_back([&, k, begin, end] { parts[k] = scene.distances(points.subspan(begin, end - begin)); });
+    }
+  }  // joined
+  std::vector<double> out;
+  out.reserve(points.size());
+  for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
 nlohmann::json metres_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 std::string metres_or_beyond(double v, double cap) {
@@ -119,7 +139,7 @@ void run_eval_map(const MapEvalOptions& o) {
   std::vector<Eigen::Vector3d> points;
   points.reserve(map.size());
   for (const protocol::MapPoint& p : map) points.push_back(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z));
-  std::vector<double> distances = scene.distances(points);
+  std::vector<double> distances = distances_in_parallel(scene, points);
   const MapAccuracy a = summarize(distances, o.within);
   const double fraction = static_cast<double>(a.within) / static_cast<double>(a.points);
 
