@@ -215,10 +215,13 @@ std::vector<double> MeshDistance::distances(std::span<const Eigen::Vector3d> poi
     order[i] = (cell << 32) | i;
   }
   std::sort(order.begin(), order.end());
-  for (const std::uint64_t key : order) {
-    const std::size_t i = key & 0xffffffffU;
-    out[i] = distance(points[i]);
-  }
+  // Gather, measure, scatter: the gather's loads are independent, so the
+  // CPU overlaps their cache misses, which the queries' dependent loads cannot.
+  std::vector<Eigen::Vector3d> sorted(points.size());
+  for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = points[order[k] & 0xffffffffU];
+  std::vector<double> measured(points.size());
+  for (std::size_t k = 0; k < sorted.size(); ++k) measured[k] = distance(sorted[k]);
+  for (std::size_t k = 0; k < order.size(); ++k) out[order[k] & 0xffffffffU] = measured[k];
   return out;
 }
 

@@ -132,13 +132,16 @@ void run_eval_map(const MapEvalOptions& o) {
     throw InputError("", "--within", fmt::format("{} m is beyond --cap {} m, where distances are not computed",
                                                  o.within, o.cap));
   const slam::MeshDistance scene(scene_triangles(o.scene), o.cap);
-  const std::vector<protocol::MapPoint> map = protocol::read_map(o.map);
-  if (map.empty()) throw InputError(o.map, "", "the map has no points");
   const Placement place = placement(o);
-
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(map.size());
-  for (const protocol::MapPoint& p : map) points.push_back(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z));
+  // Only the placed positions are kept (a 5 M-point map's fields are 200 MB).
+  const std::vector<Eigen::Vector3d> points = [&] {
+    const std::vector<protocol::MapPoint> map = protocol::read_map(o.map);
+    if (map.empty()) throw InputError(o.map, "", "the map has no points");
+    std::vector<Eigen::Vector3d> placed;
+    placed.reserve(map.size());
+    for (const protocol::MapPoint& p : map) placed.push_back(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z));
+    return placed;
+  }();
   std::vector<double> distances = distances_in_parallel(scene, points);
   const MapAccuracy a = summarize(distances, o.within);
   const double fraction = static_cast<double>(a.within) / static_cast<double>(a.points);
