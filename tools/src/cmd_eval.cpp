@@ -1,5 +1,5 @@
-// adit eval traj|endpoint|targets: accuracy numbers from trajectories and
-// total-station targets (docs/EVALUATION.md defines every metric).
+// adit eval traj|endpoint|targets|map: accuracy numbers from trajectories,
+// total-station targets and scene meshes (docs/EVALUATION.md defines every metric).
 
 #include <memory>
 
@@ -84,14 +84,41 @@ void add_targets(CLI::App& eval, int& status) {
   });
 }
 
+void add_map(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("map", "Distance of every map point to the true scene surfaces (a triangle mesh)");
+  auto o = std::make_shared<MapEvalOptions>();
+  cmd->add_option("--map", o->map, "Map file: .ply, .pcd or .las (as aditd exports them)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--scene", o->scene, "True scene: triangle mesh PLY (adit sim's scene.ply)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  auto* ref = cmd->add_option("--ref", o->ref, "Reference body trajectory (truth_body.tum) to place the map in the scene")
+                  ->check(CLI::ExistingFile);
+  auto* est = cmd->add_option("--est", o->est, "The map's own trajectory (trajectory.tum), placed by ref(t0) est(t0)^-1")
+                  ->check(CLI::ExistingFile);
+  ref->needs(est);
+  est->needs(ref);
+  cmd->add_option("--within", o->within, "Distance (m) a point must be within to count as accurate (default 0.05)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--cap", o->cap, "Distances beyond this (m) are counted as beyond, not computed (default 1)")
+      ->check(CLI::Range(1e-3, 100.0));
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_map(*o);
+    status = kExitOk;
+  });
+}
+
 }  // namespace
 
 void register_eval_commands(CLI::App& app, int& status) {
-  auto* eval = app.add_subcommand("eval", "Accuracy evaluation: trajectories, end-to-end drift, survey targets");
+  auto* eval = app.add_subcommand("eval", "Accuracy evaluation: trajectories, end-to-end drift, survey targets, map against scene");
   eval->require_subcommand(1);
   add_traj(*eval, status);
   add_endpoint(*eval, status);
   add_targets(*eval, status);
+  add_map(*eval, status);
 }
 
 }  // namespace adit::tools

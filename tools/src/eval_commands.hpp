@@ -1,5 +1,5 @@
 #pragma once
-// The three `adit eval` subcommands: their options and what runs them. Each
+// The `adit eval` subcommands: their options and what runs them. Each
 // runner prints a table (or JSON with --json) on stdout, writes the plots it
 // was asked for, and throws adit::InputError on bad input (exit status 2).
 
@@ -43,7 +43,16 @@ struct TargetsEvalOptions {
   std::string svg;
 };
 
+struct MapEvalOptions {
+  std::string map, scene;
+  std::string ref, est;  // both or neither: place the map by ref(t0) · est(t0)⁻¹
+  double within = 0.05;  // m
+  double cap = 1.0;      // m: farther distances are counted, not computed
+  bool json = false;
+};
+
 void run_eval_traj(const TrajEvalOptions& options);
+void run_eval_map(const MapEvalOptions& options);
 void run_eval_endpoint(const EndpointEvalOptions& options);
 void run_eval_targets(const TargetsEvalOptions& options);
 

@@ -1,0 +1,178 @@
+// adit eval map: how far the map's points lie from the true scene surfaces
+// (absolute point error, as surveyors judge a map). docs/EVALUATION.md, "Map
+// accuracy", defines the figures.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/protocol/map_import.hpp"
+#include "adit/protocol/ply_mesh.hpp"
+#include "adit/slam/interpolate.hpp"
+#include "adit/slam/mesh_distance.hpp"
+#include "adit/slam/trajectory_io.hpp"
+#include "eval_commands.hpp"
+
+namespace adit::tools {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+std::vector<slam::Triangle> scene_triangles(const std::string& file) {
+  const protocol::PlyMesh mesh = protocol::read_ply_mesh(file);
+  if (mesh.triangles.empty()) throw InputError(file, "element face", "the scene has no triangles");
+  const auto vertex = [&](std::uint32_t i) {
+    return Eigen::Vector3d(mesh.vertices[i][0], mesh.vertices[i][1], mesh.vertices[i][2]);
+  };
+  std::vector<slam::Triangle> out;
+  out.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) out.push_back({vertex(t[0]), vertex(t[1]), vertex(t[2])});
+  return out;
+}
+
+slam::Trajectory timed_trajectory(const std::string& file) {
+  slam::Trajectory t = slam::read_trajectory(file, slam::detect_trajectory_format(file));
+  if (t.empty() || !t.timed) throw InputError(file, "", "needs time-stamped poses");
+  return t;
+}
+
+struct Placement {
+  Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
+  double t0 = 0.0;  // s; the estimate's first stamp when placed by trajectories
+  bool by_trajectories = false;
+};
+
+// The map frame is the estimate's: its first pose est(t0) is where the body
+// was at t0, which the reference says is ref(t0) in the world. So a map point
+// p goes to ref(t0) · est(t0)⁻¹ · p.
+Placement placement(const MapEvalOptions& o) {
+  Placement p;
+  if (o.ref.empty()) return p;
+  const slam::Trajectory ref = timed_trajectory(o.ref);
+  const slam::Trajectory est = timed_trajectory(o.est);
+  p.t0 = est.stamps.front();
+  const auto ref_t0 = slam::interpolate_pose(ref, p.t0);
+  if (!ref_t0)
+    throw InputError(o.ref, "", fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
+                                            "{:.6f} .. {:.6f} s", p.t0, o.est, ref.stamps.front(), ref.stamps.back()));
+  p.world_from_map = *ref_t0 * est.poses.front().inverse();
+  p.by_trajectories = true;
+  return p;
+}
+
+struct MapAccuracy {
+  std::size_t points = 0;
+  std::size_t within = 0;      // distance <= the threshold
+  std::size_t beyond_cap = 0;  // no triangle closer than the cap
+  double median = 0.0;         // +inf when the middle lies beyond the cap
+  double p95 = 0.0;            // nearest rank; +inf likewise
+  double mean = 0.0;           // of the distances below the cap
+};
+
+// `d` is reordered. Median as compute_stats (mean of the two middle values for
+// an even count); p95 by nearest rank, the ceil(0.95 n)-th smallest.
+MapAccuracy summarize(std::vector<double>& d, double within) {
+  MapAccuracy a;
+  a.points = d.size();
+  double sum = 0.0;
+  for (const double v : d) {
+    if (v <= within) ++a.within;
+    if (std::isinf(v)) {
+      ++a.beyond_cap;
+    } else {
+      sum += v;
+    }
+  }
+  const std::size_t below = a.points - a.beyond_cap;
+  a.mean = below > 0 ? sum / static_cast<double>(below) : kInfinity;
+  const auto kth = [&](std::size_t k) {
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+    return d[k];
+  };
+  const std::size_t n = d.size();
+  a.median = n % 2 == 1 ? kth(n / 2) : 0.5 * (kth(n / 2 - 1) + kth(n / 2));
+  a.p95 = kth(static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1);
+  return a;
+}
+
+// The points in one contiguous slice per core; MeshDistance is read-only.
+std::vector<double> distances_in_parallel(const slam::MeshDistance& scene, std::span<const Eigen::Vector3d> points) {
+  const std::size_t slices =
+      std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, points.size() / 100'000));
+  std::vector<std::vector<double>> parts(slices);
+  {
+    std::vector<std::jthread> workers;
+    for (std::size_t k = 0; k < slices; ++k) {
+      const std::size_t begin = points.size() * k / slices, end = points.size() * (k + 1) / slices;
+      workers.emplace_back([&, k, begin, end] { parts[k] = scene.distances(points.subspan(begin, end - begin)); });
+    }
+  }  // joined
+  std::vector<double> out;
+  out.reserve(points.size());
+  for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
+nlohmann::json metres_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+std::string metres_or_beyond(double v, double cap) {
+  return std::isfinite(v) ? fmt::format("{:.4f} m", v) : fmt::format("> {:g} m (cap)", cap);
+}
+
+}  // namespace
+
+void run_eval_map(const MapEvalOptions& o) {
+  if (o.within > o.cap)
+    throw InputError("", "--within", fmt::format("{} m is beyond --cap {} m, where distances are not computed",
+                                                 o.within, o.cap));
+  const slam::MeshDistance scene(scene_triangles(o.scene), o.cap);
+  const Placement place = placement(o);
+  // Only the placed positions are kept (a 5 M-point map's fields are 200 MB).
+  const std::vector<Eigen::Vector3d> points = [&] {
+    const std::vector<protocol::MapPoint> map = protocol::read_map(o.map);
+    if (map.empty()) throw InputError(o.map, "", "the map has no points");
+    std::vector<Eigen::Vector3d> placed;
+    placed.reserve(map.size());
+    for (const protocol::MapPoint& p : map) placed.push_back(place.world_from_map * Eigen::Vector3d(p.x, p.y, p.z));
+    return placed;
+  }();
+  std::vector<double> distances = distances_in_parallel(scene, points);
+  const MapAccuracy a = summarize(distances, o.within);
+  const double fraction = static_cast<double>(a.within) / static_cast<double>(a.points);
+
+  if (o.json) {
+    const nlohmann::json j{{"points", a.points},
+                           {"within_m", o.within},
+                           {"fraction_within", fraction},
+                           {"median_m", metres_or_null(a.median)},
+                           {"p95_m", metres_or_null(a.p95)},
+                           {"mean_m", metres_or_null(a.mean)},
+                           {"beyond_cap", a.beyond_cap},
+                           {"cap_m", o.cap}};
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  fmt::print("map               {} ({} points)\n", o.map, a.points);
+  fmt::print("scene             {} ({} triangles)\n", o.scene, scene.size());
+  if (place.by_trajectories) {
+    const Eigen::Vector3d t = place.world_from_map.translation();
+    fmt::print("placement         ref(t0) est(t0)^-1 at t0 = {:.6f} s: map origin at ({:.3f}, {:.3f}, {:.3f}) m\n",
+               place.t0, t.x(), t.y(), t.z());
+  } else {
+    fmt::print("placement         none (map taken as in the scene frame)\n");
+  }
+  fmt::print("within {:.3f} m    {:.2f} % ({} points)\n", o.within, 100.0 * fraction, a.within);
+  fmt::print("median            {}\n", metres_or_beyond(a.median, o.cap));
+  fmt::print("p95               {}\n", metres_or_beyond(a.p95, o.cap));
+  fmt::print("mean below cap    {}\n", metres_or_beyond(a.mean, o.cap));
+  fmt::print("beyond cap {:g} m  {} points ({:.2f} %)\n", o.cap, a.beyond_cap,
+             100.0 * static_cast<double>(a.beyond_cap) / static_cast<double>(a.points));
+}
+
+}  // namespace adit::tools
