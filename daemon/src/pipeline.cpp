@@ -95,7 +95,7 @@ double thread_cpu_s(std::thread& thread) {
 }
 
 slam::TiledMapConfig map_config_of(const config::MapSection& m) {
-  return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m)};
+  return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m), static_cast<std::uint8_t>(m.min_hits)};
 }
 
 }  // namespace
@@ -160,6 +160,9 @@ struct Pipeline::Impl {
       map_times.reserve(max_points);
       map_intensities.reserve(max_points);
       map_deskewed.reserve(max_points);
+      pending.points.reserve(max_points);
+      pending.times_s.reserve(max_points);
+      pending.intensities.reserve(max_points);
       keyframe_points.reserve(max_points);
       keyframe_downsampler.emplace(max_points);
     }
@@ -362,9 +365,11 @@ struct Pipeline::Impl {
     map_slots->publish(m);
   }
 
-  // Mapping thread: deskew with the motion between this pose and the previous
-  // one (the corrected motion, not the prediction odometry deskewed with),
-  // then add to the tiled map; keyframes; changed tiles to the sink.
+  // Mapping thread. A scan spans the time from its pose to the next scan's
+  // pose, so it is mapped one scan late: deskewed with the corrected motion
+  // over its own sweep, pose_k⁻¹·pose_k+1 (odometry could only deskew with
+  // the prediction), then added to the tiled map; keyframes; changed tiles go
+  // to the sink at most once per period.
   void mapping_loop() {
     settle_thread("adit-mapping", config.threads.mapping);
     const auto period_ns = static_cast<std::int64_t>(config.map.publish_period_s * 1e9);
@@ -382,22 +387,26 @@ struct Pipeline::Impl {
         wait_a_little();
         continue;
       }
-      map_scan(*slot);
+      if (have_pending) {
+        const double dt = 1e-9 * static_cast<double>(slot->stamp_ns - pending.stamp_ns);
+        // After a gap the next pose says nothing of this sweep: keep the last motion.
+        if (dt > 0.0 && dt <= options.odometry.max_scan_gap_s)
+          map_velocity = slam::log_se3(pending.pose.inverse() * slot->pose) / dt;
+        map_scan(pending, map_velocity);
+      }
+      // The slot's buffers and the pending ones have the same capacity: swap, no copy.
+      std::swap(pending, *slot);
+      have_pending = true;
       map_slots->release(slot);
     }
+    if (have_pending && !stop.load()) map_scan(pending, map_velocity);  // the last sweep: the last motion known
+    have_pending = false;
     flush_tiles();
     stats.dropped_map_scans.store(map_slots->dropped());
     mapping_beat.finished.store(true);
   }
 
-  void map_scan(const MapSlot& slot) {
-    slam::Vector6d velocity = slam::Vector6d::Zero();
-    const double dt = 1e-9 * static_cast<double>(slot.stamp_ns - previous_map_stamp_ns);
-    if (previous_map_stamp_ns != 0 && dt > 0.0 && dt <= options.odometry.max_scan_gap_s)
-      velocity = slam::log_se3(previous_map_pose.inverse() * slot.pose) / dt;
-    previous_map_stamp_ns = slot.stamp_ns;
-    previous_map_pose = slot.pose;
-
+  void map_scan(const MapSlot& slot, const slam::Vector6d& velocity) {
     map_points.clear();
     map_times.clear();
     map_intensities.clear();
@@ -496,8 +505,9 @@ struct Pipeline::Impl {
   std::vector<float> map_intensities;
   std::vector<Eigen::Vector3f> map_deskewed;
   std::vector<Eigen::Vector3f> keyframe_points;
-  std::int64_t previous_map_stamp_ns = 0;
-  Eigen::Isometry3d previous_map_pose = Eigen::Isometry3d::Identity();
+  MapSlot pending;        // the scan waiting for the next pose
+  bool have_pending = false;
+  slam::Vector6d map_velocity = slam::Vector6d::Zero();
   std::vector<Eigen::Vector3f> body_points;
   std::vector<float> body_times;
   std::int64_t current_packet_mono_ns = 0;  // assembly thread only

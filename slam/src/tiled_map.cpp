@@ -54,8 +54,17 @@ std::size_t TiledVoxelMap::add(std::span<const Eigen::Vector3f> points, std::spa
     const Eigen::Vector3f local = p - origin;
     const auto voxel = static_cast<std::uint32_t>((index_along(local.x()) * n + index_along(local.y())) * n +
                                                   index_along(local.z()));
-    if (!tile->occupied.insert(voxel)) continue;
-    tile->points.push_back({p, has_intensity ? intensities[i] : 0.0F, time_s});
+    const auto next = static_cast<std::uint32_t>(tile->candidates.size());
+    const std::uint32_t candidate = tile->voxels.find_or_insert(voxel, next);
+    if (candidate == next) {
+      tile->candidates.push_back({p, has_intensity ? intensities[i] : 0.0F, time_s});
+      tile->hits.push_back(0);
+      ++candidates_;
+    }
+    std::uint8_t& hits = tile->hits[candidate];
+    if (hits == 255) continue;
+    if (++hits != std::max<std::uint8_t>(config_.min_hits, 1)) continue;
+    tile->points.push_back(tile->candidates[candidate]);  // confirmed now
     changed_.insert(coord);
     ++kept;
   }
@@ -63,25 +72,25 @@ std::size_t TiledVoxelMap::add(std::span<const Eigen::Vector3f> points, std::spa
   return kept;
 }
 
-bool TiledVoxelMap::VoxelSet::insert(std::uint32_t voxel) {
+std::uint32_t TiledVoxelMap::VoxelIndex::find_or_insert(std::uint32_t voxel, std::uint32_t next) {
   if (2 * (size_ + 1) > slots_.size()) grow();
   const std::size_t mask = slots_.size() - 1;
   for (std::size_t i = (voxel * 2654435761U) & mask;; i = (i + 1) & mask) {
-    if (slots_[i] == voxel) return false;
-    if (slots_[i] == kEmpty) {
-      slots_[i] = voxel;
+    if (slots_[i].voxel == voxel) return slots_[i].candidate;
+    if (slots_[i].voxel == kEmpty) {
+      slots_[i] = {voxel, next};
       ++size_;
-      return true;
+      return next;
     }
   }
 }
 
-void TiledVoxelMap::VoxelSet::grow() {
-  std::vector<std::uint32_t> old = std::move(slots_);
-  slots_.assign(old.empty() ? 64 : 2 * old.size(), kEmpty);
+void TiledVoxelMap::VoxelIndex::grow() {
+  std::vector<Slot> old = std::move(slots_);
+  slots_.assign(old.empty() ? 64 : 2 * old.size(), Slot{});
   size_ = 0;
-  for (const std::uint32_t v : old)
-    if (v != kEmpty) insert(v);
+  for (const Slot& s : old)
+    if (s.voxel != kEmpty) find_or_insert(s.voxel, s.candidate);
 }
 
 std::vector<TileCoord> TiledVoxelMap::take_changed() {

@@ -121,6 +121,7 @@ struct MapSection {
   double tile_size_m = 20.0;
   double voxel_m = 0.05;                 // one point kept per voxel
   double max_range_m = 40.0;             // farther points stay out of the map (angular error grows with range)
+  int min_hits = 2;                      // a voxel enters the map once hit this often (1 = at once)
   double publish_period_s = 1.0;         // changed tiles go out at most this often
   double keyframe_distance_m = 1.0;
   double keyframe_angle_deg = 10.0;

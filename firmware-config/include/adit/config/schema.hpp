@@ -168,6 +168,7 @@ void describe(V& v, MapSection& s) {
   v.optional("tile_size_m", s.tile_size_m, Range<double>{1.0, 60.0});  // 1 mm quanta fit uint16
   v.optional("voxel_m", s.voxel_m, Range<double>{0.01, 1.0});
   v.optional("max_range_m", s.max_range_m, Range<double>{1.0, 1000.0});
+  v.optional("min_hits", s.min_hits, Range<int>{1, 255});
   v.optional("publish_period_s", s.publish_period_s, Range<double>{0.1, 60.0});
   v.optional("keyframe_distance_m", s.keyframe_distance_m, Range<double>{0.1, 100.0});
   v.optional("keyframe_angle_deg", s.keyframe_angle_deg, Range<double>{1.0, 180.0});
