@@ -1,6 +1,7 @@
 // adit bench odometry: per-scan odometry time (median, p99), speed as a
 // multiple of real time, memory, drift against ground truth when given, and a
 // baseline (PCL GICP) on the same scans in the same run, with the ratio.
+// (adit bench pipeline lives in bench_pipeline.cpp.)
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +21,7 @@
 #include "adit/slam/trajectory.hpp"
 #include "adit/slam/trajectory_io.hpp"
 #include "bench_baseline.hpp"
+#include "bench_pipeline.hpp"
 #include "bench_scans.hpp"
 #include "commands.hpp"
 #include "process_memory.hpp"
@@ -182,6 +184,7 @@ void register_bench_commands(CLI::App& app, int& status) {
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");
     status = bench_odometry(*o);
   });
+  add_bench_pipeline_command(*bench, status);
 }
 
 }  // namespace adit::tools
