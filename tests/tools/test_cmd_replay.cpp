@@ -116,6 +116,9 @@ TEST_F(Replay, ReplaysADirectoryOfScans) {
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_EQ(json_of(run)["poses"].get<std::size_t>(), files);
   EXPECT_EQ(stamps_of(out).size(), files);
+  const CommandRun paced = adit("replay" + config() + " --scan-dir " + scans.string() + " --realtime");
+  EXPECT_EQ(paced.status, 2) << paced.output;
+  EXPECT_NE(paced.output.find("--realtime"), std::string::npos) << paced.output;
 }
 
 TEST_F(Replay, AMissingOrCorruptCaptureIsNamedWithStatus2) {

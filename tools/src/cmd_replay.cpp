@@ -27,6 +27,9 @@ const std::string& source_of(const config::Config& c) {
 
 int replay(const ReplayOptions& o) {
   const config::Config config = load_pipeline_config(o.inputs);
+  if (config.lidar.source == config::LidarSource::scan_dir && (o.realtime || o.speed > 0.0))
+    throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
+                     "a scan directory is replayed as fast as possible (the pipeline does not pace it)");
   daemon::PipelineOptions options;
   options.trajectory_file = o.out;
   options.replay_speed = o.realtime ? 1.0 : o.speed;
