@@ -128,8 +128,13 @@ int bench_pipeline(const BenchPipelineOptions& o) {
   fmt::print("from the file (no network):\n{}\n", figures_text(file, 0.1));
   fmt::print("over UDP loopback: sent {} datagrams ({} refused), received {}, lost {}\n{}\n", udp.sent.sent,
              udp.sent.refused, udp.figures.datagrams, lost, figures_text(udp.figures, 0.1));
-  fmt::print("latency p99: {:.2f} ms over loopback, {:.2f} ms from the file (network share {:+.2f} ms); target <= {:.0f} ms: {}\n",
-             udp.figures.latency_p99_ms, file.latency_p99_ms, udp.figures.latency_p99_ms - file.latency_p99_ms,
+  // The latency starts when the receiver hands the last packet of a scan on,
+  // so the kernel's loopback hop itself is outside it; what the network source
+  // changes is the receiver's batching and scheduling, seen beyond odometry.
+  fmt::print("latency p99: {:.2f} ms over loopback, {:.2f} ms from the file; beyond odometry {:.2f} ms vs {:.2f} ms "
+             "(network share {:+.2f} ms); target <= {:.0f} ms: {}\n",
+             udp.figures.latency_p99_ms, file.latency_p99_ms, udp.figures.beyond_odometry_p99_ms,
+             file.beyond_odometry_p99_ms, udp.figures.beyond_odometry_p99_ms - file.beyond_odometry_p99_ms,
              kLatencyTargetMs, udp.figures.latency_p99_ms <= kLatencyTargetMs ? "met" : "NOT met");
   return kExitOk;
 }

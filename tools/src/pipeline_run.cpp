@@ -64,6 +64,12 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks) 
   f.latency_median_ms = daemon::quantile(t.latency_ms, 0.5);
   f.latency_p99_ms = daemon::quantile(t.latency_ms, 0.99);
   f.latency_max_ms = daemon::quantile(t.latency_ms, 1.0);
+  if (t.latency_ms.size() == t.odometry_ms.size()) {  // one of each per scan, in order
+    std::vector<double> beyond(t.latency_ms.size());
+    for (std::size_t i = 0; i < beyond.size(); ++i) beyond[i] = t.latency_ms[i] - t.odometry_ms[i];
+    f.beyond_odometry_median_ms = daemon::quantile(beyond, 0.5);
+    f.beyond_odometry_p99_ms = daemon::quantile(beyond, 0.99);
+  }
   f.sensor_span_s = t.sensor_span_s;
   f.duration_s = t.duration_s;
   f.peak_resident_mb = peak_resident_mb();
@@ -97,6 +103,7 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
       {"dropped_scans", f.dropped_scans},
       {"odometry_ms", {{"median", f.odometry_median_ms}, {"p99", f.odometry_p99_ms}}},
       {"latency_ms", {{"median", f.latency_median_ms}, {"p99", f.latency_p99_ms}, {"max", f.latency_max_ms}}},
+      {"latency_beyond_odometry_ms", {{"median", f.beyond_odometry_median_ms}, {"p99", f.beyond_odometry_p99_ms}}},
       {"sensor_span_s", f.sensor_span_s},
       {"duration_s", f.duration_s},
       {"speed", f.speed()},
@@ -112,12 +119,13 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
   std::string text = fmt::format(
       "scans {} ({} incomplete), poses {} ({} invalid, {} degenerate); dropped {} packets, {} scans; {} bad packets\n"
       "odometry per scan: median {:.2f} ms, p99 {:.2f} ms\n"
-      "latency, last packet of a scan to its pose: median {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms\n"
+      "latency, last packet of a scan to its pose: median {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms "
+      "(beyond odometry: median {:.2f} ms, p99 {:.2f} ms)\n"
       "{:.1f} s of data in {:.1f} s = {:.1f}x real time\n"
       "memory: peak resident {:.1f} MB",
       f.scans, f.incomplete_scans, f.poses, f.invalid_poses, f.degenerate_poses, f.dropped_packets, f.dropped_scans,
       f.bad_packets, f.odometry_median_ms, f.odometry_p99_ms, f.latency_median_ms, f.latency_p99_ms, f.latency_max_ms,
-      f.sensor_span_s, f.duration_s, f.speed(), f.peak_resident_mb);
+      f.beyond_odometry_median_ms, f.beyond_odometry_p99_ms, f.sensor_span_s, f.duration_s, f.speed(), f.peak_resident_mb);
   if (const auto g = memory_growth(f.memory, from_fraction))
     text += fmt::format("; resident {:.1f} MB at pose {} -> {:.1f} MB at the end ({:+.2f} %, max {:.1f} MB)",
                         g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb);

@@ -50,6 +50,8 @@ struct PipelineFigures {
   double latency_median_ms = 0.0;
   double latency_p99_ms = 0.0;
   double latency_max_ms = 0.0;
+  double beyond_odometry_median_ms = 0.0;  // latency minus odometry time, per scan: queues and hand-offs
+  double beyond_odometry_p99_ms = 0.0;
   double sensor_span_s = 0.0;  // first to last scan stamp
   double duration_s = 0.0;     // wall time
   double peak_resident_mb = 0.0;
