@@ -3,38 +3,12 @@
 // global operator new to count every allocation.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/hesai.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
 #include "adit/drivers/pcap_reader.hpp"
+#include "allocation_counter.hpp"
 #include "shared_data.hpp"
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};  // test instrumentation: counts every operator new
-}
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return ::operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-// The nothrow forms too (std::stable_sort's buffer uses them): every new above pairs with free().
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return ::operator new(size, tag); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace adit::drivers {
 namespace {
@@ -46,6 +20,7 @@ struct Datagram {
 
 // Warm up on the first `warm_up` packets (one revolution), count allocations over the rest.
 void expect_no_allocation(const std::filesystem::path& capture, LidarDecoder& decoder, std::size_t warm_up) {
+  ADIT_REQUIRE_ALLOCATION_COUNTING();
   std::vector<Datagram> packets;
   {
     PcapReader reader(capture);
@@ -56,10 +31,10 @@ void expect_no_allocation(const std::filesystem::path& capture, LidarDecoder& de
   std::uint64_t scans = 0;
   DecodeStream stream(decoder, assembler, [&](LidarScan&) { ++scans; });
   for (std::size_t i = 0; i < warm_up; ++i) stream.push(packets[i].payload, packets[i].time_ns);
-  const std::uint64_t before = g_allocations.load();
+  const std::uint64_t before = adit::test::allocations();
   const std::uint64_t scans_before = scans;
   for (std::size_t i = warm_up; i < packets.size(); ++i) stream.push(packets[i].payload, packets[i].time_ns);
-  EXPECT_EQ(g_allocations.load() - before, 0u) << "over " << packets.size() - warm_up << " packets";
+  EXPECT_EQ(adit::test::allocations() - before, 0u) << "over " << packets.size() - warm_up << " packets";
   EXPECT_GE(scans - scans_before, 2u);
 }
 

@@ -3,48 +3,14 @@
 // operator new to count every allocation.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
 #include <cstring>
-#include <new>
 
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/velodyne.hpp"
 #include "adit/drivers/pcap_reader.hpp"
 #include "adit/drivers/udp.hpp"
+#include "allocation_counter.hpp"
 #include "shared_data.hpp"
-
-// Sanitizers bring their own operator new; counting is done in plain builds.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define ADIT_COUNTING_ALLOCATIONS 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define ADIT_COUNTING_ALLOCATIONS 0
-#endif
-#endif
-#ifndef ADIT_COUNTING_ALLOCATIONS
-#define ADIT_COUNTING_ALLOCATIONS 1
-#endif
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};  // test instrumentation: counts every operator new
-}
-
-#if ADIT_COUNTING_ALLOCATIONS
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return ::operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#endif
-
-#define ADIT_REQUIRE_COUNTING() \
-  if (!ADIT_COUNTING_ALLOCATIONS) GTEST_SKIP() << "allocations are counted in builds without sanitizers"
 
 namespace adit::drivers {
 namespace {
@@ -58,7 +24,7 @@ std::vector<std::vector<std::uint8_t>> payloads(const std::filesystem::path& cap
 }
 
 TEST(NoAllocation, DecodeAndAssembleAllocateNothingPerPacket) {
-  ADIT_REQUIRE_COUNTING();
+  ADIT_REQUIRE_ALLOCATION_COUNTING();
   ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-vlp16-dual");
   // Four passes over the capture, each later by the capture's length, so sensor time keeps going forward.
   const auto one_pass = payloads(dir / "capture.pcap");
@@ -85,9 +51,9 @@ TEST(NoAllocation, DecodeAndAssembleAllocateNothingPerPacket) {
   std::int64_t host = 1'673'400'471'737'000'000;
   const std::size_t warm_up = one_pass.size();
   for (std::size_t i = 0; i < warm_up; ++i) stream.push(packets[i], host += 663'000);
-  const std::uint64_t before = g_allocations.load();
+  const std::uint64_t before = adit::test::allocations();
   for (std::size_t i = warm_up; i < packets.size(); ++i) stream.push(packets[i], host += 663'000);
-  const std::uint64_t allocations = g_allocations.load() - before;
+  const std::uint64_t allocations = adit::test::allocations() - before;
   EXPECT_EQ(allocations, 0u) << "over " << packets.size() - warm_up << " packets";
   EXPECT_EQ(assembler.totals().missing_packets + assembler.totals().out_of_order_packets, 0u);
   EXPECT_GT(scans, 10u);
@@ -95,20 +61,20 @@ TEST(NoAllocation, DecodeAndAssembleAllocateNothingPerPacket) {
 }
 
 TEST(NoAllocation, ReceivingAllocatesNothing) {
-  ADIT_REQUIRE_COUNTING();
+  ADIT_REQUIRE_ALLOCATION_COUNTING();
   UdpReceiverConfig config;
   config.bind_address = "127.0.0.1";
   config.batch = 16;
   UdpReceiver receiver(config);
   UdpSender sender("127.0.0.1", receiver.port());
   const std::vector<std::uint8_t> payload(1206, 0x11);
-  const std::uint64_t before = g_allocations.load();
+  const std::uint64_t before = adit::test::allocations();
   std::uint64_t received = 0;
   for (int round = 0; round < 20; ++round) {
     for (int i = 0; i < 16; ++i) sender.send(payload);
     for (auto batch = receiver.receive(100); !batch.empty(); batch = receiver.receive(0)) received += batch.size();
   }
-  EXPECT_EQ(g_allocations.load() - before, 0u);
+  EXPECT_EQ(adit::test::allocations() - before, 0u);
   EXPECT_EQ(received, 320u);
 }
 

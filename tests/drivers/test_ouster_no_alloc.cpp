@@ -3,49 +3,18 @@
 // (Its own executable: it replaces the global operator new to count.)
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <string>
 
 #include "adit/drivers/lidar/ouster_decoder.hpp"
 #include "adit/drivers/lidar/scan_assembler.hpp"
+#include "allocation_counter.hpp"
 #include "ouster_packet_builder.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Every replaceable form, so all allocations are counted and each is freed
-// by its own kind (sanitizers check the pairing).
-namespace {
-void* counted_alloc(std::size_t size) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace adit::drivers {
 namespace {
 
 TEST(OusterDecoder, DecodingAndAssemblingAllocateNothingPerPacket) {
+  ADIT_REQUIRE_ALLOCATION_COUNTING();
   OusterMetadata m;
   m.lidar_mode = "1024x10";
   m.columns_per_frame = 1024;
@@ -81,20 +50,20 @@ TEST(OusterDecoder, DecodingAndAssemblingAllocateNothingPerPacket) {
 
   // Warm up one frame (the assembler's scans reach their reserved size).
   for (int p = 0; p < 64; ++p) (void)assembler.add(decoder.decode(packets[static_cast<std::size_t>(p)], 0));
-  const long before = g_allocations.load();
+  const std::uint64_t before = adit::test::allocations();
   int scans = 0;
   for (std::size_t p = 64; p < packets.size(); ++p) {
     scans += assembler.add(decoder.decode(packets[p], 0)) != nullptr;
     (void)decoder.decode(imu, 0);
     (void)decoder.decode(junk, 0);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(adit::test::allocations() - before, 0U);
   EXPECT_EQ(scans, 1);
   // The counter does count: a heap string bumps it.
-  const long probe_before = g_allocations.load();
+  const std::uint64_t probe_before = adit::test::allocations();
   const std::string probe(200, 'x');
   EXPECT_EQ(probe.size(), 200U);
-  EXPECT_GT(g_allocations.load(), probe_before);
+  EXPECT_GT(adit::test::allocations(), probe_before);
 }
 
 }  // namespace

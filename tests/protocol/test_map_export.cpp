@@ -3,12 +3,9 @@
 
 #include <unistd.h>
 
-#include <sstream>
-
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/map_export.hpp"
-#include "adit/protocol/trajectory_tum.hpp"
 #include "map_readers.hpp"
 
 namespace adit::protocol {
@@ -87,15 +84,6 @@ TEST(MapExport, UnwritablePathsNameTheFile) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "/nonexistent-dir/map.ply");
   }
-}
-
-TEST(TrajectoryTum, OneLinePerPoseInTumOrder) {
-  std::ostringstream out;
-  const StampedPose poses[] = {{1.5, 1, 2, 3, 0.5, 0.5, 0.5, 0.5}, {2.0, 0, 0, 0, 1, 0, 0, 0}};
-  write_tum(out, poses);
-  EXPECT_EQ(out.str(),
-            "1.500000 1.000000 2.000000 3.000000 0.500000000 0.500000000 0.500000000 0.500000000\n"
-            "2.000000 0.000000 0.000000 0.000000 0.000000000 0.000000000 0.000000000 1.000000000\n");
 }
 
 }  // namespace

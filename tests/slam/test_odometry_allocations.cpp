@@ -3,30 +3,17 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <random>
 
 #include "adit/slam/odometry.hpp"
+#include "allocation_counter.hpp"
 #include "synthetic_scenes.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};  // test instrumentation only
-}
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace adit::slam {
 namespace {
 
 TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) {
+  ADIT_REQUIRE_ALLOCATION_COUNTING();
   const auto hall = test::room(200000, 31, 20.0F, 10.0F, 4.0F);
   OdometryConfig config;
   config.max_range_m = 30.0F;
@@ -46,15 +33,15 @@ TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) {
     fill(0.1 * k);
     ASSERT_TRUE(odometry.process({k * 100'000'000LL, scan, times}).valid);
   }
-  long allocations = 0;
+  std::uint64_t allocations = 0;
   for (int k = 5; k < 15; ++k) {
     fill(0.1 * k);
-    const long before = g_allocations.load();
+    const std::uint64_t before = adit::test::allocations();
     const OdometryResult r = odometry.process({k * 100'000'000LL, scan, times});
-    allocations += g_allocations.load() - before;
+    allocations += adit::test::allocations() - before;
     ASSERT_TRUE(r.valid);
   }
-  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(allocations, 0U);
 }
 
 }  // namespace

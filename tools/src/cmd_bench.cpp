@@ -1,13 +1,13 @@
 // adit bench odometry: per-scan odometry time (median, p99), speed as a
 // multiple of real time, memory, drift against ground truth when given, and a
 // baseline (PCL GICP) on the same scans in the same run, with the ratio.
-
-#include <sys/resource.h>
+// (adit bench pipeline lives in bench_pipeline.cpp.)
 
 #include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -21,8 +21,10 @@
 #include "adit/slam/trajectory.hpp"
 #include "adit/slam/trajectory_io.hpp"
 #include "bench_baseline.hpp"
+#include "bench_pipeline.hpp"
 #include "bench_scans.hpp"
 #include "commands.hpp"
+#include "process_memory.hpp"
 
 namespace adit::tools {
 namespace {
@@ -43,20 +45,6 @@ double quantile(std::vector<double> v, double q) {
   const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return v[k];
-}
-
-double resident_mb() {
-  std::ifstream statm("/proc/self/statm");
-  long size = 0;
-  long resident = 0;
-  statm >> size >> resident;
-  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
-double peak_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 template <typename F>
@@ -134,7 +122,7 @@ int bench_odometry(const BenchOptions& o) {
              "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
              "  registration: {:.0f} points, {:.0f} iterations per scan (medians)\n",
              median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
-             peak_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5));
+             peak_resident_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5));
   if (!o.out.empty()) {
     std::ofstream out(o.out);
     slam::write_tum(out, estimate);
@@ -196,6 +184,7 @@ void register_bench_commands(CLI::App& app, int& status) {
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");
     status = bench_odometry(*o);
   });
+  add_bench_pipeline_command(*bench, status);
 }
 
 }  // namespace adit::tools

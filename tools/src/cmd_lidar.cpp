@@ -1,6 +1,7 @@
 // adit pcap-info / decode / pcap-send: LiDAR captures on the bench.
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -18,8 +19,8 @@
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/drivers/pcap_reader.hpp"
-#include "adit/drivers/pcap_replay.hpp"
 #include "adit/drivers/udp.hpp"
+#include "capture_sender.hpp"
 #include "commands.hpp"
 
 namespace adit::tools {
@@ -202,16 +203,10 @@ int decode(const DecodeOptions& o, const std::string& out_dir, const std::string
 
 int pcap_send(const std::string& file, const std::string& to, double speed, int only_port) {
   const auto [host, port] = drivers::parse_host_port(to, "--to");
-  drivers::UdpSender sender(host, port);
-  drivers::PacedPcapReader reader(file, speed);
-  UdpDatagram d;
-  std::uint64_t sent = 0;
-  while (reader.next(d)) {
-    if (only_port > 0 && d.dst_port != only_port) continue;
-    sent += sender.send(d.payload) ? 1 : 0;
-  }
-  fmt::print("sent {} datagrams to {} ({} refused)\n", sent, to, sender.failures());
-  return sender.failures() == 0 ? kExitOk : kExitFailure;
+  const std::atomic<bool> never{false};
+  const SendTotals totals = send_capture(file, host, port, speed, only_port, never);
+  fmt::print("sent {} datagrams to {} ({} refused)\n", totals.sent, to, totals.refused);
+  return totals.refused == 0 ? kExitOk : kExitFailure;
 }
 
 }  // namespace

@@ -1,0 +1,164 @@
+// adit replay and adit bench pipeline run as a user would, on a short session
+// that `adit sim` writes for this test: one pose per scan in the trajectory,
+// the pace honoured, bad captures named with exit status 2, and a capture sent
+// over UDP loopback arriving whole at the pipeline.
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "run_program.hpp"
+#include "shared_data.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using adit::test::CommandRun;
+CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
+
+// A 10 s simulated drift with a VLP-16 (about 100 scans), written once and
+// shared by the test processes (renamed into place whole, so never half-read);
+// each process writes its outputs in a folder of its own.
+class Replay : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    session_ = adit::test::binary_dir() / "test-sessions" / "replay-drift-10s";
+    if (!fs::exists(session_ / "session.yaml")) {
+      const fs::path partial = session_.string() + ".partial-" + std::to_string(::getpid());
+      const CommandRun sim = adit("sim --scene drift --platform robot --sensor VLP-16 --duration 10 --seed 7 --out " +
+                                  partial.string());
+      ASSERT_EQ(sim.status, 0) << sim.output;
+      std::error_code already_there;
+      fs::rename(partial, session_, already_there);
+      fs::remove_all(partial);
+    }
+    dir_ = adit::test::binary_dir() / "test-sessions" / ("replay-out-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static std::string config() { return " --config " + (session_ / "session.yaml").string(); }
+  static nlohmann::json json_of(const CommandRun& run) {
+    const auto start = run.output.find('{');
+    return start == std::string::npos ? nlohmann::json() : nlohmann::json::parse(run.output.substr(start), nullptr, false);
+  }
+
+  static fs::path session_;
+  static fs::path dir_;
+};
+fs::path Replay::session_;
+fs::path Replay::dir_;
+
+std::vector<double> stamps_of(const fs::path& tum) {
+  std::vector<double> stamps;
+  std::ifstream in(tum);
+  for (std::string line; std::getline(in, line);) stamps.push_back(std::stod(line));
+  return stamps;
+}
+
+TEST_F(Replay, WritesOnePosePerScanAsFastAsItCan) {
+  const fs::path out = dir_ / "replay" / "trajectory.tum";
+  const CommandRun run = adit("replay" + config() + " --out " + out.string() + " --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const nlohmann::json j = json_of(run);
+  ASSERT_TRUE(j.is_object()) << run.output;
+  const auto scans = j["scans"].get<std::uint64_t>();
+  EXPECT_GE(scans, 95U) << run.output;  // 10 s at 10 Hz
+  EXPECT_EQ(j["poses"].get<std::uint64_t>(), scans);
+  EXPECT_EQ(j["invalid_poses"].get<std::uint64_t>(), 0U);
+  EXPECT_EQ(j["dropped_packets"].get<std::uint64_t>(), 0U);
+  EXPECT_EQ(j["dropped_scans"].get<std::uint64_t>(), 0U);
+  EXPECT_GT(j["speed"].get<double>(), 0.0);
+  EXPECT_GT(j["odometry_ms"]["median"].get<double>(), 0.0);
+  EXPECT_GE(j["odometry_ms"]["p99"].get<double>(), j["odometry_ms"]["median"].get<double>());
+  EXPECT_GT(j["peak_resident_mb"].get<double>(), 0.0);
+  EXPECT_TRUE(j.contains("resident_growth")) << run.output;
+
+  const std::vector<double> stamps = stamps_of(out);
+  ASSERT_EQ(stamps.size(), scans);
+  for (std::size_t i = 1; i < stamps.size(); ++i) EXPECT_GT(stamps[i], stamps[i - 1]) << "line " << i + 1;
+}
+
+TEST_F(Replay, PrintsTheFiguresForPeople) {
+  const CommandRun run = adit("replay" + config() + " --pcap " + (session_ / "lidar.pcap").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* figure : {"scans ", "odometry per scan: median", "latency", "x real time", "peak resident"})
+    EXPECT_NE(run.output.find(figure), std::string::npos) << figure << " in\n" << run.output;
+}
+
+TEST_F(Replay, HonoursTheRequestedPace) {
+  const CommandRun run = adit("replay" + config() + " --speed 4 --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const nlohmann::json j = json_of(run);
+  const double span = j["sensor_span_s"].get<double>();
+  EXPECT_GT(span, 9.0);
+  EXPECT_GE(j["duration_s"].get<double>(), 0.95 * span / 4.0) << run.output;
+  EXPECT_EQ(adit("replay" + config() + " --realtime --speed 2").status, 2);
+}
+
+TEST_F(Replay, ReplaysADirectoryOfScans) {
+  const fs::path scans = dir_ / "scans";
+  const CommandRun decode = adit("decode " + (session_ / "lidar.pcap").string() + " --calibration " +
+                                 (session_ / "VLP16.yaml").string() + " --out " + scans.string());
+  ASSERT_EQ(decode.status, 0) << decode.output;
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(scans)) files += entry.path().extension() == ".pcd";
+  ASSERT_GE(files, 95U);
+  const fs::path out = dir_ / "scan-dir.tum";
+  const CommandRun run = adit("replay" + config() + " --scan-dir " + scans.string() + " --out " + out.string() + " --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(json_of(run)["poses"].get<std::size_t>(), files);
+  EXPECT_EQ(stamps_of(out).size(), files);
+  const CommandRun paced = adit("replay" + config() + " --scan-dir " + scans.string() + " --realtime");
+  EXPECT_EQ(paced.status, 2) << paced.output;
+  EXPECT_NE(paced.output.find("--realtime"), std::string::npos) << paced.output;
+}
+
+TEST_F(Replay, AMissingOrCorruptCaptureIsNamedWithStatus2) {
+  const fs::path missing = dir_ / "no-such.pcap";
+  const CommandRun run = adit("replay" + config() + " --pcap " + missing.string());
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find(missing.string()), std::string::npos) << run.output;
+
+  const fs::path corrupt = dir_ / "corrupt.pcap";
+  std::ofstream(corrupt) << "this is not a capture file, just text long enough to hold a pcap header";
+  const CommandRun bad = adit("replay" + config() + " --pcap " + corrupt.string());
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find(corrupt.string()), std::string::npos) << bad.output;
+  EXPECT_EQ(bad.output.find("scans "), std::string::npos) << "no figures after an error";
+
+  EXPECT_EQ(adit("replay --config " + (dir_ / "none.yaml").string()).status, 2);
+  EXPECT_EQ(adit("replay" + config() + " --pcap a.pcap --scan-dir b").status, 2);
+}
+
+TEST_F(Replay, BenchPipelineReceivesTheWholeCaptureOverLoopback) {
+  const CommandRun run = adit("bench pipeline" + config() + " --speed 4 --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const nlohmann::json j = json_of(run);
+  ASSERT_TRUE(j.is_object()) << run.output;
+  const nlohmann::json& file = j["file"];
+  const nlohmann::json& udp = j["udp"];
+  EXPECT_GT(udp["sent"].get<std::uint64_t>(), 1000U);
+  EXPECT_EQ(udp["lost"].get<std::uint64_t>(), 0U) << run.output;
+  EXPECT_EQ(udp["datagrams"].get<std::uint64_t>(), udp["sent"].get<std::uint64_t>());
+  // Live, the last scan is never cut (no packet of the next revolution follows
+  // it), and a busy machine may drop scans odometry cannot keep up with: each
+  // is counted, every other one becomes a pose.
+  EXPECT_GE(udp["scans"].get<std::uint64_t>() + 1, file["scans"].get<std::uint64_t>()) << run.output;
+  EXPECT_EQ(udp["poses"].get<std::uint64_t>() + udp["dropped_scans"].get<std::uint64_t>(), udp["scans"].get<std::uint64_t>());
+  EXPECT_EQ(file["poses"].get<std::uint64_t>(), file["scans"].get<std::uint64_t>());
+  EXPECT_GT(udp["latency_ms"]["p99"].get<double>(), 0.0);
+  EXPECT_GE(udp["latency_ms"]["max"].get<double>(), udp["latency_ms"]["p99"].get<double>());
+  // Latency covers the scan's odometry: paired per scan, the rest is never negative.
+  EXPECT_GE(file["latency_beyond_odometry_ms"]["median"].get<double>(), 0.0);
+  EXPECT_GE(udp["latency_beyond_odometry_ms"]["median"].get<double>(), 0.0);
+}
+
+}  // namespace

@@ -1,0 +1,77 @@
+// adit replay: aditd's packet-to-pose pipeline on a capture or a directory of
+// scans, as fast as possible or at a chosen pace; writes the trajectory and
+// prints the pipeline's figures (counters, odometry time, latency, memory).
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/daemon/pipeline.hpp"
+#include "commands.hpp"
+#include "pipeline_run.hpp"
+
+namespace adit::tools {
+namespace {
+
+struct ReplayOptions {
+  PipelineInputs inputs;
+  std::string out;
+  bool realtime = false;
+  double speed = 0.0;  // × real time; 0 = as fast as possible
+  bool json = false;
+  double memory_from = 0.1;
+};
+
+const std::string& source_of(const config::Config& c) {
+  return c.lidar.source == config::LidarSource::scan_dir ? c.lidar.scan_dir : c.lidar.pcap;
+}
+
+int replay(const ReplayOptions& o) {
+  const config::Config config = load_pipeline_config(o.inputs);
+  if (config.lidar.source == config::LidarSource::scan_dir && (o.realtime || o.speed > 0.0))
+    throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
+                     "a scan directory is replayed as fast as possible (the pipeline does not pace it)");
+  daemon::PipelineOptions options;
+  options.trajectory_file = o.out;
+  options.replay_speed = o.realtime ? 1.0 : o.speed;
+  daemon::Pipeline pipeline(config, options);
+  const PipelineFigures figures = run_pipeline(pipeline);
+  for (const std::string& warning : pipeline.warnings()) fmt::print(stderr, "adit replay: {}\n", warning);
+  if (o.json) {
+    nlohmann::json j = figures_json(figures, o.memory_from);
+    j["trajectory"] = o.out;
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("replay of {} ({})\n{}", source_of(config), config.lidar.model, figures_text(figures, o.memory_from));
+    if (!o.out.empty()) fmt::print("trajectory: {} ({} poses)\n", o.out, figures.poses - figures.invalid_poses);
+  }
+  if (figures.scans == 0) throw InputError(source_of(config), "lidar.model", "no scans decoded: is it a " + config.lidar.model + " capture?");
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_replay_commands(CLI::App& app, int& status) {
+  auto o = std::make_shared<ReplayOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "replay", "Run aditd's pipeline on a capture or a scan directory: trajectory, counters, timing, latency, memory");
+  cmd->add_option("--config", o->inputs.config_file, "Payload configuration (YAML) giving the lidar section")
+      ->capture_default_str();
+  auto* pcap = cmd->add_option("--pcap", o->inputs.pcap, "Capture to replay (sets lidar.source: pcap)");
+  auto* scans = cmd->add_option("--scan-dir", o->inputs.scan_dir, "Directory of PCD or KITTI .bin scans (lidar.source: scan_dir)");
+  pcap->excludes(scans);
+  cmd->add_option("--model", o->inputs.model, "Override lidar.model (VLP-16, PandarXT32, OS1-64, ...)");
+  cmd->add_option("--calibration", o->inputs.calibration, "Override lidar.calibration");
+  cmd->add_option("--out", o->out, "Write the trajectory here (TUM: one line per valid pose)");
+  auto* realtime = cmd->add_flag("--realtime", o->realtime, "Replay at the recorded rate (default: as fast as possible)");
+  auto* speed = cmd->add_option("--speed", o->speed, "Replay at X times the recorded rate; 0 = as fast as possible")
+                    ->check(CLI::Range(0.0, 1e6));
+  realtime->excludes(speed);
+  cmd->add_flag("--json", o->json, "Print the figures as JSON (for scripts)");
+  cmd->add_option("--memory-from", o->memory_from,
+                  "Resident growth is measured from this fraction of the poses (local map full) to the end")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->callback([o, &status] { status = replay(*o); });
+}
+
+}  // namespace adit::tools
