@@ -22,8 +22,9 @@ SpinningSensor make_spinning_sensor(std::string_view model) {
   if (model == "VLP-16") return velodyne_vlp16_sensor();
   if (model == "RS-16") return robosense_rs16_sensor();
   if (model == "PandarXT32") return hesai_xt32_sensor();
+  if (model == "OS1-64") return ouster_os1_64_sensor();
   throw InputError("adit sim", "--sensor",
-                   "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32)");
+                   "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32, OS1-64)");
 }
 
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
@@ -38,6 +39,9 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
   const auto packets = static_cast<std::uint64_t>(body.duration() * 1e9 / static_cast<double>(sensor.packet_period_ns));
   const double turn_per_s = 2.0 * std::numbers::pi * o.rpm / 60.0;  // rad/s, clockwise seen from above
   const auto head = [&](double t) { return std::fmod(t * turn_per_s, 2.0 * std::numbers::pi); };
+  const std::size_t channels = sensor.channels;
+  const std::size_t firings = sensor.blocks * channels;
+  const Eigen::Isometry3d mount = o.extrinsics * sensor.lidar_to_sensor;  // the beams' frame in the body
 
   // One packet, a pure function of its index.
   const auto simulate_packet = [&](std::uint64_t k, SpinningPacket& packet, std::uint64_t& returns) {
@@ -52,19 +56,19 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
     Eigen::Isometry3d pose0 = Eigen::Isometry3d::Identity();
     Eigen::Isometry3d pose1 = Eigen::Isometry3d::Identity();
     double t0 = 0.0, t_span = 1.0;
-    for (std::size_t i = 0; i < sensor.blocks * kChannels; ++i) {
+    for (std::size_t i = 0; i < firings; ++i) {
       const double t = static_cast<double>(packet_ns + sensor.firing_ns[i]) * 1e-9;
-      if (i % kChannels == 0) {
+      if (i % channels == 0) {
         block_head = head(t);
-        packet.azimuth[i / kChannels] =
+        packet.azimuth[i / channels] =
             static_cast<std::uint16_t>(std::lround(block_head * 18000.0 / std::numbers::pi) % 36000);
         const auto first = sensor.firing_ns.begin() + static_cast<std::ptrdiff_t>(i);
-        const std::int64_t last_ns = *std::max_element(first, first + kChannels);
+        const std::int64_t last_ns = *std::max_element(first, first + static_cast<std::ptrdiff_t>(channels));
         t0 = t;
         const double t1 = static_cast<double>(packet_ns + last_ns) * 1e-9;
         t_span = std::max(t1 - t0, 1e-12);
-        pose0 = body.pose(t0) * o.extrinsics;
-        pose1 = body.pose(t1) * o.extrinsics;
+        pose0 = body.pose(t0) * mount;
+        pose1 = body.pose(t1) * mount;
       }
       const double a = sensor.block_azimuth ? block_head : head(t);
       packet.range_m[i] = 0.0;
@@ -87,7 +91,7 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
         const Hit person = people.intersect(origin, dir, 0.0F, hit.valid() ? hit.distance : far, t);
         if (person.valid()) hit = person;
       }
-      const Return r = measure(o.effects, o.seed, k * kFirings + i, hit, origin, dir, mesh, targets);
+      const Return r = measure(o.effects, o.seed, k * firings + i, hit, origin, dir, mesh, targets);
       if (!r.valid || r.range_m > sensor.max_range_m) continue;
       packet.range_m[i] = r.range_m;
       packet.reflectivity[i] = r.reflectivity;
@@ -104,7 +108,7 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
   endpoints.src_port = sensor.port;
   endpoints.dst_port = sensor.port;
   const std::int64_t last_firing =
-      *std::max_element(sensor.firing_ns.begin(), sensor.firing_ns.begin() + static_cast<std::ptrdiff_t>(sensor.blocks * kChannels));
+      *std::max_element(sensor.firing_ns.begin(), sensor.firing_ns.begin() + static_cast<std::ptrdiff_t>(firings));
   for (std::uint64_t first = 0; first < packets; first += kChunk) {
     const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, packets - first));
     {
@@ -124,7 +128,7 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajec
     }
     stats.packets += n;
   }
-  stats.rays = stats.packets * sensor.blocks * kChannels;
+  stats.rays = stats.packets * firings;
   for (const std::uint64_t r : returns) stats.returns += r;
   return stats;
 }
