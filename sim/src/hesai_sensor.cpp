@@ -8,6 +8,7 @@
 
 #include "adit/drivers/lidar/hesai_encoder.hpp"
 #include "adit/sim/spinning_lidar.hpp"
+#include "block_packet.hpp"
 
 namespace adit::sim {
 
@@ -25,9 +26,9 @@ SpinningSensor hesai_xt32_sensor() {
   // `first` after the packet's timestamp (negative: the timestamp comes later).
   const std::int32_t first = hesai_firing_ns(model, 1, 0, 0, 0);
   for (std::size_t b = 0; b < s.blocks; ++b) {
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      s.firing_ns[b * kChannels + c] = hesai_firing_ns(model, 1, 0, b, c) - first;
-      s.beam[b * kChannels + c] = static_cast<std::uint16_t>(c);
+    for (std::size_t c = 0; c < kBlockChannels; ++c) {
+      s.firing_ns[b * kBlockChannels + c] = hesai_firing_ns(model, 1, 0, b, c) - first;
+      s.beam[b * kBlockChannels + c] = static_cast<std::uint16_t>(c);
     }
   }
   s.packet_period_ns = static_cast<std::int64_t>(s.blocks) *
@@ -44,10 +45,9 @@ SpinningSensor hesai_xt32_sensor() {
     p.sequence = static_cast<std::uint32_t>(in.index);
     for (std::size_t b = 0; b < p.azimuth.size(); ++b) {
       p.azimuth[b] = in.azimuth[b];
-      for (std::size_t c = 0; c < kChannels; ++c) {
-        const double r = in.range_m[b * kChannels + c];
-        p.distance[b * kChannels + c] = static_cast<std::uint16_t>(r > 0 ? std::lround(r / unit) : 0);
-        p.reflectivity[b * kChannels + c] = in.reflectivity[b * kChannels + c];
+      for (std::size_t c = 0; c < kBlockChannels; ++c) {
+        p.distance[b * kBlockChannels + c] = range_counts(in.range_m[b * kBlockChannels + c], unit);
+        p.reflectivity[b * kBlockChannels + c] = in.reflectivity[b * kBlockChannels + c];
       }
     }
     encode_hesai_xt32_packet(p, out.first<kHesaiXt32PacketSize>());

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace adit::sim {
@@ -62,6 +63,45 @@ Hit RayCaster::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& d
   hit.triangle = rh.hit.primID;
   hit.normal = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
   return hit;
+}
+
+void RayCaster::intersect(std::span<const Eigen::Vector3f> origins, std::span<const Eigen::Vector3f> directions,
+                          float near_m, float far_m, std::span<Hit> hits) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  RTCRayHit16 rh;
+  alignas(64) int valid[kPacket];
+  for (std::size_t first = 0; first < origins.size(); first += kPacket) {
+    const std::size_t n = std::min(kPacket, origins.size() - first);
+    for (std::size_t i = 0; i < kPacket; ++i) {
+      valid[i] = i < n ? -1 : 0;
+      const std::size_t k = first + std::min(i, n - 1);  // inactive lanes copy a valid ray
+      rh.ray.org_x[i] = origins[k].x();
+      rh.ray.org_y[i] = origins[k].y();
+      rh.ray.org_z[i] = origins[k].z();
+      rh.ray.dir_x[i] = directions[k].x();
+      rh.ray.dir_y[i] = directions[k].y();
+      rh.ray.dir_z[i] = directions[k].z();
+      rh.ray.tnear[i] = near_m;
+      rh.ray.tfar[i] = far_m;
+      rh.ray.time[i] = 0.0F;
+      rh.ray.mask[i] = 0xFFFFFFFFu;
+      rh.ray.id[i] = static_cast<unsigned>(i);
+      rh.ray.flags[i] = 0;
+      rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, static_cast<RTCScene>(scene_), &context, &rh);
+    for (std::size_t i = 0; i < n; ++i) {
+      Hit& hit = hits[first + i];
+      hit = Hit{};
+      if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+      hit.distance = rh.ray.tfar[i];
+      hit.triangle = rh.hit.primID[i];
+      hit.normal = Eigen::Vector3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]).normalized();
+    }
+  }
 }
 
 }  // namespace adit::sim

@@ -6,6 +6,7 @@
 
 #include "adit/drivers/lidar/robosense_encoder.hpp"
 #include "adit/sim/spinning_lidar.hpp"
+#include "block_packet.hpp"
 
 namespace adit::sim {
 
@@ -18,12 +19,12 @@ SpinningSensor robosense_rs16_sensor() {
   s.port = 6699;
   s.packet_size = kRoboSenseMsopSize;
   const auto block_ns = std::llround(2.0 * robosense_sequence_us(model) * 1000.0);
-  s.packet_period_ns = static_cast<std::int64_t>(kBlocks) * block_ns;
+  s.packet_period_ns = static_cast<std::int64_t>(s.blocks) * block_ns;
   const auto firing = robosense_firing_us(model);
-  for (std::size_t b = 0; b < kBlocks; ++b) {
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      s.firing_ns[b * kChannels + c] = static_cast<std::int64_t>(b) * block_ns + std::llround(firing[c] * 1000.0);
-      s.beam[b * kChannels + c] = static_cast<std::uint16_t>(c % 16);
+  for (std::size_t b = 0; b < s.blocks; ++b) {
+    for (std::size_t c = 0; c < kBlockChannels; ++c) {
+      s.firing_ns[b * kBlockChannels + c] = static_cast<std::int64_t>(b) * block_ns + std::llround(firing[c] * 1000.0);
+      s.beam[b * kBlockChannels + c] = static_cast<std::uint16_t>(c % 16);
     }
   }
   const double deg = std::numbers::pi / 180.0;
@@ -36,14 +37,7 @@ SpinningSensor robosense_rs16_sensor() {
   s.encode = [unit](const SpinningPacket& in, std::span<std::uint8_t> out) {
     RoboSenseMsop p;
     p.time_ns = in.time_ns;
-    for (std::size_t b = 0; b < kBlocks; ++b) {
-      p.blocks[b].azimuth = in.azimuth[b];
-      for (std::size_t c = 0; c < kChannels; ++c) {
-        const double r = in.range_m[b * kChannels + c];
-        p.blocks[b].distance[c] = static_cast<std::uint16_t>(r > 0 ? std::lround(r / unit) : 0);
-        p.blocks[b].reflectivity[c] = in.reflectivity[b * kChannels + c];
-      }
-    }
+    copy_blocks(in, unit, p.blocks);
     encode_robosense_msop(RoboSenseModel::rs16, p, out.first<kRoboSenseMsopSize>());
   };
   s.calibration_file = "RS16.csv";

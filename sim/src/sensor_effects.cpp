@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "adit/sim/hash_noise.hpp"
 
 namespace adit::sim {
 namespace {
@@ -11,12 +10,14 @@ constexpr std::uint64_t kRangeStream = 0x52616E6765ULL;
 constexpr std::uint64_t kDropStream = 0x44726F70ULL;
 }  // namespace
 
-Return measure(const SensorEffects& e, std::uint64_t seed, std::uint64_t ray, const Hit& hit,
+SensorNoise::SensorNoise(std::uint64_t seed) : range(seed, kRangeStream), drop(seed, kDropStream) {}
+
+Return measure(const SensorEffects& e, const SensorNoise& noise, std::uint64_t ray, const Hit& hit,
                const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, const TriangleMesh& mesh,
                std::span<const Target> targets) {
   Return r;
-  if (!hit.valid() || uniform(seed, kDropStream, ray) < e.dropout) return r;
-  const double range = hit.distance + e.range_sigma_m * gaussian(seed, kRangeStream, ray);
+  if (!hit.valid() || noise.drop.uniform(ray) < e.dropout) return r;
+  const double range = hit.distance + e.range_sigma_m * noise.range.gaussian(ray);
   if (range < e.min_range_m || range > e.max_range_m) return r;
   r.valid = true;
   r.range_m = range;

@@ -65,7 +65,7 @@ void validate(const SimOptions& o) {
           "unknown scene '" + o.scene + "' (mine, drift, building)");
   require(o.platform == "robot" || o.platform == "drone", "--platform",
           "unknown platform '" + o.platform + "' (robot, drone)");
-  make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
+  const SpinningSensor sensor = make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
   const double shortest = is_drone(o) ? drone_min_duration_s() : robot_min_duration_s();
   require(std::isfinite(o.duration_s) && o.duration_s >= shortest && o.duration_s <= 7200.0, "--duration",
           "must be between " + std::to_string(shortest) + " and 7200 s for the " + o.platform);
@@ -76,6 +76,9 @@ void validate(const SimOptions& o) {
   require(std::isfinite(o.max_range_m) && o.max_range_m > o.min_range_m && o.max_range_m <= 130.0, "--max-range-m",
           "must exceed --min-range-m and be at most 130 m (the VLP-16's 16-bit range field)");
   require(std::isfinite(o.rpm) && o.rpm >= 300.0 && o.rpm <= 1200.0, "--rpm", "the VLP-16 turns at 300-1200 rpm");
+  require(sensor.fixed_rpm == 0.0 || o.rpm == sensor.fixed_rpm, "--rpm",
+          "the " + sensor.model + " turns at " + std::to_string(static_cast<int>(sensor.fixed_rpm)) +
+              " rpm in its simulated lidar mode");
   const double fastest = is_drone(o) ? DronePathOptions::kMaxSpeed : RobotPathOptions::kMaxSpeed;
   require(std::isfinite(o.speed_mps) && o.speed_mps > 0.0 && o.speed_mps <= fastest, "--speed",
           "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s");

@@ -4,6 +4,7 @@
 
 #include "adit/drivers/lidar/velodyne_encoder.hpp"
 #include "adit/sim/spinning_lidar.hpp"
+#include "block_packet.hpp"
 
 namespace adit::sim {
 
@@ -17,11 +18,11 @@ SpinningSensor velodyne_vlp16_sensor() {
   s.packet_size = kVelodyneDataPacketSize;
   s.packet_period_ns = velodyne_packet_period_ns(model, VelodyneReturnMode::strongest);
   const std::size_t per_group = velodyne_blocks_per_group(model);
-  for (std::size_t b = 0; b < kBlocks; ++b) {
-    for (std::size_t c = 0; c < kChannels; ++c) {
+  for (std::size_t b = 0; b < s.blocks; ++b) {
+    for (std::size_t c = 0; c < kBlockChannels; ++c) {
       const VelodyneFiring f = velodyne_firing(model, b % per_group, c);
-      s.firing_ns[b * kChannels + c] = static_cast<std::int64_t>(b / per_group) * velodyne_group_ns(model) + f.time_ns;
-      s.beam[b * kChannels + c] = f.laser;
+      s.firing_ns[b * kBlockChannels + c] = static_cast<std::int64_t>(b / per_group) * velodyne_group_ns(model) + f.time_ns;
+      s.beam[b * kBlockChannels + c] = f.laser;
     }
   }
   for (const VelodyneLaser& l : calibration.lasers) {
@@ -33,14 +34,7 @@ SpinningSensor velodyne_vlp16_sensor() {
   s.encode = [unit](const SpinningPacket& in, std::span<std::uint8_t> out) {
     VelodyneDataPacket p;
     p.us_past_hour = static_cast<std::uint32_t>((in.time_ns / 1000) % 3'600'000'000LL);
-    for (std::size_t b = 0; b < kBlocks; ++b) {
-      p.blocks[b].azimuth = in.azimuth[b];
-      for (std::size_t c = 0; c < kChannels; ++c) {
-        const double r = in.range_m[b * kChannels + c];
-        p.blocks[b].distance[c] = static_cast<std::uint16_t>(r > 0 ? std::lround(r / unit) : 0);
-        p.blocks[b].reflectivity[c] = in.reflectivity[b * kChannels + c];
-      }
-    }
+    copy_blocks(in, unit, p.blocks);
     encode_velodyne_packet(VelodyneModel::vlp16, p, out.first<kVelodyneDataPacketSize>());
   };
   s.calibration_file = "VLP16.yaml";

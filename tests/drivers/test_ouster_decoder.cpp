@@ -6,12 +6,10 @@
 #include <random>
 
 #include "adit/drivers/lidar/ouster_decoder.hpp"
-#include "ouster_packet_builder.hpp"
+#include "adit/drivers/lidar/ouster_encoder.hpp"
 
 namespace adit::drivers {
 namespace {
-
-using test::OusterPacketBuilder;
 
 // A 4-beam, 1024-column sensor with simple geometry.
 OusterMetadata simple_metadata(OusterProfile profile) {
@@ -45,7 +43,8 @@ class OusterProfiles : public ::testing::TestWithParam<OusterProfile> {};
 TEST_P(OusterProfiles, DecodesFieldsGeometryTimeAndSequence) {
   const OusterMetadata m = simple_metadata(GetParam());
   OusterDecoder decoder(m);
-  OusterPacketBuilder b(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
   b.frame_id(5);
   for (int c = 0; c < 16; ++c) b.column_header(c, 1'000'000 + 1000 * c, static_cast<std::uint16_t>(256 + c));
   // Column 0 (mid 256: a quarter turn), beam 3 (altitude 0) and beam 0 (30°).
@@ -85,7 +84,8 @@ INSTANTIATE_TEST_SUITE_P(AllProfiles, OusterProfiles,
 TEST(OusterDecoder, DualProfileGivesTwoReturnsPerPixel) {
   const OusterMetadata m = simple_metadata(OusterProfile::rng19_rfl8_sig16_nir16_dual);
   OusterDecoder decoder(m);
-  OusterPacketBuilder b(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
   for (int c = 0; c < 16; ++c) b.column_header(c, 10, static_cast<std::uint16_t>(c));
   b.pixel(2, 1, 5000, 50, 400, 7);
   b.pixel_bytes(2, 1, 4, 7000, 3).pixel_bytes(2, 1, 7, 60, 1).pixel_bytes(2, 1, 10, 900, 2);  // second return
@@ -114,7 +114,8 @@ TEST(OusterDecoder, SensorTransformAndBeamOriginFollowTheManual) {
   m.beam_to_lidar[3] = 12.0;
   m.lidar_to_sensor = {-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 36.18, 0, 0, 0, 1};
   OusterDecoder decoder(m);
-  OusterPacketBuilder b(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
   for (int c = 0; c < 16; ++c) b.column_header(c, 10, static_cast<std::uint16_t>(c));
   b.pixel(0, 0, 1000, 1, 1, 1);  // mid 0, altitude 30°
   const DecodedPacket p = decoder.decode(b.bytes(), 0);
@@ -129,7 +130,8 @@ TEST(OusterDecoder, SensorTransformAndBeamOriginFollowTheManual) {
 TEST(OusterDecoder, InvalidColumnsAndZeroRangesGiveNoPoints) {
   const OusterMetadata m = simple_metadata(OusterProfile::rng19_rfl8_sig16_nir16);
   OusterDecoder decoder(m);
-  OusterPacketBuilder b(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
   for (int c = 0; c < 16; ++c) b.column_header(c, 10, static_cast<std::uint16_t>(c), /*valid=*/c != 3);
   b.pixel(3, 0, 1000, 1, 1, 1).pixel(4, 0, 1000, 1, 1, 1);
   const DecodedPacket p = decoder.decode(b.bytes(), 0);
@@ -143,7 +145,8 @@ TEST(OusterDecoder, RangeInMetresGivesBackTheExactMillimetres) {
   OusterDecoder decoder(m);
   std::mt19937 rng(7);
   for (int i = 0; i < 200; ++i) {
-    OusterPacketBuilder b(OusterPacketLayout::of(m));
+    std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+    OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
     for (int c = 0; c < 16; ++c) b.column_header(c, 10, static_cast<std::uint16_t>(c));
     const std::uint32_t mm = i == 0 ? 0xFFFFFU : (rng() & 0xFFFFFU) | 1U;  // up to the 20-bit maximum
     b.pixel(0, 0, mm, 1, 1, 1);
@@ -184,9 +187,10 @@ TEST(OusterDecoder, ImuPacketsAreDecodedToSi) {
 TEST(OusterDecoder, TruncatedForeignAndMalformedPacketsAreRejected) {
   const OusterMetadata m = simple_metadata(OusterProfile::rng19_rfl8_sig16_nir16);
   OusterDecoder decoder(m);
-  OusterPacketBuilder b(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> b_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder b(OusterPacketLayout::of(m), b_packet);
   for (int c = 0; c < 16; ++c) b.column_header(c, 10, static_cast<std::uint16_t>(c));
-  const auto& good = b.bytes();
+  const std::vector<std::uint8_t>& good = b_packet;
 
   std::vector<std::uint8_t> cut(good.begin(), good.end() - 1);
   EXPECT_EQ(decoder.decode(cut, 0).status, PacketStatus::truncated);
@@ -199,7 +203,8 @@ TEST(OusterDecoder, TruncatedForeignAndMalformedPacketsAreRejected) {
   other_type[0] = 2;
   EXPECT_EQ(decoder.decode(other_type, 0).status, PacketStatus::foreign);
 
-  OusterPacketBuilder bad(OusterPacketLayout::of(m));
+  std::vector<std::uint8_t> bad_packet(OusterPacketLayout::of(m).packet_bytes);
+  OusterPacketEncoder bad(OusterPacketLayout::of(m), bad_packet);
   for (int c = 0; c < 16; ++c) bad.column_header(c, 10, 5000);  // beyond 1024 columns
   EXPECT_EQ(decoder.decode(bad.bytes(), 0).status, PacketStatus::malformed);
   EXPECT_EQ(decoder.counters().lidar_packets, 0U);

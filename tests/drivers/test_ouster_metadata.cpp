@@ -4,6 +4,7 @@
 #include <string>
 
 #include "adit/common/error.hpp"
+#include "adit/drivers/lidar/ouster_encoder.hpp"
 #include "adit/drivers/lidar/ouster_metadata.hpp"
 #include "shared_data.hpp"
 
@@ -111,6 +112,24 @@ TEST(OusterMetadataRealData, CaptureMetadataFields) {
 
   const auto window = load_ouster_metadata(dir / "metadata/2_5_0_os-992146000760-128_legacy.json");
   EXPECT_EQ(window.column_window, (std::array<int, 2>{912, 1022}));
+}
+
+// The nominal angles and destaggering are those of a real unit to within its
+// unit-to-unit spread.
+TEST(OusterMetadataRealData, SimulatorsNominalOs164IsCloseToARealOne) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/ouster/metadata");
+  const OusterMetadata real = load_ouster_metadata(dir / "2_1_2_os1-991913000010-64_legacy.json");
+  const OusterMetadata m = ouster_os1_64_nominal_metadata();
+  ASSERT_EQ(real.pixels_per_column, m.pixels_per_column);
+  EXPECT_EQ(real.lidar_mode, m.lidar_mode);
+  EXPECT_DOUBLE_EQ(real.lidar_origin_to_beam_origin_mm, m.lidar_origin_to_beam_origin_mm);
+  EXPECT_EQ(real.lidar_to_sensor, m.lidar_to_sensor);
+  for (std::size_t i = 0; i < m.beam_altitude_deg.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_NEAR(m.beam_altitude_deg[i], real.beam_altitude_deg[i], 0.2);
+    EXPECT_NEAR(m.beam_azimuth_deg[i], real.beam_azimuth_deg[i], 0.35);
+    EXPECT_NEAR(m.pixel_shift_by_row[i], real.pixel_shift_by_row[i], 1);
+  }
 }
 
 TEST(OusterMetadata, Firmware112DefaultsApplyWhenDataFormatIsMissing) {

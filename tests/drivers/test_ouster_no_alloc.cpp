@@ -6,9 +6,9 @@
 #include <string>
 
 #include "adit/drivers/lidar/ouster_decoder.hpp"
+#include "adit/drivers/lidar/ouster_encoder.hpp"
 #include "adit/drivers/lidar/scan_assembler.hpp"
 #include "allocation_counter.hpp"
-#include "ouster_packet_builder.hpp"
 
 namespace adit::drivers {
 namespace {
@@ -36,14 +36,15 @@ TEST(OusterDecoder, DecodingAndAssemblingAllocateNothingPerPacket) {
   std::vector<std::vector<std::uint8_t>> packets;
   for (std::uint16_t frame = 0; frame < 2; ++frame)
     for (int p = 0; p < 64; ++p) {
-      test::OusterPacketBuilder b(decoder.layout());
+      std::vector<std::uint8_t> packet(decoder.layout().packet_bytes);
+      OusterPacketEncoder b(decoder.layout(), packet);
       b.frame_id(frame);
       for (int c = 0; c < 16; ++c) {
         const auto mid = static_cast<std::uint16_t>(p * 16 + c);
         b.column_header(c, 1'000'000'000ULL * frame + 97'656ULL * mid, mid);
         for (int row = 0; row < 64; ++row) b.pixel(c, row, 1000 + row, 10, 20, 30);
       }
-      packets.push_back(b.bytes());
+      packets.push_back(packet);
     }
   const std::vector<std::uint8_t> imu(48, 0);
   const std::vector<std::uint8_t> junk(100, 0xAB);

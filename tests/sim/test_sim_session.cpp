@@ -50,6 +50,27 @@ TEST(SimSession, SameSeedAndOptionsGiveIdenticalFilesWhateverTheThreads) {
   EXPECT_NE(slurp(a.out / "scene.ply"), slurp(c.out / "scene.ply"));
 }
 
+// The OS1-64 too: its pcap and metadata are the same bytes on 1 and 2 threads.
+TEST(SimSession, Os164IsDeterministicWhateverTheThreads) {
+  SimOptions a = test::short_session("same-os1-a");
+  a.sensor = "OS1-64";
+  a.wheels = false;
+  a.threads = 1;
+  SimOptions b = a;
+  b.out = test::short_session("same-os1-b").out;
+  b.threads = 2;
+  run_simulation(a);
+  run_simulation(b);
+  for (const char* name : {"lidar.pcap", "OS1-64.json", "session.yaml"}) {
+    const std::string mine = slurp(a.out / name);
+    EXPECT_FALSE(mine.empty()) << name;
+    EXPECT_TRUE(mine == slurp(b.out / name)) << name << " differs";
+  }
+  const auto config = config::load_config(a.out / "session.yaml");
+  EXPECT_EQ(config.lidar.model, "OS1-64");
+  EXPECT_TRUE(config.lidar.calibration.ends_with("OS1-64.json"));
+}
+
 struct WheelTruthRow {
   double t, left, right;
 };
@@ -145,6 +166,10 @@ TEST(SimSession, ImpossibleOptionsAreRejectedBeforeAnyWork) {
   bad = o;
   bad.sensor = "HDL-64E";
   expect_rejected(bad, "--sensor");
+  bad = o;
+  bad.sensor = "OS1-64";
+  bad.rpm = 1200;  // its simulated mode is 1024x10
+  expect_rejected(bad, "--rpm");
   bad = o;
   bad.scene = "moon";
   expect_rejected(bad, "--scene");

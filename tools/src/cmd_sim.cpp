@@ -16,7 +16,7 @@ void register_sim_commands(CLI::App& app, int& status) {
   cmd->add_option("--scene", o->scene, "Scene: mine (drift loop, junctions, stope), drift (straight, featureless 200 m) or building (office floor; writes bim.ply)")
       ->capture_default_str();
   cmd->add_option("--platform", o->platform, "Platform: robot (differential drive, wheel encoders on CAN) or drone (6-DoF multirotor)")->capture_default_str();
-  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16, RS-16 or PandarXT32")->capture_default_str();
+  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16, RS-16, PandarXT32 or OS1-64 (1024x10, LEGACY profile, 600 rpm)")->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Session length, seconds")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed: the same seed and options give byte-identical files")->capture_default_str();
   cmd->add_option("--out", *out, "Output folder (created)")->required();

@@ -23,15 +23,32 @@ constexpr std::uint64_t hash3(std::uint64_t seed, std::uint64_t stream, std::uin
   return mix64(mix64(mix64(seed) ^ stream) ^ index);
 }
 
-// Uniform in [0, 1) with 53 random bits.
+// The draws of one (seed, stream) with its key mixed once: for hot loops, one
+// mix64 per draw instead of three, the same numbers as the free functions.
+class NoiseStream {
+ public:
+  constexpr NoiseStream(std::uint64_t seed, std::uint64_t stream) : key_(mix64(mix64(seed) ^ stream)) {}
+
+  // Uniform in [0, 1) with 53 random bits.
+  constexpr double uniform(std::uint64_t index) const {
+    return static_cast<double>(mix64(key_ ^ index) >> 11) * 0x1.0p-53;
+  }
+  double gaussian(std::uint64_t index) const {
+    const double u1 = 1.0 - uniform(2 * index);  // (0, 1]
+    const double u2 = uniform(2 * index + 1);
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  }
+
+ private:
+  std::uint64_t key_;
+};
+
 constexpr double uniform(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
-  return static_cast<double>(hash3(seed, stream, index) >> 11) * 0x1.0p-53;
+  return NoiseStream(seed, stream).uniform(index);
 }
 
 inline double gaussian(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
-  const double u1 = 1.0 - uniform(seed, stream, 2 * index);  // (0, 1]
-  const double u2 = uniform(seed, stream, 2 * index + 1);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  return NoiseStream(seed, stream).gaussian(index);
 }
 
 // Smooth value noise in [-1, 1] on a unit lattice.

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include <Eigen/Core>
 
@@ -32,6 +33,15 @@ class RayCaster {
   RayCaster& operator=(const RayCaster&) = delete;
 
   Hit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float near_m, float far_m) const;
+
+  // Many rays, cast kPacket at a time as Embree ray packets, which traverse
+  // the BVH together: much faster than one by one for coherent rays (the
+  // beams of one firing of a spinning LiDAR). A ray's hit does not depend on
+  // the other rays of its packet, but may differ from intersect()'s in the
+  // last bits (Embree's packet kernels). hits.size() == origins.size() == directions.size().
+  static constexpr std::size_t kPacket = 16;
+  void intersect(std::span<const Eigen::Vector3f> origins, std::span<const Eigen::Vector3f> directions, float near_m,
+                 float far_m, std::span<Hit> hits) const;
 
  private:
   void* device_ = nullptr;  // RTCDevice, RTCScene: opaque here to keep Embree out of the header

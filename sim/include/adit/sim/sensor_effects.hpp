@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "adit/sim/hash_noise.hpp"
 #include "adit/sim/mesh.hpp"
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/targets.hpp"
@@ -29,7 +30,14 @@ struct Return {
   std::uint8_t reflectivity = 0;
 };
 
-Return measure(const SensorEffects& effects, std::uint64_t seed, std::uint64_t ray, const Hit& hit,
+// The random draws of measure(), keyed once per session.
+struct SensorNoise {
+  explicit SensorNoise(std::uint64_t seed);
+  NoiseStream range;
+  NoiseStream drop;
+};
+
+Return measure(const SensorEffects& effects, const SensorNoise& noise, std::uint64_t ray, const Hit& hit,
                const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, const TriangleMesh& mesh,
                std::span<const Target> targets);
 

@@ -2,7 +2,8 @@
 // One simulated survey session: options in, a folder of files out, laid out
 // like a field recording plus its ground truth:
 //   lidar.pcap        the sensor's UDP packets       can.log          wheel TPDOs (candump -L)
-//   VLP16.yaml/RS16.csv the calibration       session.yaml     an adit config that replays it
+//   VLP16.yaml, RS16.csv, PandarXT32.csv or OS1-64.json (metadata): the calibration
+//   session.yaml      an adit config that replays it
 //   truth_body.tum    body trajectory (TUM)          truth_sensor.tum sensor trajectory (TUM)
 //   truth_wheels.csv  wheel angles per CAN frame     scene.ply        the surfaces (binary PLY mesh)
 //   targets.csv       surveyed wall targets (id,x,y,z)
@@ -22,7 +23,7 @@ namespace adit::sim {
 struct SimOptions {
   std::string scene = "mine";      // mine | drift
   std::string platform = "robot";  // robot | drone (no wheels, no can.log)
-  std::string sensor = "VLP-16";   // VLP-16 | RS-16 | PandarXT32
+  std::string sensor = "VLP-16";   // VLP-16 | RS-16 | PandarXT32 | OS1-64
   double duration_s = 60.0;
   std::uint64_t seed = 1;
   std::filesystem::path out;

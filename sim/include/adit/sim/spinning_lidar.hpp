@@ -5,7 +5,9 @@
 // points carry motion distortion exactly as the real sensor's do. The returns
 // are written as the model's data packets (the drivers' encoders) in a pcap at
 // the model's packet rate. The model-specific part is a SpinningSensor value
-// (velodyne_sensor.cpp, robosense_sensor.cpp).
+// (velodyne_sensor.cpp, robosense_sensor.cpp, hesai_sensor.cpp,
+// ouster_sensor.cpp). A "block" is what shares one azimuth field: a Velodyne,
+// RoboSense or Hesai data block of 32 channels, or an Ouster column of 64 pixels.
 
 #include <array>
 #include <cstdint>
@@ -27,8 +29,8 @@
 
 namespace adit::sim {
 
-inline constexpr std::size_t kBlocks = 12;     // at most (Velodyne, RoboSense: 12; XT32: 8), of 32 channels
-inline constexpr std::size_t kChannels = 32;
+inline constexpr std::size_t kBlocks = 16;     // at most per packet (Velodyne, RoboSense: 12; XT32: 8; Ouster: 16)
+inline constexpr std::size_t kChannels = 64;   // at most per block (Velodyne, RoboSense, Hesai: 32; OS1-64: 64)
 inline constexpr std::size_t kFirings = kBlocks * kChannels;
 
 // One beam's geometry as the decoders model it. With a the head azimuth
@@ -36,7 +38,8 @@ inline constexpr std::size_t kFirings = kBlocks * kChannels;
 // offset, the point at range r is
 //   r (cos v cos θ, −cos v sin θ, sin v)                                 the beam
 //   + vo (−sin v cos θ, sin v sin θ, cos v) + ho (sin θ, cos θ, 0)       Velodyne's offsets
-//   + rx (cos a, −sin a, 0)                                              RoboSense's lens offset
+//   + rx (cos a, −sin a, 0)                                              RoboSense's lens offset,
+//                                                                        Ouster's beam origin
 struct Beam {
   double elevation_rad = 0.0;
   double azimuth_offset_rad = 0.0;
@@ -49,7 +52,7 @@ struct SpinningPacket {
   std::uint64_t index = 0;                    // packets since the start
   std::int64_t time_ns = 0;                   // Unix time of the packet's first firing
   std::array<std::uint16_t, kBlocks> azimuth{};  // 0.01° at each block's first firing
-  std::array<double, kFirings> range_m{};     // 0: no return
+  std::array<double, kFirings> range_m{};     // block-major (block × channels + channel); 0: no return
   std::array<std::uint8_t, kFirings> reflectivity{};
 };
 
@@ -58,24 +61,31 @@ struct SpinningSensor {
   std::uint16_t port = 0;                  // UDP destination port of data packets
   std::size_t packet_size = 0;
   std::int64_t packet_period_ns = 0;
-  std::size_t blocks = kBlocks;            // per packet
+  std::size_t blocks = 12;                 // per packet
+  std::size_t channels = 32;               // per block
   // Every channel of a block cast at the block's azimuth, as the model's point
   // formula has it (Hesai); otherwise each at the head's azimuth at its firing.
   bool block_azimuth = false;
   std::array<std::int64_t, kFirings> firing_ns{};  // after the packet's first firing, block-major
   std::array<std::uint16_t, kFirings> beam{};      // which Beam fires in each slot
   std::vector<Beam> beams;
+  // The beams' frame in the sensor frame the decoder reports points in
+  // (Ouster: lidar_to_sensor_transform, in metres); identity for the others.
+  Eigen::Isometry3d lidar_to_sensor = Eigen::Isometry3d::Identity();
+  double fixed_rpm = 0.0;                  // > 0: the model turns at exactly this rate (Ouster 1024x10: 600)
   double max_range_m = 0.0;                // the range field's limit
   std::function<void(const SpinningPacket&, std::span<std::uint8_t>)> encode;
   std::string calibration_file;            // written next to the pcap, e.g. "VLP16.yaml"
   std::string calibration_text;
 };
 
-// "VLP-16", "RS-16" or "PandarXT32" (names as the drivers accept them); throws adit::InputError (key --sensor) otherwise.
+// "VLP-16", "RS-16", "PandarXT32" or "OS1-64" (names as the configs and the
+// drivers' registry accept them); throws adit::InputError (key --sensor) otherwise.
 SpinningSensor make_spinning_sensor(std::string_view model);
 SpinningSensor velodyne_vlp16_sensor();
 SpinningSensor robosense_rs16_sensor();
 SpinningSensor hesai_xt32_sensor();
+SpinningSensor ouster_os1_64_sensor();
 
 struct LidarSimOptions {
   SensorEffects effects;
