@@ -31,8 +31,9 @@ void check_size(std::string_view bytes, std::size_t offset, std::uint64_t count,
                 const std::string& name) {
   const std::size_t room = bytes.size() >= offset ? bytes.size() - offset : 0;
   if (record == 0 || count > room / record)
-    throw InputError(name, "", fmt::format("truncated: {} points of {} bytes need {} bytes after the header, file has {}",
-                                           count, record, static_cast<double>(count) * record, room));
+    throw InputError(name, "",
+                     fmt::format("truncated: {} points of {} bytes need {} bytes after the header, file has {}", count,
+                                 record, static_cast<double>(count) * record, room));
 }
 
 void check_finite(const MapPoint& p, std::size_t index, const std::string& name) {
@@ -52,8 +53,7 @@ std::vector<MapPoint> read_ply_map(std::string_view bytes, const std::string& na
   std::optional<Field> x, y, z, intensity;
   std::size_t record = 0;
   for (const PlyProperty& p : vertex.properties) {
-    if (!p.count_type.empty())
-      throw InputError(name, "property " + p.name, "list properties in 'vertex' are not read");
+    if (!p.count_type.empty()) throw InputError(name, "property " + p.name, "list properties in 'vertex' are not read");
     const Field f{p.type, record};
     if (p.name == "x") x = f;
     if (p.name == "y") y = f;
@@ -138,7 +138,8 @@ std::vector<MapPoint> read_pcd_map(std::string_view bytes, const std::string& na
     }
   }
   if (counts.empty()) counts.assign(fields.size(), 1);
-  if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() || counts.size() != fields.size())
+  if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() ||
+      counts.size() != fields.size())
     throw InputError(name, "FIELDS", "FIELDS, SIZE, TYPE and COUNT must list the same number of fields");
   if (!points_count) throw InputError(name, "POINTS", "the header has no POINTS line");
   struct Field {
@@ -152,7 +153,8 @@ std::vector<MapPoint> read_pcd_map(std::string_view bytes, const std::string& na
     const Field f{types[i][0], sizes[i], record};
     const bool number = f.size == 4 || f.size == 8 || (f.type != 'F' && (f.size == 1 || f.size == 2));
     if (!number)
-      throw InputError(name, "SIZE", fmt::format("field {}: {} {} is not a binary number type", fields[i], types[i], sizes[i]));
+      throw InputError(name, "SIZE",
+                       fmt::format("field {}: {} {} is not a binary number type", fields[i], types[i], sizes[i]));
     if (fields[i] == "x") x = f;
     if (fields[i] == "y") y = f;
     if (fields[i] == "z") z = f;
@@ -163,14 +165,15 @@ std::vector<MapPoint> read_pcd_map(std::string_view bytes, const std::string& na
   check_size(bytes, offset, *points_count, record, name);
   const auto value = [&](const Field& f, std::size_t at) -> double {
     switch (f.type) {
-      case 'F': return f.size == 4 ? load<float>(bytes, at) : load<double>(bytes, at);
+      case 'F':
+        return f.size == 4 ? load<float>(bytes, at) : load<double>(bytes, at);
       case 'I':
-        return f.size == 1 ? load<std::int8_t>(bytes, at)
+        return f.size == 1   ? load<std::int8_t>(bytes, at)
                : f.size == 2 ? load<std::int16_t>(bytes, at)
                : f.size == 4 ? load<std::int32_t>(bytes, at)
                              : static_cast<double>(load<std::int64_t>(bytes, at));
       default:
-        return f.size == 1 ? load<std::uint8_t>(bytes, at)
+        return f.size == 1   ? load<std::uint8_t>(bytes, at)
                : f.size == 2 ? load<std::uint16_t>(bytes, at)
                : f.size == 4 ? load<std::uint32_t>(bytes, at)
                              : static_cast<double>(load<std::uint64_t>(bytes, at));
@@ -196,7 +199,8 @@ std::vector<MapPoint> read_las_map(std::string_view bytes, const std::string& na
     throw InputError(name, "", "not a LAS file (no 'LASF' signature or shorter than a header)");
   const auto major = load<std::uint8_t>(bytes, 24);
   const auto minor = load<std::uint8_t>(bytes, 25);
-  if (major != 1 || minor > 4) throw InputError(name, "version", fmt::format("LAS {}.{} is not read (1.0-1.4 are)", major, minor));
+  if (major != 1 || minor > 4)
+    throw InputError(name, "version", fmt::format("LAS {}.{} is not read (1.0-1.4 are)", major, minor));
   const auto header_size = load<std::uint16_t>(bytes, 94);
   const auto data_offset = load<std::uint32_t>(bytes, 96);
   const auto format_byte = load<std::uint8_t>(bytes, 104);
@@ -209,8 +213,8 @@ std::vector<MapPoint> read_las_map(std::string_view bytes, const std::string& na
     throw InputError(name, "point data record length",
                      fmt::format("{} bytes is short for format {} ({})", record, format_byte, kMinRecord[format_byte]));
   if (header_size < kMinHeader || data_offset < header_size || data_offset > bytes.size())
-    throw InputError(name, "offset to point data", fmt::format("{} (header size {}, file {} bytes)", data_offset,
-                                                               header_size, bytes.size()));
+    throw InputError(name, "offset to point data",
+                     fmt::format("{} (header size {}, file {} bytes)", data_offset, header_size, bytes.size()));
   std::uint64_t count = load<std::uint32_t>(bytes, 107);  // legacy count
   if (minor >= 4 && header_size >= 375 && bytes.size() >= 255) count = std::max(count, load<std::uint64_t>(bytes, 247));
   std::array<double, 3> scale{}, offset{};
@@ -254,9 +258,12 @@ MapFormat map_format_of(const std::filesystem::path& file) {
 
 std::vector<MapPoint> read_map(std::string_view bytes, MapFormat format, const std::string& name) {
   switch (format) {
-    case MapFormat::ply: return read_ply_map(bytes, name);
-    case MapFormat::pcd: return read_pcd_map(bytes, name);
-    case MapFormat::las: return read_las_map(bytes, name);
+    case MapFormat::ply:
+      return read_ply_map(bytes, name);
+    case MapFormat::pcd:
+      return read_pcd_map(bytes, name);
+    case MapFormat::las:
+      return read_las_map(bytes, name);
   }
   return {};
 }

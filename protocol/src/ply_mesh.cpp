@@ -15,7 +15,8 @@ namespace {
 // Reads scalars one after another, refusing to run past the end.
 class Cursor {
  public:
-  Cursor(std::string_view bytes, std::size_t offset, const std::string& name) : bytes_(bytes), at_(offset), name_(name) {}
+  Cursor(std::string_view bytes, std::size_t offset, const std::string& name)
+      : bytes_(bytes), at_(offset), name_(name) {}
   double next(std::string_view type, const char* what, std::uint64_t index) {
     const std::size_t size = ply_type_size(type);
     if (bytes_.size() - at_ < size)
@@ -56,11 +57,13 @@ PlyMesh read_ply_mesh(std::string_view bytes, const std::string& name) {
   std::size_t vertex_record = 0;
   for (const PlyProperty& p : vertex.properties) vertex_record += ply_type_size(p.type);
   std::size_t face_least = 0;  // an empty list takes only its count
-  for (const PlyProperty& p : face.properties) face_least += ply_type_size(p.count_type.empty() ? p.type : p.count_type);
+  for (const PlyProperty& p : face.properties)
+    face_least += ply_type_size(p.count_type.empty() ? p.type : p.count_type);
   const std::size_t room = bytes.size() - header.data_offset;
   if (vertex.count > room / vertex_record || face.count > (room - vertex.count * vertex_record) / face_least)
-    throw InputError(name, "element", fmt::format("truncated: {} vertices and {} faces cannot fit in {} bytes",
-                                                  vertex.count, face.count, room));
+    throw InputError(
+        name, "element",
+        fmt::format("truncated: {} vertices and {} faces cannot fit in {} bytes", vertex.count, face.count, room));
   Cursor in(bytes, header.data_offset, name);
   PlyMesh mesh;
   mesh.vertices.resize(vertex.count);
@@ -91,14 +94,15 @@ PlyMesh read_ply_mesh(std::string_view bytes, const std::string& name) {
         const double index = in.next(p.type, "face", i);
         if (&p != indices) continue;
         if (!(index >= 0.0 && index < static_cast<double>(vertex.count)))
-          throw InputError(name, fmt::format("face {}", i), fmt::format("vertex index {} of {} vertices", index,
-                                                                        vertex.count));
+          throw InputError(name, fmt::format("face {}", i),
+                           fmt::format("vertex index {} of {} vertices", index, vertex.count));
         polygon.push_back(static_cast<std::uint32_t>(index));
       }
       if (&p != indices) continue;
       if (polygon.size() < 3) throw InputError(name, fmt::format("face {}", i), "fewer than 3 vertices");
       // A convex polygon as a fan of triangles from its first vertex.
-      for (std::size_t k = 1; k + 1 < polygon.size(); ++k) mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+      for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
+        mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
     }
   }
   return mesh;

@@ -11,8 +11,7 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // A dense grid of at most this many cells (4 bytes each for the CSR starts).
 constexpr double kMaxCells = 1 << 25;
 
-Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                         const Eigen::Vector3d& b) {
+Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double len_sq = ab.squaredNorm();
   if (len_sq == 0.0) return a;
@@ -105,7 +104,8 @@ MeshDistance::MeshDistance(std::vector<Triangle> triangles, double cap, double c
   // Triangles stored in the order of their centroid's cell: those a query
   // tests together sit together in memory (a 2x speed-up on a mine mesh).
   const auto cell_of = [&](const Triangle& t) {
-    const Eigen::Array3i c = (((t.a + t.b + t.c) / 3.0 - origin_) / cell_).array().floor().cast<int>().max(0).min(dims_ - 1);
+    const Eigen::Array3i c =
+        (((t.a + t.b + t.c) / 3.0 - origin_) / cell_).array().floor().cast<int>().max(0).min(dims_ - 1);
     return (static_cast<std::int64_t>(c.z()) * dims_.y() + c.y()) * dims_.x() + c.x();
   };
   std::vector<std::pair<std::int64_t, std::uint32_t>> order(triangles_.size());
@@ -187,8 +187,8 @@ double MeshDistance::distance(const Eigen::Vector3d& p) const {
           // Most neighbours lie farther than the best so far: skip them whole.
           const Eigen::Vector3d lo = origin_ + cell_ * Eigen::Vector3d(x, y, z);
           if (r > 0 && squared_distance_to_box(p, lo, lo + Eigen::Vector3d::Constant(cell_)) >= best_sq) continue;
-          best_sq = squared_distance_in_cell((static_cast<std::int64_t>(z) * dims_.y() + y) * dims_.x() + x, p,
-                                             best_sq);
+          best_sq =
+              squared_distance_in_cell((static_cast<std::int64_t>(z) * dims_.y() + y) * dims_.x() + x, p, best_sq);
         }
       }
     }
@@ -210,8 +210,10 @@ std::vector<double> MeshDistance::distances(std::span<const Eigen::Vector3d> poi
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Array3d c = ((points[i] - origin_) / cell_).array().floor();
     const Eigen::Array3d top = (dims_ - 1).cast<double>();
-    const Eigen::Array3i k = c.isFinite().all() ? Eigen::Array3i(c.max(0.0).min(top).cast<int>()) : Eigen::Array3i::Zero();
-    const auto cell = static_cast<std::uint64_t>((static_cast<std::int64_t>(k.z()) * dims_.y() + k.y()) * dims_.x() + k.x());
+    const Eigen::Array3i k =
+        c.isFinite().all() ? Eigen::Array3i(c.max(0.0).min(top).cast<int>()) : Eigen::Array3i::Zero();
+    const auto cell =
+        static_cast<std::uint64_t>((static_cast<std::int64_t>(k.z()) * dims_.y() + k.y()) * dims_.x() + k.x());
     order[i] = (cell << 32) | i;
   }
   std::sort(order.begin(), order.end());

@@ -61,8 +61,9 @@ void expect_same(const std::vector<MapPoint>& back, const std::vector<MapPoint>&
 TEST_F(MapImport, EveryFormatReadsBackWhatWriteMapWrote) {
   const auto points = sample_points();
   // PLY and PCD hold float32 (~3e-5 m at 250 m), LAS 1 mm integers.
-  for (const auto& [name, format, tolerance] :
-       {std::tuple{"map.ply", MapFormat::ply, 1e-4}, {"map.pcd", MapFormat::pcd, 1e-4}, {"map.LAS", MapFormat::las, 5e-4}}) {
+  for (const auto& [name, format, tolerance] : {std::tuple{"map.ply", MapFormat::ply, 1e-4},
+                                                {"map.pcd", MapFormat::pcd, 1e-4},
+                                                {"map.LAS", MapFormat::las, 5e-4}}) {
     const auto f = file(name);
     write_map(f, format, points);
     SCOPED_TRACE(name);
@@ -103,14 +104,17 @@ TEST_F(MapImport, BadFilesAreNamed) {
   EXPECT_EQ(error_of(write("map.xyz", "1 2 3\n")), file("map.xyz").string());
   EXPECT_EQ(error_of(write("text.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n")),
             file("text.ply").string() + ":2");
-  EXPECT_EQ(error_of(write("noz.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
-                                      "property float y\nend_header\n")),
+  EXPECT_EQ(error_of(write("noz.ply",
+                           "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
+                           "property float y\nend_header\n")),
             file("noz.ply").string());
-  EXPECT_EQ(error_of(write("faces.ply", "ply\nformat binary_little_endian 1.0\nelement face 0\n"
-                                        "property list uchar uint vertex_indices\nend_header\n")),
+  EXPECT_EQ(error_of(write("faces.ply",
+                           "ply\nformat binary_little_endian 1.0\nelement face 0\n"
+                           "property list uchar uint vertex_indices\nend_header\n")),
             file("faces.ply").string());
-  EXPECT_EQ(error_of(write("ascii.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\n"
-                                        "HEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n")),
+  EXPECT_EQ(error_of(write("ascii.pcd",
+                           "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\n"
+                           "HEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n")),
             file("ascii.pcd").string() + ":9");
   EXPECT_EQ(error_of(write("fields.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 0\nDATA binary\n")),
             file("fields.pcd").string());

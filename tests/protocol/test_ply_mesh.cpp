@@ -66,7 +66,7 @@ TEST(PlyMesh, PolygonsBecomeFans) {
 TEST(PlyMesh, BadMeshesAreNamed) {
   EXPECT_EQ(error_key(scene_bytes(4)), "face 1");  // index past the 4 vertices
   const std::string good = scene_bytes();
-  EXPECT_EQ(error_key(good.substr(0, good.size() - 3)), "face 1");  // truncated inside the last face
+  EXPECT_EQ(error_key(good.substr(0, good.size() - 3)), "face 1");                     // truncated inside the last face
   EXPECT_EQ(error_key(good.substr(0, good.find("end_header") + 11 + 20)), "element");  // counts cannot fit
   std::string no_faces = good;
   no_faces.replace(no_faces.find("element face 2"), 14, "element edge 2");

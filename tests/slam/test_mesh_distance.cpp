@@ -32,9 +32,9 @@ TEST(ClosestPointOnTriangle, VertexRegions) {
 }
 
 TEST(ClosestPointOnTriangle, EdgeRegions) {
-  expect_closest({0.5, -1, 0.5}, {0.5, 0, 0});  // AB
-  expect_closest({-1, 0.5, 0}, {0, 0.5, 0});    // AC
-  expect_closest({1, 1, 0}, {0.5, 0.5, 0});     // BC, distance sqrt(0.5)
+  expect_closest({0.5, -1, 0.5}, {0.5, 0, 0});   // AB
+  expect_closest({-1, 0.5, 0}, {0, 0.5, 0});     // AC
+  expect_closest({1, 1, 0}, {0.5, 0.5, 0});      // BC, distance sqrt(0.5)
   expect_closest({0.8, 0.6, 3}, {0.6, 0.4, 0});  // BC off the plane: b + 0.4 (c - b)
 }
 

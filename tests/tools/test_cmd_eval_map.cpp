@@ -37,7 +37,7 @@ std::string scene_bytes() {
       "ply\nformat binary_little_endian 1.0\ncomment adit sim scene\nelement vertex 8\nproperty float x\n"
       "property float y\nproperty float z\nelement face 4\nproperty list uchar uint vertex_indices\n"
       "property uchar reflectivity\nend_header\n";
-  const std::vector<std::array<float, 3>> vertices{{0, 0, 0},  {10, 0, 0}, {10, 10, 0}, {0, 10, 0},
+  const std::vector<std::array<float, 3>> vertices{{0, 0, 0},  {10, 0, 0},  {10, 10, 0}, {0, 10, 0},
                                                    {10, 0, 0}, {10, 10, 0}, {10, 10, 5}, {10, 0, 5}};
   for (const auto& v : vertices)
     for (float c : v) put(b, c);
@@ -87,7 +87,7 @@ class AditEvalMap : public ::testing::Test {
 
 TEST_F(AditEvalMap, KnownDistancesInTheSceneFrame) {
   const TempFile map("", ".ply");
-    fill(map, Eigen::Isometry3d::Identity());
+  fill(map, Eigen::Isometry3d::Identity());
   const auto j = json_of(adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --json"));
   EXPECT_EQ(j["points"].get<int>(), 11);
   EXPECT_NEAR(j["fraction_within"].get<double>(), 6.0 / 11.0, 1e-12);
@@ -122,8 +122,9 @@ TEST_F(AditEvalMap, EveryMapFormatGivesTheSameFigures) {
 // 100 s (interpolated between 99 s and 101 s) at (2, 3, 0) facing +y, where
 // the estimate says (0.5, 0, 0) facing +x.
 TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
-  const TempFile ref("99.0 1 3 0 0 0 0.7071067811865476 0.7071067811865476\n"
-                     "101.0 3 3 0 0 0 0.7071067811865476 0.7071067811865476\n");
+  const TempFile ref(
+      "99.0 1 3 0 0 0 0.7071067811865476 0.7071067811865476\n"
+      "101.0 3 3 0 0 0 0.7071067811865476 0.7071067811865476\n");
   const TempFile est("100.0 0.5 0 0 0 0 0 1\n100.1 0.6 0 0 0 0 0 1\n");
   Eigen::Isometry3d ref_t0 = Eigen::Isometry3d::Identity();
   ref_t0.translation() = Eigen::Vector3d(2, 3, 0);
@@ -132,10 +133,10 @@ TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
   est_t0.translation() = Eigen::Vector3d(0.5, 0, 0);
   const Eigen::Isometry3d map_from_world = est_t0 * ref_t0.inverse();
   const TempFile map("", ".ply");
-    fill(map, map_from_world);
+  fill(map, map_from_world);
 
-  const auto placed = json_of(adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) +
-                                        " --est " + q(est) + " --json"));
+  const auto placed = json_of(
+      adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) + " --est " + q(est) + " --json"));
   EXPECT_NEAR(placed["fraction_within"].get<double>(), 6.0 / 11.0, 1e-12);
   EXPECT_NEAR(placed["median_m"].get<double>(), 0.0495, 1e-5);
   EXPECT_EQ(placed["beyond_cap"].get<int>(), 1);
@@ -156,7 +157,7 @@ TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
 
 TEST_F(AditEvalMap, BadFilesAreNamed) {
   const TempFile map("", ".ply");
-    fill(map, Eigen::Isometry3d::Identity());
+  fill(map, Eigen::Isometry3d::Identity());
   std::filesystem::resize_file(map.path(), std::filesystem::file_size(map.path()) - 5);
   const EvalRun cut = adit_eval("map --map "s + q(map) + " --scene " + q(scene));
   EXPECT_EQ(cut.status, 2) << cut.output;
@@ -166,7 +167,7 @@ TEST_F(AditEvalMap, BadFilesAreNamed) {
   const std::string good = scene_bytes();
   const TempFile bad_scene(good.substr(0, good.size() - 4), ".ply");
   const TempFile whole("", ".pcd");
-    fill(whole, Eigen::Isometry3d::Identity());
+  fill(whole, Eigen::Isometry3d::Identity());
   const EvalRun scene_cut = adit_eval("map --map "s + q(whole) + " --scene " + q(bad_scene));
   EXPECT_EQ(scene_cut.status, 2) << scene_cut.output;
   EXPECT_NE(scene_cut.output.find(bad_scene.path().string()), std::string::npos) << scene_cut.output;

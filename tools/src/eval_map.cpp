@@ -59,8 +59,10 @@ Placement placement(const MapEvalOptions& o) {
   p.t0 = est.stamps.front();
   const auto ref_t0 = slam::interpolate_pose(ref, p.t0);
   if (!ref_t0)
-    throw InputError(o.ref, "", fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
-                                            "{:.6f} .. {:.6f} s", p.t0, o.est, ref.stamps.front(), ref.stamps.back()));
+    throw InputError(o.ref, "",
+                     fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
+                                 "{:.6f} .. {:.6f} s",
+                                 p.t0, o.est, ref.stamps.front(), ref.stamps.back()));
   p.world_from_map = *ref_t0 * est.poses.front().inverse();
   p.by_trajectories = true;
   return p;
@@ -103,8 +105,8 @@ MapAccuracy summarize(std::vector<double>& d, double within) {
 
 // The points in one contiguous slice per core; MeshDistance is read-only.
 std::vector<double> distances_in_parallel(const slam::MeshDistance& scene, std::span<const Eigen::Vector3d> points) {
-  const std::size_t slices =
-      std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, points.size() / 100'000));
+  const std::size_t slices = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1,
+                                                     std::max<std::size_t>(1, points.size() / 100'000));
   std::vector<std::vector<double>> parts(slices);
   {
     std::vector<std::jthread> workers;
@@ -129,8 +131,8 @@ std::string metres_or_beyond(double v, double cap) {
 
 void run_eval_map(const MapEvalOptions& o) {
   if (o.within > o.cap)
-    throw InputError("", "--within", fmt::format("{} m is beyond --cap {} m, where distances are not computed",
-                                                 o.within, o.cap));
+    throw InputError("", "--within",
+                     fmt::format("{} m is beyond --cap {} m, where distances are not computed", o.within, o.cap));
   const slam::MeshDistance scene(scene_triangles(o.scene), o.cap);
   const Placement place = placement(o);
   // Only the placed positions are kept (a 5 M-point map's fields are 200 MB).

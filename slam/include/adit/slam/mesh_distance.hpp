@@ -59,8 +59,8 @@ class MeshDistance {
   double cell_ = 1.0;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // corner of cell (0, 0, 0)
   Eigen::Array3i dims_ = Eigen::Array3i::Zero();
-  Box bounds_;                               // of all triangles
-  std::vector<std::uint32_t> cell_start_;    // CSR: triangles of cell k are
+  Box bounds_;                                 // of all triangles
+  std::vector<std::uint32_t> cell_start_;      // CSR: triangles of cell k are
   std::vector<std::uint32_t> cell_triangles_;  // cell_triangles_[start[k], start[k+1])
 };
 
