@@ -29,13 +29,13 @@ struct NormalEquations {
 // perturbation T·exp(δ): T·exp(δ)·p ≈ T(p + v + ω×p), so with n_b = Rᵀn,
 // ∂r/∂[v; ω] = [n_b; p × n_b] (p in the body frame: lever arms are ranges).
 NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map, const Eigen::Isometry3d& T,
-                      double max_distance_m, double kappa2, float max_plane_error_m) {
+                      double max_distance_m, double kappa2, const RegistrationConfig& config) {
   NormalEquations ne;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
   for (const Eigen::Vector3f& p : points) {
     const Eigen::Vector3f q = R * p + t;
-    const MapPlane plane = map.nearest_plane(q, max_plane_error_m);
+    const MapPlane plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
     if (!plane.found) continue;
     const double r = plane.normal.dot(q - plane.point);
     if (std::abs(r) > max_distance_m) continue;
@@ -118,7 +118,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
   NormalEquations ne;
   Degeneracy degeneracy;
   for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
-    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config.max_plane_error_m);
+    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config);
     degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
     // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
     // e(T·exp(δ)) ≈ e + δ to first order.

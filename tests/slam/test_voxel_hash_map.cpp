@@ -63,7 +63,7 @@ TEST(VoxelHashMap, NearestPlaneFitsTheNeighboursAndRefusesLinesAndClutter) {
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) floor.emplace_back(0.1F * static_cast<float>(i), 0.1F * static_cast<float>(j), 0.2F);
   map.add(floor);
-  const MapPlane plane = map.nearest_plane({0.25F, 0.25F, 0.3F});
+  const MapPlane plane = map.nearest_plane({0.25F, 0.25F, 0.3F}, 5);
   ASSERT_TRUE(plane.found);
   EXPECT_NEAR(std::abs(plane.normal.z()), 1.0F, 1e-4F);
   EXPECT_NEAR(plane.point.z(), 0.2F, 1e-5F);
@@ -73,7 +73,7 @@ TEST(VoxelHashMap, NearestPlaneFitsTheNeighboursAndRefusesLinesAndClutter) {
   std::vector<Eigen::Vector3f> line;
   for (int i = 0; i < 10; ++i) line.emplace_back(5.0F + 0.05F * static_cast<float>(i), 1.0F, 0.0F);
   ring.add(line);
-  EXPECT_FALSE(ring.nearest_plane({5.2F, 1.05F, 0.0F}).found);
+  EXPECT_FALSE(ring.nearest_plane({5.2F, 1.05F, 0.0F}, 5).found);
 
   // Clutter: neighbours spread in every direction (an octahedron's corners).
   VoxelHashMap clutter(0.5F, 256);
@@ -82,10 +82,10 @@ TEST(VoxelHashMap, NearestPlaneFitsTheNeighboursAndRefusesLinesAndClutter) {
   for (int axis = 0; axis < 3; ++axis)
     for (const float sign : {-0.1F, 0.1F}) corners.push_back(c + sign * Eigen::Vector3f::Unit(axis));
   clutter.add(corners);
-  EXPECT_FALSE(clutter.nearest_plane(c).found);
+  EXPECT_FALSE(clutter.nearest_plane(c, 5).found);
 
-  // Fewer than kPlaneNeighbors points within a voxel edge: none.
-  EXPECT_FALSE(map.nearest_plane({3.0F, 3.0F, 3.0F}).found);
+  // Fewer neighbours within a voxel edge than asked for: none.
+  EXPECT_FALSE(map.nearest_plane({3.0F, 3.0F, 3.0F}, 5).found);
 }
 
 // remove_far under heavy hash collisions (a small, nearly full table): every

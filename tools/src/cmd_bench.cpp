@@ -39,6 +39,7 @@ struct BenchOptions {
   float map_voxel_m = 0.5F;
   double degeneracy_threshold = slam::RegistrationConfig{}.degeneracy_threshold;
   double point_sigma_m = slam::RegistrationConfig{}.point_sigma_m;
+  int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -115,6 +116,7 @@ int bench_odometry(const BenchOptions& o) {
   config.registration_voxel_m = 1.5F * o.map_voxel_m;
   config.registration.degeneracy_threshold = o.degeneracy_threshold;
   config.registration.point_sigma_m = o.point_sigma_m;
+  config.registration.plane_neighbors = o.plane_neighbors;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
@@ -130,6 +132,7 @@ int bench_odometry(const BenchOptions& o) {
   std::size_t invalid = 0;
   std::vector<double> iterations;
   std::vector<double> used_points;
+  std::vector<double> weakest;
   std::size_t without_wheels = 0;
   std::size_t wheel_rejected = 0;
   for (std::size_t i = 0; i < scans.size(); ++i) {
@@ -146,6 +149,8 @@ int bench_odometry(const BenchOptions& o) {
     wheel_rejected += r.wheel_rejected ? 1 : 0;
     iterations.push_back(r.registration.iterations);
     used_points.push_back(static_cast<double>(r.registration_points));
+    if (r.status == slam::OdometryStatus::ok || r.status == slam::OdometryStatus::degenerate)
+      weakest.push_back(r.registration.weakest_eigenvalue);
     estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
   }
   if (without_wheels > 0) fmt::print("wheels: {} scans outside the wheel log ran on constant velocity\n", without_wheels);
@@ -153,9 +158,11 @@ int bench_odometry(const BenchOptions& o) {
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
              "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
-             "  registration: {:.0f} points, {:.0f} iterations per scan (medians)\n",
+             "  registration: {:.0f} points, {:.0f} iterations per scan (medians); weakest direction's "
+             "eigenvalue median {:.4f}, 10th percentile {:.4f} (degenerate below {})\n",
              median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
-             peak_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5));
+             peak_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
+             quantile(weakest, 0.1), o.degeneracy_threshold);
   if (!o.out.empty()) {
     std::ofstream out(o.out);
     slam::write_tum(out, estimate);
@@ -216,6 +223,8 @@ void register_bench_commands(CLI::App& app, int& status) {
                        "Normalised Hessian eigenvalue below which a direction counts as unconstrained");
   odometry->add_option("--point-sigma", o->point_sigma_m,
                        "σ of one point-to-plane residual, m: weighs the scan against the motion prior");
+  odometry->add_option("--plane-neighbors", o->plane_neighbors, "Map points each local plane is fitted through (3-16)")
+      ->check(CLI::Range(3, 16));
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");

@@ -32,9 +32,10 @@ namespace adit::slam {
 
 struct RegistrationConfig {
   int max_iterations = 30;
-  double convergence_norm = 1e-4;       // settle when the update is below this (m, rad)
+  double convergence_norm = 5e-4;       // settle when the update is below this (m, rad)
   double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
   float max_plane_error_m = 0.1F;       // a map neighbour farther than this from its plane: not a plane
+  int plane_neighbors = 10;             // map points a plane is fitted through (5: planes too noisy to see a drift's axis as degenerate)
   // Effective σ of one point-to-plane residual: the scan's information is
   // Σ w·JᵀJ / σ², in the same units as the prior's. Far above the range noise
   // because residuals are not independent (shared map points, the rings'

@@ -40,7 +40,7 @@ struct MapPlane {
 class VoxelHashMap {
  public:
   static constexpr int kMaxPointsPerVoxel = 20;
-  static constexpr int kPlaneNeighbors = 5;  // LOAM's and FAST-LIO's choice
+  static constexpr int kMaxPlaneNeighbors = 16;
 
   // capacity_voxels is rounded up to a power of two; the table is kept at
   // most 3/4 full (beyond that new voxels are refused and counted).
@@ -58,11 +58,12 @@ class VoxelHashMap {
   MapNeighbor nearest(const Eigen::Vector3f& query,
                       float max_distance_m = std::numeric_limits<float>::infinity()) const;
 
-  // The plane through the kPlaneNeighbors map points nearest `query`, all
-  // within one voxel edge of it (so the 27 voxels around it hold them all).
-  // Found only when they span a plane: not a line (a single ring of a
-  // spinning LiDAR), and every one within max_plane_error_m of the plane.
-  MapPlane nearest_plane(const Eigen::Vector3f& query, float max_plane_error_m = 0.1F) const;
+  // The plane through the `neighbors` (≤ kMaxPlaneNeighbors) map points
+  // nearest `query`, all within one voxel edge of it (so the 27 voxels around
+  // it hold them all). Found only when they span a plane: not a line (a
+  // single ring of a spinning LiDAR), and every one within
+  // max_plane_error_m of the plane.
+  MapPlane nearest_plane(const Eigen::Vector3f& query, int neighbors, float max_plane_error_m = 0.1F) const;
 
   void clear();
   bool empty() const { return voxel_count_ == 0; }
