@@ -31,6 +31,7 @@ Odometry::Odometry(const OdometryConfig& config)
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
   for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
   filtered_times_.reserve(config.max_scan_points);
+  planes_.resize(config.max_scan_points);
 }
 
 OdometryResult Odometry::process(const ScanInput& scan, const std::optional<MotionPrior>& wheel) {
@@ -112,7 +113,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // After a gap or a lost scan the prediction is poor: search as widely as at the start.
   const double sigma = reacquire_ ? config_.initial_threshold_m / 3.0 : threshold_.sigma();
   reacquire_ = false;
-  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration);
+  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
   // Wheels that slipped (or a wrong encoder) put the prediction where the
   // scan no longer overlaps the map: far fewer correspondences than the last
   // scan had. Then the constant-velocity prediction is tried too, and the
@@ -122,7 +123,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   };
   if (wheel && !enough(result.registration)) {
     const RegistrationResult alternative =
-        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration);
+        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
     if (alternative.correspondences > result.registration.correspondences) {
       result.registration = alternative;
       result.wheel_rejected = true;

@@ -29,13 +29,18 @@ struct NormalEquations {
 // perturbation T·exp(δ): T·exp(δ)·p ≈ T(p + v + ω×p), so with n_b = Rᵀn,
 // ∂r/∂[v; ω] = [n_b; p × n_b] (p in the body frame: lever arms are ranges).
 NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map, const Eigen::Isometry3d& T,
-                      double max_distance_m, double kappa2, const RegistrationConfig& config) {
+                      double max_distance_m, double kappa2, const RegistrationConfig& config,
+                      std::span<MapPlane> planes, bool associate) {
   NormalEquations ne;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
-  for (const Eigen::Vector3f& p : points) {
+  const bool cached = planes.size() >= points.size();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
     const Eigen::Vector3f q = R * p + t;
-    const MapPlane plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
+    MapPlane local;
+    MapPlane& plane = cached ? planes[i] : local;
+    if (associate || !cached) plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
     if (!plane.found) continue;
     const double r = plane.normal.dot(q - plane.point);
     if (std::abs(r) > max_distance_m) continue;
@@ -107,6 +112,12 @@ Degeneracy analyse(const NormalEquations& ne, double threshold, int min_correspo
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config) {
+  return register_scan(points, map, prior, max_distance_m, kernel_scale_m, config, {});
+}
+
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes) {
   RegistrationResult result;
   result.pose = prior.mean;
   // Graduated kernel: start wide enough to pull in from the prediction's
@@ -117,8 +128,16 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
   const double data_scale = 1.0 / (config.point_sigma_m * config.point_sigma_m);
   NormalEquations ne;
   Degeneracy degeneracy;
+  // The planes found for each point are kept (when `planes` has room) and
+  // searched again only after the pose has moved enough to change them: the
+  // search is most of the cost, and near convergence the pose moves by mm.
+  Eigen::Isometry3d associated_at = result.pose;
   for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
-    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config);
+    const Eigen::Isometry3d moved = associated_at.inverse() * result.pose;
+    const bool associate = iteration == 1 || moved.translation().norm() > config.reassociate_m ||
+                           Eigen::AngleAxisd(moved.linear()).angle() > config.reassociate_rad;
+    if (associate) associated_at = result.pose;
+    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config, planes, associate);
     degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
     // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
     // e(T·exp(δ)) ≈ e + δ to first order.

@@ -104,6 +104,7 @@ class Odometry {
   std::vector<Eigen::Vector3f> frame_;       // map-resolution points
   std::vector<Eigen::Vector3f> source_;      // registration-resolution points
   std::vector<Eigen::Vector3f> registered_;
+  std::vector<MapPlane> planes_;             // registration's per-point planes
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Vector6d velocity_ = Vector6d::Zero();     // body twist per second
   std::int64_t last_stamp_ns_ = 0;

@@ -35,6 +35,10 @@ struct RegistrationConfig {
   double convergence_norm = 5e-4;       // settle when the update is below this (m, rad)
   double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
   float max_plane_error_m = 0.1F;       // a map neighbour farther than this from its plane: not a plane
+  // Planes are searched again once the pose moved this far since the last
+  // search (with a `planes` buffer; without one, every iteration).
+  double reassociate_m = 0.02;
+  double reassociate_rad = 0.002;
   int plane_neighbors = 10;             // map points a plane is fitted through (5: planes too noisy to see a drift's axis as degenerate)
   // Effective σ of one point-to-plane residual: the scan's information is
   // Σ w·JᵀJ / σ², in the same units as the prior's. Far above the range noise
@@ -81,5 +85,10 @@ struct RegistrationResult {
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config = {});
+// The same, keeping each point's plane in `planes` (at least points.size()
+// long) between iterations, so that steady-state calls allocate nothing.
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes);
 
 }  // namespace adit::slam
