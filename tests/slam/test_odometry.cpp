@@ -106,6 +106,22 @@ TEST(Odometry, AWheelPriorThatSlippedIsOverruledByTheScan) {
   }
 }
 
+TEST(Odometry, AFeaturelessTunnelIsReportedDegenerateWithALooseAxis) {
+  const auto tunnel = test::tunnel(400000, 24);
+  Odometry odometry(OdometryConfig{});
+  OdometryResult r;
+  for (int k = 0; k < 6; ++k) {
+    r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, observe(tunnel, planar_pose(0.1 * k, 0.0, 0.0), 15000,
+                                                                                300 + static_cast<unsigned>(k)), {}});
+    ASSERT_TRUE(r.valid) << "scan " << k;
+  }
+  // Valid, but the status and the covariance say the axis is unknown: no
+  // confident answer along it.
+  EXPECT_EQ(r.status, OdometryStatus::degenerate);
+  EXPECT_GT(std::abs(r.registration.weakest_direction(0)), 0.99) << r.registration.weakest_direction.transpose();
+  EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));
+}
+
 TEST(Deskew, UndoesTheMotionDuringTheScan) {
   // A sensor moving at 2 m/s along x and turning at 90°/s measures a wall at
   // x = 5 (world) over 0.1 s; deskewed, the points lie on the wall in the
