@@ -5,17 +5,6 @@
 namespace adit::slam {
 namespace {
 
-// The adjoint of SE(3) for twists ordered [v; ω] (Barfoot 2017, eq. 7.32):
-// maps a body-frame perturbation into the world frame.
-Matrix6d adjoint(const Eigen::Isometry3d& T) {
-  Matrix6d Ad = Matrix6d::Zero();
-  const Eigen::Matrix3d R = T.linear();
-  Ad.topLeftCorner<3, 3>() = R;
-  Ad.topRightCorner<3, 3>() = skew(T.translation()) * R;
-  Ad.bottomRightCorner<3, 3>() = R;
-  return Ad;
-}
-
 void transform_into(std::span<const Eigen::Vector3f> in, const Eigen::Isometry3d& T, std::vector<Eigen::Vector3f>& out) {
   const Eigen::Isometry3f Tf = T.cast<float>();
   out.clear();
@@ -42,6 +31,7 @@ Odometry::Odometry(const OdometryConfig& config)
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
   for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
   filtered_times_.reserve(config.max_scan_points);
+  planes_.resize(config.max_scan_points);
 }
 
 OdometryResult Odometry::process(const ScanInput& scan, const std::optional<MotionPrior>& wheel) {
@@ -106,24 +96,40 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     return result;
   }
 
-  PosePrior prior;
-  prior.mean = predicted;
+  PosePrior constant_velocity;
+  constant_velocity.mean = pose_ * exp_se3(velocity_ * dt);
+  Vector6d information;
+  information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
+  information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
+  constant_velocity.information = information.asDiagonal();
+  PosePrior prior = constant_velocity;
   if (wheel) {
-    // Body-frame covariance of the motion, carried to the world (left) tangent at the prediction.
-    const Matrix6d Ad = adjoint(predicted);
-    prior.information = (Ad * wheel->covariance * Ad.transpose()).inverse();
-  } else {
-    Vector6d information;
-    information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
-    information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
-    prior.information = information.asDiagonal();
+    prior.mean = predicted;
+    // The motion's covariance is in the body frame at the prediction, where the prior lives.
+    prior.information = wheel->covariance.inverse();
+    if (!prior.information.allFinite()) prior.information.setZero();
   }
-  if (!prior.information.allFinite()) prior.information.setZero();
 
   // After a gap or a lost scan the prediction is poor: search as widely as at the start.
   const double sigma = reacquire_ ? config_.initial_threshold_m / 3.0 : threshold_.sigma();
   reacquire_ = false;
-  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration);
+  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
+  // Wheels that slipped (or a wrong encoder) put the prediction where the
+  // scan no longer overlaps the map: far fewer correspondences than the last
+  // scan had. Then the constant-velocity prediction is tried too, and the
+  // registration that explains more of the scan wins.
+  const auto enough = [&](const RegistrationResult& r) {
+    return static_cast<double>(r.correspondences) >= config_.min_correspondence_share * last_correspondences_;
+  };
+  if (wheel && !enough(result.registration)) {
+    const RegistrationResult alternative =
+        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
+    if (alternative.correspondences > result.registration.correspondences) {
+      result.registration = alternative;
+      result.wheel_rejected = true;
+    }
+  }
+  last_correspondences_ = static_cast<double>(result.registration.correspondences);
   const Eigen::Isometry3d corrected = result.registration.pose;
 
   threshold_.update(predicted.inverse() * corrected, pose_.inverse() * corrected);

@@ -1,6 +1,8 @@
 #include "adit/slam/registration.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 
@@ -18,67 +20,38 @@ struct NormalEquations {
   Matrix6d H = Matrix6d::Zero();
   Vector6d g = Vector6d::Zero();
   double weight_sum = 0.0;
-  // The point-to-plane part alone, for the degeneracy analysis: point-to-point
-  // residuals against a sparse map "constrain" every direction through the
-  // sampling pattern, which would hide a tunnel's axis.
-  Matrix6d H_plane = Matrix6d::Zero();
-  double plane_weight_sum = 0.0;
-  int plane_count = 0;
   double residual2_sum = 0.0;  // Σ w·r², robust-weighted
   int count = 0;
 };
 
-// Point-to-plane: r = n·(q − μ); ∂r/∂[v; ω] = [nᵀ, (q × n)ᵀ] for q ← exp(δ)q.
-void accumulate_plane(NormalEquations& ne, const Eigen::Vector3d& q, const Eigen::Vector3d& n, double r,
-                      double kappa2) {
-  Vector6d J;
-  J << n, q.cross(n);
-  const double w = geman_mcclure_weight(r * r, kappa2);
-  const Matrix6d JJ = w * J * J.transpose();
-  ne.H += JJ;
-  ne.H_plane += JJ;
-  ne.g.noalias() += w * J * r;
-  ne.weight_sum += w;
-  ne.plane_weight_sum += w;
-  ne.residual2_sum += w * r * r;
-  ++ne.count;
-  ++ne.plane_count;
-}
-
-// One pass over the points at pose T: linearised residuals and their weights.
+// One pass over the points at pose T: each point's plane in the map, its
+// point-to-plane residual r = n·(T p − m), and the Jacobian for the body-frame
+// perturbation T·exp(δ): T·exp(δ)·p ≈ T(p + v + ω×p), so with n_b = Rᵀn,
+// ∂r/∂[v; ω] = [n_b; p × n_b] (p in the body frame: lever arms are ranges).
 NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map, const Eigen::Isometry3d& T,
-                      double max_distance_m, double kappa2) {
+                      double max_distance_m, double kappa2, const RegistrationConfig& config,
+                      std::span<MapPlane> planes, bool associate) {
   NormalEquations ne;
-  const double max_d2 = max_distance_m * max_distance_m;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
-  for (const Eigen::Vector3f& body : points) {
-    const Eigen::Vector3f q = R * body + t;
-    const Eigen::Vector3d qd = q.cast<double>();
-    if (const VoxelPlane* plane = map.plane_at(q); plane != nullptr && (q - plane->mean).squaredNorm() <= max_d2) {
-      const Eigen::Vector3d n = plane->normal.cast<double>();
-      accumulate_plane(ne, qd, n, n.dot(qd - plane->mean.cast<double>()), kappa2);
-      continue;
-    }
-    const MapNeighbor nb = map.nearest(q, static_cast<float>(max_distance_m));
-    if (!nb.found) continue;
-    if (!nb.normal.isZero()) {
-      // The query's own voxel is not flat (or is empty) but its nearest
-      // neighbour's is: point-to-plane through that neighbour.
-      const Eigen::Vector3d n = nb.normal.cast<double>();
-      accumulate_plane(ne, qd, n, n.dot(qd - nb.point.cast<double>()), kappa2);
-      continue;
-    }
-    // Point-to-point where the map has no plane yet (a sparse start, clutter):
-    // r = q − p; ∂r/∂[v; ω] = [I, −[q]×] (Besl & McKay 1992).
-    const Eigen::Vector3d r = qd - nb.point.cast<double>();
-    Eigen::Matrix<double, 3, 6> J;
-    J << Eigen::Matrix3d::Identity(), -skew(qd);
-    const double w = geman_mcclure_weight(r.squaredNorm(), kappa2);
-    ne.H.noalias() += w * J.transpose() * J;
-    ne.g.noalias() += w * J.transpose() * r;
+  const bool cached = planes.size() >= points.size();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    const Eigen::Vector3f q = R * p + t;
+    MapPlane local;
+    MapPlane& plane = cached ? planes[i] : local;
+    if (associate || !cached) plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
+    if (!plane.found) continue;
+    const double r = plane.normal.dot(q - plane.point);
+    if (std::abs(r) > max_distance_m) continue;
+    const Eigen::Vector3d n_b = (R.transpose() * plane.normal).cast<double>();
+    Vector6d J;
+    J << n_b, p.cast<double>().cross(n_b);
+    const double w = geman_mcclure_weight(r * r, kappa2);
+    ne.H.noalias() += w * J * J.transpose();
+    ne.g.noalias() += w * r * J;
     ne.weight_sum += w;
-    ne.residual2_sum += w * r.squaredNorm();
+    ne.residual2_sum += w * r * r;
     ++ne.count;
   }
   return ne;
@@ -93,27 +66,26 @@ struct Degeneracy {
 };
 
 // Zhang, Kaess & Singh 2016, per block: eigen-directions of the normalised
-// data Hessian below the threshold are not constrained by the scan. Judged on
-// the point-to-plane part when there is enough of it (see NormalEquations).
-Degeneracy analyse(const NormalEquations& ne, double threshold, int min_plane_correspondences) {
+// data Hessian below the threshold are not constrained by the scan.
+Degeneracy analyse(const NormalEquations& ne, double threshold, int min_correspondences) {
   Degeneracy d;
-  const bool planes = ne.plane_count >= min_plane_correspondences && ne.plane_weight_sum > 0.0;
-  const Matrix6d& H = planes ? ne.H_plane : ne.H;
-  const double weight_sum = planes ? ne.plane_weight_sum : ne.weight_sum;
-  if (weight_sum <= 0.0) {
+  if (ne.weight_sum <= 0.0) {
     d.degenerate = true;
     d.translation_projector.setZero();
     d.rotation_projector.setZero();
     d.weakest << 1, 0, 0, 0, 0, 0;
     return d;
   }
+  d.degenerate = ne.count < min_correspondences;
   // Per unit weight: translation eigenvalues are the share of residuals that
   // watch a direction (0..1); rotation ones are that share times the squared
   // lever arm in m², i.e. displacement per radian judged at 1 m.
-  const Eigen::Matrix3d Ht = H.topLeftCorner<3, 3>() / weight_sum;
-  const Eigen::Matrix3d Hr = H.bottomRightCorner<3, 3>() / weight_sum;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(Ht);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> er(Hr);
+  const Eigen::Matrix3d Ht = ne.H.topLeftCorner<3, 3>() / ne.weight_sum;
+  const Eigen::Matrix3d Hr = ne.H.bottomRightCorner<3, 3>() / ne.weight_sum;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> er;
+  et.computeDirect(Ht);
+  er.computeDirect(Hr);
   d.weakest_eigenvalue = std::numeric_limits<double>::max();
   for (int block = 0; block < 2; ++block) {
     const auto& solver = block == 0 ? et : er;
@@ -140,36 +112,48 @@ Degeneracy analyse(const NormalEquations& ne, double threshold, int min_plane_co
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config) {
+  return register_scan(points, map, prior, max_distance_m, kernel_scale_m, config, {});
+}
+
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes) {
   RegistrationResult result;
   result.pose = prior.mean;
-  // Graduated kernel (in the spirit of GNC, Yang et al., RA-L 2020): start
-  // wide enough to pull in from the prediction's error, then halve the scale
-  // each time the estimate settles, down to the floor set by the sensor's
-  // noise, so that wrong associations made early cannot bias the end result.
+  // Graduated kernel: start wide enough to pull in from the prediction's
+  // error, halve the scale every iteration down to the floor set by the
+  // sensor's noise (so that associations made early cannot bias the end
+  // result), then iterate at the floor until the update is negligible.
   double kappa = std::max(kernel_scale_m, config.min_kernel_scale_m);
+  const double data_scale = 1.0 / (config.point_sigma_m * config.point_sigma_m);
   NormalEquations ne;
   Degeneracy degeneracy;
+  // The planes found for each point are kept (when `planes` has room) and
+  // searched again only after the pose has moved enough to change them: the
+  // search is most of the cost, and near convergence the pose moves by mm.
+  Eigen::Isometry3d associated_at = result.pose;
   for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
-    ne = build(points, map, result.pose, max_distance_m, kappa * kappa);
+    const Eigen::Isometry3d moved = associated_at.inverse() * result.pose;
+    const bool associate = iteration == 1 || moved.translation().norm() > config.reassociate_m ||
+                           Eigen::AngleAxisd(moved.linear()).angle() > config.reassociate_rad;
+    if (associate) associated_at = result.pose;
+    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config, planes, associate);
     degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
-    // Prior residual in the left tangent space: e = log(T · mean⁻¹), ∂e/∂δ ≈ I.
-    const Vector6d e = log_se3(result.pose * prior.mean.inverse());
-    const Matrix6d H = ne.H + prior.information;
-    const Vector6d g = ne.g + prior.information * e;
+    // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
+    // e(T·exp(δ)) ≈ e + δ to first order.
+    const Vector6d e = log_se3(prior.mean.inverse() * result.pose);
+    const Matrix6d H = ne.H * data_scale + prior.information;
+    const Vector6d g = ne.g * data_scale + prior.information * e;
     Vector6d delta = H.ldlt().solve(-g);
     if (!delta.allFinite()) delta.setZero();
     // Solution remapping: no update along directions the scan cannot see.
     delta.head<3>() = degeneracy.translation_projector * delta.head<3>();
     delta.tail<3>() = degeneracy.rotation_projector * delta.tail<3>();
-    result.pose = exp_se3(delta) * result.pose;
+    result.pose = result.pose * exp_se3(delta);
     result.iterations = iteration;
-    // Wider kernels only steer: move on once they settle roughly; the final
-    // kernel decides, to the full tolerance.
     const bool last_level = kappa <= config.min_kernel_scale_m;
-    if (delta.norm() < (last_level ? 1.0 : 10.0) * config.convergence_norm) {
-      if (last_level) break;
-      kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
-    }
+    if (last_level && delta.norm() < config.convergence_norm) break;
+    kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
   }
   result.correspondences = ne.count;
   result.inlier_ratio = points.empty() ? 0.0 : static_cast<double>(ne.count) / static_cast<double>(points.size());
@@ -178,10 +162,13 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
   result.weakest_direction = degeneracy.weakest;
   result.weakest_eigenvalue = degeneracy.weakest_eigenvalue;
 
-  // Covariance ≈ σ² (H_data + Λ_prior)⁻¹ with σ the residual RMS (Censi 2007
-  // discusses why this is optimistic); directions constrained by nothing get
-  // a large variance instead of an infinite one.
-  const Matrix6d H = ne.H + prior.information;
+  // Covariance ≈ (H_data/σ² + Λ_prior)⁻¹, σ the larger of the configured
+  // point σ and the residual RMS (Censi 2007 discusses why this is
+  // optimistic); directions constrained by nothing get a large variance
+  // instead of an infinite one. Solved in the body frame, reported for a
+  // world-frame perturbation.
+  const double sigma = std::max(config.point_sigma_m, result.rmse_m);
+  const Matrix6d H = ne.H / (sigma * sigma) + prior.information;
   const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(H);
   constexpr double kUnconstrainedVariance = 1e6;
   Vector6d inverse_eigenvalues;
@@ -189,8 +176,9 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
     const double lambda = solver.eigenvalues()(i);
     inverse_eigenvalues(i) = lambda > 1e-9 ? 1.0 / lambda : kUnconstrainedVariance;
   }
-  const double sigma2 = std::max(result.rmse_m * result.rmse_m, 1e-6);
-  result.covariance = sigma2 * solver.eigenvectors() * inverse_eigenvalues.asDiagonal() * solver.eigenvectors().transpose();
+  const Matrix6d body = solver.eigenvectors() * inverse_eigenvalues.asDiagonal() * solver.eigenvectors().transpose();
+  const Matrix6d Ad = adjoint(result.pose);
+  result.covariance = Ad * body * Ad.transpose();
   return result;
 }
 

@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include <Eigen/Eigenvalues>
 
@@ -37,7 +38,6 @@ std::size_t VoxelHashMap::find_or_insert(const VoxelKey& key) {
   if (slots_[i].count > 0) return i;
   if (voxel_count_ >= max_voxels_) return kNone;
   slots_[i].key = key;  // count stays 0 until the caller stores a point
-  voxels_[i].plane = {};
   ++voxel_count_;
   return i;
 }
@@ -50,76 +50,99 @@ void VoxelHashMap::add(std::span<const Eigen::Vector3f> points) {
       continue;
     }
     voxels_[i].points[static_cast<std::size_t>(slots_[i].count++)] = p;
-    if (slots_[i].count >= kMinPointsForPlane) refit_plane(i);
   }
 }
 
-// The plane of a voxel's points: the covariance's eigenvector of the smallest
-// eigenvalue. Accepted only when the points are clearly flat (smallest
-// eigenvalue well below the middle one), else the normal stays zero and the
-// registration looks for a plane in a neighbouring voxel.
-void VoxelHashMap::refit_plane(std::size_t index) {
-  const int n = slots_[index].count;
-  Voxel& voxel = voxels_[index];
-  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-  for (int i = 0; i < n; ++i) mean += voxel.points[static_cast<std::size_t>(i)];
-  mean /= static_cast<float>(n);
-  Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3f d = voxel.points[static_cast<std::size_t>(i)] - mean;
-    covariance.noalias() += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance, Eigen::ComputeEigenvectors);
-  const Eigen::Vector3f& eigenvalues = solver.eigenvalues();  // ascending
-  // 0.25 still accepts rock walls with a few cm of roughness over a voxel,
-  // and refuses voxels that straddle an edge or hold clutter.
-  constexpr float kFlatness = 0.25F;  // λ0 / λ1
-  voxel.plane.mean = mean;
-  voxel.plane.normal = eigenvalues(0) < kFlatness * eigenvalues(1) ? Eigen::Vector3f(solver.eigenvectors().col(0))
-                                                                    : Eigen::Vector3f::Zero();
+template <typename Bound, typename F>
+void VoxelHashMap::visit_around(const Eigen::Vector3f& query, Bound&& bound, F&& f) const {
+  const VoxelKey center = key_of(query);
+  // The query's offset inside its voxel, per axis: the squared distance to a
+  // neighbour voxel's box is the sum of the gaps on the axes where it differs.
+  // Neighbours whose box is already farther than the bound are skipped, the
+  // own voxel first, so most queries look at one or a few voxels.
+  const Eigen::Vector3f low = query - Eigen::Vector3f(static_cast<float>(center.x), static_cast<float>(center.y),
+                                                      static_cast<float>(center.z)) * voxel_size_;
+  const Eigen::Vector3f high = Eigen::Vector3f::Constant(voxel_size_) - low;
+  const auto gap2 = [&](int d, int axis) { return d < 0 ? low[axis] * low[axis] : d > 0 ? high[axis] * high[axis] : 0.0F; };
+  const auto visit = [&](int dx, int dy, int dz) {
+    if (gap2(dx, 0) + gap2(dy, 1) + gap2(dz, 2) >= bound()) return;
+    const std::size_t s = find({center.x + dx, center.y + dy, center.z + dz});
+    if (s != kNone) f(voxels_[s].points, slots_[s].count);
+  };
+  visit(0, 0, 0);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz)
+        if (dx != 0 || dy != 0 || dz != 0) visit(dx, dy, dz);
 }
 
 MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distance_m) const {
   MapNeighbor best;
   best.distance_sq = max_distance_m * max_distance_m;
-  const VoxelKey center = key_of(query);
-  // The query's offset inside its voxel, per axis: the squared distance to a
-  // neighbour voxel's box is the sum of the gaps on the axes where it differs.
-  // Neighbours whose box is already farther than the best match are skipped,
-  // the own voxel first, so most queries look at one or a few voxels.
-  const Eigen::Vector3f low = query - Eigen::Vector3f(static_cast<float>(center.x), static_cast<float>(center.y),
-                                                      static_cast<float>(center.z)) * voxel_size_;
-  const Eigen::Vector3f high = Eigen::Vector3f::Constant(voxel_size_) - low;
-  const auto gap2 = [&](int d, int axis) { return d < 0 ? low[axis] * low[axis] : d > 0 ? high[axis] * high[axis] : 0.0F; };
-  const auto search = [&](int dx, int dy, int dz) {
-    if (gap2(dx, 0) + gap2(dy, 1) + gap2(dz, 2) >= best.distance_sq) return;
-    const std::size_t s = find({center.x + dx, center.y + dy, center.z + dz});
-    if (s == kNone) return;
-    const Voxel& v = voxels_[s];
-    for (int i = 0; i < slots_[s].count; ++i) {
-      const Eigen::Vector3f& p = v.points[static_cast<std::size_t>(i)];
+  visit_around(query, [&] { return best.distance_sq; }, [&](const auto& points, int count) {
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector3f& p = points[static_cast<std::size_t>(i)];
       const float d = (p - query).squaredNorm();
       if (d < best.distance_sq) {
         best.distance_sq = d;
         best.point = p;
-        best.normal = v.plane.normal;
         best.found = true;
       }
     }
-  };
-  search(0, 0, 0);
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz)
-        if (dx != 0 || dy != 0 || dz != 0) search(dx, dy, dz);
+  });
   if (!best.found) best.distance_sq = 0.0F;
   return best;
 }
 
-const VoxelPlane* VoxelHashMap::plane_at(const Eigen::Vector3f& query) const {
-  const std::size_t s = find(key_of(query));
-  return s != kNone && slots_[s].count >= kMinPointsForPlane && !voxels_[s].plane.normal.isZero() ? &voxels_[s].plane
-                                                                                                   : nullptr;
+MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors, float max_plane_error_m) const {
+  // k nearest within one voxel edge, kept sorted by distance (k is small).
+  const int k = std::clamp(neighbors, 3, kMaxPlaneNeighbors);
+  std::array<float, kMaxPlaneNeighbors> d2;
+  std::array<Eigen::Vector3f, kMaxPlaneNeighbors> near;
+  d2.fill(voxel_size_ * voxel_size_);
+  int found = 0;
+  visit_around(query, [&] { return d2[static_cast<std::size_t>(k - 1)]; }, [&](const auto& points, int count) {
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector3f& p = points[static_cast<std::size_t>(i)];
+      const float d = (p - query).squaredNorm();
+      if (d >= d2[static_cast<std::size_t>(k - 1)]) continue;
+      int j = k - 1;
+      for (; j > 0 && d2[static_cast<std::size_t>(j - 1)] > d; --j) {
+        d2[static_cast<std::size_t>(j)] = d2[static_cast<std::size_t>(j - 1)];
+        near[static_cast<std::size_t>(j)] = near[static_cast<std::size_t>(j - 1)];
+      }
+      d2[static_cast<std::size_t>(j)] = d;
+      near[static_cast<std::size_t>(j)] = p;
+      found = std::min(found + 1, k);
+    }
+  });
+  MapPlane plane;
+  if (found < k) return plane;
+  // The plane: the covariance's eigenvector of the smallest eigenvalue
+  // (relative to the first neighbour, in double, for precision far from the origin).
+  const auto used = std::span(near).first(static_cast<std::size_t>(k));
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : used) mean += (p - near[0]).cast<double>();
+  mean /= k;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto& p : used) {
+    const Eigen::Vector3d d = (p - near[0]).cast<double>() - mean;
+    covariance.noalias() += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
+  const Eigen::Vector3d& lambda = solver.eigenvalues();  // ascending
+  // Five points along one ring are a line: their "normal" would be any
+  // direction across it. Flat means thin across, wide along two directions.
+  constexpr double kFlatness = 0.1;  // λ0 / λ1
+  if (!(lambda(0) < kFlatness * lambda(1))) return plane;
+  const Eigen::Vector3d normal = solver.eigenvectors().col(0);
+  for (const auto& p : used)
+    if (std::abs(normal.dot((p - near[0]).cast<double>() - mean)) > max_plane_error_m) return plane;
+  plane.point = near[0] + mean.cast<float>();
+  plane.normal = normal.cast<float>();
+  plane.found = true;
+  return plane;
 }
 
 void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {

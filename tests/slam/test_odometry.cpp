@@ -80,6 +80,48 @@ TEST(Odometry, BadScansAreHeldWithAReasonAndTheOdometryRecovers) {
   EXPECT_LT((again.pose.translation() - Eigen::Vector3d(0.5, 0.1, 0.0)).norm(), 0.05);
 }
 
+TEST(Odometry, AWheelPriorThatSlippedIsOverruledByTheScan) {
+  const auto hall = test::room(400000, 23, 25.0F, 12.0F, 4.0F);
+  OdometryConfig config;
+  config.max_range_m = 30.0F;
+  Odometry odometry(config);
+  MotionPrior step;  // 0.15 m forward per scan, as the wheels report it
+  step.delta.translation() << 0.15, 0.0, 0.0;
+  step.covariance.diagonal() << 1e-4, 1e-4, 2.5e-3, 4e-4, 4e-4, 2.5e-5;  // σ 1 cm, 5 cm z, 1.1° roll/pitch, 0.3° yaw
+  OdometryResult r;
+  for (int k = 0; k < 12; ++k) {
+    const Eigen::Isometry3d truth = planar_pose(-6.0 + 0.15 * k, 0.0, 0.0);
+    std::optional<MotionPrior> wheel;
+    if (k > 0) wheel = step;
+    if (k == 8) {  // a wheel spun: the encoders claim a 25° turn and 1.5 m
+      wheel->delta = planar_pose(1.5, 0.0, 25.0 * M_PI / 180);
+    }
+    r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, observe(hall, truth, 20000, 200 + static_cast<unsigned>(k)), {}},
+                         wheel);
+    ASSERT_TRUE(r.valid) << "scan " << k;
+    EXPECT_EQ(r.wheel_rejected, k == 8) << "scan " << k;
+    const Eigen::Isometry3d expected = planar_pose(-6.0, 0.0, 0.0).inverse() * truth;
+    EXPECT_LT((r.pose.translation() - expected.translation()).norm(), 0.03) << "scan " << k;
+    EXPECT_LT(Eigen::AngleAxisd(r.pose.linear().transpose() * expected.linear()).angle(), 0.3 * M_PI / 180) << "scan " << k;
+  }
+}
+
+TEST(Odometry, AFeaturelessTunnelIsReportedDegenerateWithALooseAxis) {
+  const auto tunnel = test::tunnel(400000, 24);
+  Odometry odometry(OdometryConfig{});
+  OdometryResult r;
+  for (int k = 0; k < 6; ++k) {
+    r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, observe(tunnel, planar_pose(0.1 * k, 0.0, 0.0), 15000,
+                                                                                300 + static_cast<unsigned>(k)), {}});
+    ASSERT_TRUE(r.valid) << "scan " << k;
+  }
+  // Valid, but the status and the covariance say the axis is unknown: no
+  // confident answer along it.
+  EXPECT_EQ(r.status, OdometryStatus::degenerate);
+  EXPECT_GT(std::abs(r.registration.weakest_direction(0)), 0.99) << r.registration.weakest_direction.transpose();
+  EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));
+}
+
 TEST(Deskew, UndoesTheMotionDuringTheScan) {
   // A sensor moving at 2 m/s along x and turning at 90°/s measures a wall at
   // x = 5 (world) over 0.1 s; deskewed, the points lie on the wall in the

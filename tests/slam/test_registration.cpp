@@ -39,7 +39,9 @@ TEST(Registration, RecoversAKnownMotionInARoom) {
   EXPECT_LT((r.pose.translation() - truth.translation()).norm(), 0.005);
   EXPECT_LT(rotation_error_deg(r.pose, truth), 0.05);
   EXPECT_FALSE(r.degenerate) << "weakest " << r.weakest_direction.transpose() << " λ " << r.weakest_eigenvalue;
-  EXPECT_GT(r.inlier_ratio, 0.95);
+  // Points whose 10 nearest map points straddle an edge of the room have no
+  // plane, by design (about 6% of a 12 × 8 × 4 m room at 0.5 m voxels).
+  EXPECT_GT(r.inlier_ratio, 0.9);
   EXPECT_LT(r.rmse_m, 0.01);
 }
 
@@ -73,6 +75,24 @@ TEST(Registration, AnInformativePriorDecidesTheDegenerateDirection) {
   const RegistrationResult r = register_scan(scan, map, prior, 1.0, 0.2);
   EXPECT_NEAR(r.pose.translation().x(), 1.3, 1e-3);
   EXPECT_NEAR(r.pose.translation().y(), 0.0, 0.005);  // the walls win across the tunnel
+}
+
+// Far from the odometry origin a world-frame perturbation mixes rotation into
+// translation (a rotation about the origin 200 m away moves the sensor 3.5 m
+// per degree): the prior and the degeneracy test must be judged at the sensor.
+TEST(Registration, FarFromTheOriginTheRotationIsNotHeldBackByThePrior) {
+  const Eigen::Isometry3d far = pose(200.0, -150.0, 10.0, 30.0);
+  VoxelHashMap map(0.5F, 1 << 16);
+  map.add(test::transformed(test::room(60000, 11), far));
+  const Eigen::Isometry3d truth = far * pose(0.2, -0.1, 0.0, 3.0);
+  const auto scan = test::transformed(test::room(8000, 12), truth.inverse() * far);
+  PosePrior prior;  // constant velocity: the previous pose, loose
+  prior.mean = far;
+  prior.information.diagonal() << 4.0, 4.0, 4.0, 25.0, 25.0, 25.0;
+  const RegistrationResult r = register_scan(scan, map, prior, 1.0, 0.2);
+  EXPECT_LT((r.pose.translation() - truth.translation()).norm(), 0.01);
+  EXPECT_LT(rotation_error_deg(r.pose, truth), 0.05);
+  EXPECT_FALSE(r.degenerate) << "weakest " << r.weakest_direction.transpose() << " λ " << r.weakest_eigenvalue;
 }
 
 TEST(Registration, AnEmptyMapOrScanLeavesThePriorAndFlagsIt) {

@@ -57,20 +57,35 @@ TEST(VoxelHashMap, RefusesNewVoxelsBeyondThreeQuartersOfTheTable) {
   EXPECT_EQ(map.dropped_points(), 8U);
 }
 
-TEST(VoxelHashMap, FlatVoxelsGetTheirPlaneNormalAndCornersNone) {
-  VoxelHashMap map(1.0F, 64);
-  std::vector<Eigen::Vector3f> floor;  // z = 0.2 plane inside voxel (0,0,0)
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) floor.emplace_back(0.1F + 0.2F * static_cast<float>(i), 0.1F + 0.2F * static_cast<float>(j), 0.2F);
+TEST(VoxelHashMap, NearestPlaneFitsTheNeighboursAndRefusesLinesAndClutter) {
+  VoxelHashMap map(0.5F, 256);
+  std::vector<Eigen::Vector3f> floor;  // z = 0.2, spread over several voxels
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) floor.emplace_back(0.1F * static_cast<float>(i), 0.1F * static_cast<float>(j), 0.2F);
   map.add(floor);
-  const MapNeighbor n = map.nearest({0.5F, 0.5F, 0.25F});
-  ASSERT_TRUE(n.found);
-  EXPECT_NEAR(std::abs(n.normal.z()), 1.0F, 1e-4F);
+  const MapPlane plane = map.nearest_plane({0.25F, 0.25F, 0.3F}, 5);
+  ASSERT_TRUE(plane.found);
+  EXPECT_NEAR(std::abs(plane.normal.z()), 1.0F, 1e-4F);
+  EXPECT_NEAR(plane.point.z(), 0.2F, 1e-5F);
 
-  std::vector<Eigen::Vector3f> blob = random_points(VoxelHashMap::kMaxPointsPerVoxel, 0.45F, 3);
-  for (auto& p : blob) p += Eigen::Vector3f(5.5F, 5.5F, 5.5F);
-  map.add(blob);
-  EXPECT_EQ(map.nearest({5.5F, 5.5F, 5.5F}).normal, Eigen::Vector3f::Zero());
+  // One ring of a spinning LiDAR: points along a line have no plane.
+  VoxelHashMap ring(0.5F, 256);
+  std::vector<Eigen::Vector3f> line;
+  for (int i = 0; i < 10; ++i) line.emplace_back(5.0F + 0.05F * static_cast<float>(i), 1.0F, 0.0F);
+  ring.add(line);
+  EXPECT_FALSE(ring.nearest_plane({5.2F, 1.05F, 0.0F}, 5).found);
+
+  // Clutter: neighbours spread in every direction (an octahedron's corners).
+  VoxelHashMap clutter(0.5F, 256);
+  const Eigen::Vector3f c(5.25F, 5.25F, 5.25F);
+  std::vector<Eigen::Vector3f> corners;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const float sign : {-0.1F, 0.1F}) corners.push_back(c + sign * Eigen::Vector3f::Unit(axis));
+  clutter.add(corners);
+  EXPECT_FALSE(clutter.nearest_plane(c, 5).found);
+
+  // Fewer neighbours within a voxel edge than asked for: none.
+  EXPECT_FALSE(map.nearest_plane({3.0F, 3.0F, 3.0F}, 5).found);
 }
 
 // remove_far under heavy hash collisions (a small, nearly full table): every

@@ -23,6 +23,7 @@
 #include "bench_baseline.hpp"
 #include "bench_pipeline.hpp"
 #include "bench_scans.hpp"
+#include "bench_wheels.hpp"
 #include "commands.hpp"
 #include "process_memory.hpp"
 
@@ -34,10 +35,13 @@ struct BenchOptions {
   std::string truth;
   std::string out;
   std::string baseline = "gicp";
+  std::string wheels_config;  // session config whose CAN log gives a wheel prior
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
   float max_range_m = 100.0F;
   float map_voxel_m = 0.5F;
   double degeneracy_threshold = slam::RegistrationConfig{}.degeneracy_threshold;
+  double point_sigma_m = slam::RegistrationConfig{}.point_sigma_m;
+  int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -99,7 +103,15 @@ int bench_odometry(const BenchOptions& o) {
   config.map_voxel_m = o.map_voxel_m;
   config.registration_voxel_m = 1.5F * o.map_voxel_m;
   config.registration.degeneracy_threshold = o.degeneracy_threshold;
+  config.registration.point_sigma_m = o.point_sigma_m;
+  config.registration.plane_neighbors = o.plane_neighbors;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
+  std::optional<WheelTrack> wheels;
+  if (!o.wheels_config.empty()) {
+    wheels = load_wheel_track(o.wheels_config);
+    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted)\n", wheels->t.size(),
+               wheels->distance.back(), wheels->rejected);
+  }
   const double rss_before = resident_mb();
   slam::Odometry odometry(config);
   slam::Trajectory estimate;
@@ -108,21 +120,37 @@ int bench_odometry(const BenchOptions& o) {
   std::size_t invalid = 0;
   std::vector<double> iterations;
   std::vector<double> used_points;
-  for (const BenchScan& scan : scans) {
+  std::vector<double> weakest;
+  std::size_t without_wheels = 0;
+  std::size_t wheel_rejected = 0;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const BenchScan& scan = scans[i];
+    std::optional<slam::MotionPrior> prior;
+    if (wheels && i > 0) {
+      prior = wheel_prior(*wheels, 1e-9 * static_cast<double>(scans[i - 1].stamp_ns), 1e-9 * static_cast<double>(scan.stamp_ns));
+      without_wheels += prior ? 0 : 1;
+    }
     slam::OdometryResult r;
-    ms.push_back(time_ms([&] { r = odometry.process({scan.stamp_ns, scan.points, scan.times_s}); }));
+    ms.push_back(time_ms([&] { r = odometry.process({scan.stamp_ns, scan.points, scan.times_s}, prior); }));
     degenerate += r.status == slam::OdometryStatus::degenerate ? 1 : 0;
     invalid += r.valid ? 0 : 1;
+    wheel_rejected += r.wheel_rejected ? 1 : 0;
     iterations.push_back(r.registration.iterations);
     used_points.push_back(static_cast<double>(r.registration_points));
+    if (r.status == slam::OdometryStatus::ok || r.status == slam::OdometryStatus::degenerate)
+      weakest.push_back(r.registration.weakest_eigenvalue);
     estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
   }
+  if (without_wheels > 0) fmt::print("wheels: {} scans outside the wheel log ran on constant velocity\n", without_wheels);
+  if (wheels) fmt::print("wheels: the prior disagreed with the scan on {} scans (constant velocity used)\n", wheel_rejected);
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
              "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
-             "  registration: {:.0f} points, {:.0f} iterations per scan (medians)\n",
+             "  registration: {:.0f} points, {:.0f} iterations per scan (medians); weakest direction's "
+             "eigenvalue median {:.4f}, 10th percentile {:.4f} (degenerate below {})\n",
              median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
-             peak_resident_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5));
+             peak_resident_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
+             quantile(weakest, 0.1), o.degeneracy_threshold);
   if (!o.out.empty()) {
     std::ofstream out(o.out);
     slam::write_tum(out, estimate);
@@ -174,11 +202,17 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--out", o->out, "Write adit's trajectory (TUM) here");
   odometry->add_option("--baseline", o->baseline, "gicp (PCL Generalized-ICP, scan to scan) or none")
       ->check(CLI::IsMember({"gicp", "none"}));
+  odometry->add_option("--wheels", o->wheels_config,
+                       "Session config (as aditd reads it) whose CAN log and wheel_odometry section give a motion prior");
   odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
   odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
   odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");
   odometry->add_option("--degeneracy-threshold", o->degeneracy_threshold,
                        "Normalised Hessian eigenvalue below which a direction counts as unconstrained");
+  odometry->add_option("--point-sigma", o->point_sigma_m,
+                       "σ of one point-to-plane residual, m: weighs the scan against the motion prior");
+  odometry->add_option("--plane-neighbors", o->plane_neighbors, "Map points each local plane is fitted through (3-16)")
+      ->check(CLI::Range(3, 16));
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");

@@ -62,4 +62,15 @@ inline Vector6d log_se3(const Eigen::Isometry3d& T) {
   return xi;
 }
 
+// The adjoint of SE(3) for twists ordered [v; ω] (Barfoot 2017, eq. 7.32):
+// T·exp(ε) = exp(Ad(T)·ε)·T, so a covariance moves between frames as Ad Σ Adᵀ.
+inline Matrix6d adjoint(const Eigen::Isometry3d& T) {
+  Matrix6d Ad = Matrix6d::Zero();
+  const Eigen::Matrix3d R = T.linear();
+  Ad.topLeftCorner<3, 3>() = R;
+  Ad.topRightCorner<3, 3>() = skew(T.translation()) * R;
+  Ad.bottomRightCorner<3, 3>() = R;
+  return Ad;
+}
+
 }  // namespace adit::slam

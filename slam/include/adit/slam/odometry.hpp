@@ -39,6 +39,9 @@ struct OdometryConfig {
   // weak prior so that degenerate directions stay anchored to the prediction.
   double constant_velocity_sigma_m = 0.5;
   double constant_velocity_sigma_rad = 0.2;
+  // A wheel prior whose registration matches fewer than this share of the
+  // previous scan's correspondences is checked against constant velocity.
+  double min_correspondence_share = 0.7;
   RegistrationConfig registration;
 };
 
@@ -71,6 +74,7 @@ struct OdometryResult {
   Matrix6d covariance = Matrix6d::Identity();
   OdometryStatus status = OdometryStatus::ok;
   bool valid = false;       // the pose comes from registration
+  bool wheel_rejected = false;  // the wheel prior disagreed with the scan; constant velocity was used
   RegistrationResult registration;
   std::size_t input_points = 0;
   std::size_t registration_points = 0;
@@ -100,11 +104,13 @@ class Odometry {
   std::vector<Eigen::Vector3f> frame_;       // map-resolution points
   std::vector<Eigen::Vector3f> source_;      // registration-resolution points
   std::vector<Eigen::Vector3f> registered_;
+  std::vector<MapPlane> planes_;             // registration's per-point planes
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Vector6d velocity_ = Vector6d::Zero();     // body twist per second
   std::int64_t last_stamp_ns_ = 0;
   bool started_ = false;
   bool reacquire_ = false;  // the next registration uses the initial threshold
+  double last_correspondences_ = 0.0;
 };
 
 }  // namespace adit::slam

@@ -6,9 +6,11 @@
 // the odometry thread can own it in steady state (open addressing, linear
 // probing, backward-shift deletion: Knuth, TAOCP vol. 3, §6.4, Algorithm R).
 //
-// Each voxel also keeps the plane fitted to its points (normal and a flatness
-// score), refreshed when the voxel changes; voxels fill up and then stop
-// changing, so the cost is paid a bounded number of times per voxel.
+// Point-to-plane registration asks for the plane through the k map points
+// nearest a query (as LOAM / FAST-LIO do), not for a plane fitted inside one
+// voxel: a VLP-16's sparse rings leave most single voxels with too few points
+// to fit, and snapping to ring points (point-to-point) pulls every scan back
+// towards the previous sensor position.
 
 #include <array>
 #include <cstdint>
@@ -22,23 +24,23 @@
 
 namespace adit::slam {
 
-// A voxel's fitted plane: a point on it (the points' mean) and its normal.
-struct VoxelPlane {
-  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
-};
-
 struct MapNeighbor {
   Eigen::Vector3f point = Eigen::Vector3f::Zero();  // the nearest map point
-  Eigen::Vector3f normal = Eigen::Vector3f::Zero(); // its voxel's plane normal, zero when not planar
   float distance_sq = 0.0F;
+  bool found = false;
+};
+
+// A local plane of the map: a point on it (the neighbours' mean) and its unit normal.
+struct MapPlane {
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
   bool found = false;
 };
 
 class VoxelHashMap {
  public:
   static constexpr int kMaxPointsPerVoxel = 20;
-  static constexpr int kMinPointsForPlane = 6;
+  static constexpr int kMaxPlaneNeighbors = 16;
 
   // capacity_voxels is rounded up to a power of two; the table is kept at
   // most 3/4 full (beyond that new voxels are refused and counted).
@@ -56,9 +58,12 @@ class VoxelHashMap {
   MapNeighbor nearest(const Eigen::Vector3f& query,
                       float max_distance_m = std::numeric_limits<float>::infinity()) const;
 
-  // The plane of the voxel containing `query`, when that voxel is flat: an
-  // O(1) correspondence for point-to-plane registration; nullptr otherwise.
-  const VoxelPlane* plane_at(const Eigen::Vector3f& query) const;
+  // The plane through the `neighbors` (≤ kMaxPlaneNeighbors) map points
+  // nearest `query`, all within one voxel edge of it (so the 27 voxels around
+  // it hold them all). Found only when they span a plane: not a line (a
+  // single ring of a spinning LiDAR), and every one within
+  // max_plane_error_m of the plane.
+  MapPlane nearest_plane(const Eigen::Vector3f& query, int neighbors, float max_plane_error_m = 0.1F) const;
 
   void clear();
   bool empty() const { return voxel_count_ == 0; }
@@ -84,7 +89,6 @@ class VoxelHashMap {
     std::int32_t count = 0;  // 0 = empty slot
   };
   struct Voxel {
-    VoxelPlane plane;  // normal is zero while the points are not clearly flat
     std::array<Eigen::Vector3f, kMaxPointsPerVoxel> points;
   };
 
@@ -94,7 +98,10 @@ class VoxelHashMap {
   std::size_t find(const VoxelKey& key) const;
   std::size_t find_or_insert(const VoxelKey& key);
   void erase_at(std::size_t index);
-  void refit_plane(std::size_t index);
+  // Visits the 27 voxels around `query`, own voxel first, skipping those whose
+  // box is farther than bound() (re-read after each voxel): f(points, count).
+  template <typename Bound, typename F>
+  void visit_around(const Eigen::Vector3f& query, Bound&& bound, F&& f) const;
   static constexpr std::size_t kNone = ~std::size_t{0};
 
   float voxel_size_;
