@@ -16,6 +16,7 @@
 #include "adit/common/log.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/thread_settings.hpp"
+#include "adit/daemon/wheel_feed.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_directory.hpp"
@@ -148,6 +149,7 @@ struct Pipeline::Impl {
       return slot;
     });
     odometry.emplace(options.odometry);
+    if (c.can.enabled && c.wheel_odometry.enabled) wheels.emplace(c);
     if (options.mapping) {
       map_slots.emplace(kMapSlots, overflow, [max_points] {
         MapSlot slot;
@@ -321,8 +323,10 @@ struct Pipeline::Impl {
         body_points.push_back(extrinsic * Eigen::Vector3f(p.x, p.y, p.z));
         body_times.push_back(1e-9F * static_cast<float>(p.time_offset_ns));
       }
+      const std::optional<slam::MotionPrior> prior = wheel_prior_for(slot->scan.start_time_ns);
       const std::int64_t t0 = monotonic_ns();
-      const slam::OdometryResult result = odometry->process({slot->scan.start_time_ns, body_points, body_times});
+      const slam::OdometryResult result =
+          odometry->process({slot->scan.start_time_ns, body_points, body_times}, prior);
       const std::int64_t t1 = monotonic_ns();
       if (timings.odometry_ms.size() < kTimingCapacity) timings.odometry_ms.push_back(1e-6 * static_cast<double>(t1 - t0));
       if (first_stamp_ns == 0) first_stamp_ns = slot->scan.start_time_ns;
@@ -345,6 +349,27 @@ struct Pipeline::Impl {
     stats.dropped_scans.store(scans->dropped());
     odometry_done.store(true, std::memory_order_release);
     odometry_beat.finished.store(true);
+  }
+
+  // Odometry thread: the wheels' motion since the previous scan, or nullopt
+  // (then odometry predicts with constant velocity). A replayed CAN log is
+  // waited for, so a replay as fast as possible still gets its priors.
+  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns) {
+    if (!wheels) return std::nullopt;
+    const double t = 1e-9 * static_cast<double>(stamp_ns);
+    wheels->drain_into(wheel_history);
+    while (wheels->replay() && wheel_history.latest() < t && !wheels->finished() &&
+           !stop.load(std::memory_order_relaxed)) {
+      odometry_beat.beat();
+      wait_a_little();
+      wheels->drain_into(wheel_history);
+    }
+    const double previous = previous_odometry_stamp_s;
+    previous_odometry_stamp_s = t;
+    if (previous <= 0.0) return std::nullopt;
+    std::optional<slam::MotionPrior> prior = wheel_history.prior(previous, t);
+    (prior ? stats.wheel_priors : stats.scans_without_wheels).fetch_add(1, std::memory_order_relaxed);
+    return prior;
   }
 
   // Odometry thread: copies (no allocation: the slot's buffers are reserved).
@@ -493,6 +518,9 @@ struct Pipeline::Impl {
   std::optional<slam::Odometry> odometry;
   Eigen::Isometry3f extrinsic;
   std::optional<drivers::PcapWriter> recorder;
+  std::optional<WheelFeed> wheels;
+  WheelHistory wheel_history{8192};       // odometry thread only: 80 s at 100 Hz
+  double previous_odometry_stamp_s = 0.0;  // odometry thread only
   std::optional<Handoff<MapSlot>> map_slots;
   // Mapping thread only:
   slam::TiledVoxelMap map;
@@ -548,6 +576,7 @@ void Pipeline::start(const SessionFiles& files) {
   Impl& i = *impl_;
   if (!i.threads.empty()) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.record_file);
+  if (i.wheels) i.wheels->start(files.can_record_file);
   if (i.config.threads.lock_memory) {
     auto w = lock_memory();
     i.warnings.insert(i.warnings.end(), w.begin(), w.end());
@@ -567,6 +596,7 @@ void Pipeline::join() {
   Impl& i = *impl_;
   for (std::thread& t : i.threads)
     if (t.joinable()) t.join();
+  if (i.wheels) i.wheels->stop();
   if (!i.threads.empty()) {
     i.timings.duration_s = 1e-9 * static_cast<double>(monotonic_ns() - i.started_ns);
     i.timings.sensor_span_s = 1e-9 * static_cast<double>(i.last_stamp_ns - i.first_stamp_ns);
@@ -592,6 +622,7 @@ std::vector<const Heartbeat*> Pipeline::heartbeats() const {
   std::vector<const Heartbeat*> beats{&impl_->receiver_beat, &impl_->assembly_beat, &impl_->odometry_beat,
                                       &impl_->output_beat};
   if (impl_->map_slots) beats.push_back(&impl_->mapping_beat);
+  if (impl_->wheels) beats.push_back(&impl_->wheels->heartbeat());
   return beats;
 }
 

@@ -129,6 +129,7 @@ std::string Sessions::start_locked() {
   SessionFiles files;
   files.trajectory_file = dir / "trajectory.tum";
   if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
+  if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
   try {
     if (!pipeline) pipeline = build_pipeline();  // the last one could not be built ahead
     pipeline->start(files);
@@ -216,6 +217,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       files.push_back("keyframes.tum");
     }
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
+    if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {
         {"session", id},
         {"lidar", {{"model", config_.lidar.model}, {"datagrams", s.datagrams.load()},
@@ -224,7 +226,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"scans", {{"total", s.scans.load()}, {"incomplete", s.incomplete_scans.load()},
                    {"dropped", s.dropped_scans.load()}}},
         {"poses", {{"total", s.poses.load()}, {"invalid", s.invalid_poses.load()},
-                   {"degenerate", s.degenerate_poses.load()}}},
+                   {"degenerate", s.degenerate_poses.load()}, {"with_wheel_prior", s.wheel_priors.load()},
+                   {"wheels_missing", s.scans_without_wheels.load()}}},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()}}},

@@ -72,6 +72,8 @@ struct PipelineStats {
   std::atomic<std::uint64_t> map_points{0};
   std::atomic<std::uint64_t> map_tiles{0};
   std::atomic<std::uint64_t> keyframes{0};
+  std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
+  std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
 };
 
 // A stage's queue and its thread's CPU time, for the status message.
@@ -98,6 +100,7 @@ struct PipelineTimings {
 struct SessionFiles {
   std::filesystem::path trajectory_file;  // TUM; empty = none (or PipelineOptions')
   std::filesystem::path record_file;      // raw packets as pcap; empty = none
+  std::filesystem::path can_record_file;  // the CAN bus as candump -L; empty = none
 };
 
 class Pipeline {

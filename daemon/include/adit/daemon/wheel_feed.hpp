@@ -1,0 +1,99 @@
+#pragma once
+// Wheel encoders for the odometry's prior (config `can:` + `wheel_odometry:`).
+// A thread reads CAN frames (SocketCAN on the payload, or a candump -L log
+// for replays), records the bus when `can.record` is set, decodes the two
+// wheel signals, integrates slam::WheelOdometry and hands timed planar poses
+// to the odometry thread through a lock-free hand-off. The odometry thread
+// keeps the recent ones in a WheelHistory and asks it for the motion between
+// two scans (slam::wheel_motion_prior).
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/handoff.hpp"
+#include "adit/daemon/heartbeat.hpp"
+#include "adit/drivers/can/dbc.hpp"
+#include "adit/slam/odometry.hpp"
+#include "adit/slam/pose2.hpp"
+
+namespace adit::daemon {
+
+// The messages that carry the config's signals: its DBC file and inline
+// signals (throws adit::InputError naming the DBC file).
+std::vector<drivers::can::MessageSpec> can_messages_of(const config::Config& config);
+
+struct WheelSample {
+  double t = 0.0;         // s, on the LiDAR clock (wheel_odometry.time_offset_s removed)
+  slam::Pose2 pose;       // integrated body pose
+  double distance = 0.0;  // m travelled so far
+};
+
+// The odometry thread's recent wheel samples: fixed capacity, oldest dropped.
+class WheelHistory {
+ public:
+  explicit WheelHistory(std::size_t capacity);
+  void push(const WheelSample& sample);
+  // Time of the newest sample; -infinity when empty.
+  double latest() const;
+  // The body motion from t0 to t1 by the wheels (interpolated), nullopt
+  // when the samples do not cover [t0, t1].
+  std::optional<slam::MotionPrior> prior(double t0, double t1) const;
+
+ private:
+  const WheelSample& at(std::size_t i) const { return ring_[(first_ + i) % ring_.size()]; }
+  bool interpolate(double t, slam::Pose2& pose, double& distance) const;
+  std::vector<WheelSample> ring_;
+  std::size_t first_ = 0;
+  std::size_t size_ = 0;
+};
+
+struct WheelFeedStats {
+  std::atomic<std::uint64_t> frames{0};
+  std::atomic<std::uint64_t> samples{0};
+  std::atomic<std::uint64_t> untrusted{0};  // slip, glitches, gaps (slam::WheelStep other than integrated)
+  std::atomic<std::uint64_t> dropped{0};    // live: the odometry thread fell behind
+  std::atomic<std::uint64_t> recorded{0};
+  std::atomic<std::int64_t> last_frame_us{0};
+};
+
+class WheelFeed {
+ public:
+  // Opens the source (throws adit::InputError naming the log or the
+  // interface) and builds the decoder; `replay` hand-offs wait instead of
+  // dropping, so a replay as fast as possible loses nothing.
+  explicit WheelFeed(const config::Config& config);
+  ~WheelFeed();
+  WheelFeed(const WheelFeed&) = delete;
+  WheelFeed& operator=(const WheelFeed&) = delete;
+
+  // Starts the thread; `record_file` (candump -L) may be empty.
+  void start(const std::filesystem::path& record_file);
+  void stop();
+  // Odometry thread: moves every available sample into `history`.
+  void drain_into(WheelHistory& history);
+  // A replayed log has been read to its end and every sample handed over.
+  bool finished() const { return finished_.load(std::memory_order_acquire); }
+  bool replay() const { return replay_; }
+  const WheelFeedStats& stats() const { return stats_; }
+  const Heartbeat& heartbeat() const { return beat_; }
+
+ private:
+  struct Impl;
+  void run();
+  std::unique_ptr<Impl> impl_;
+  bool replay_ = false;
+  Handoff<WheelSample> samples_;
+  WheelFeedStats stats_;
+  Heartbeat beat_{"wheels"};
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> finished_{false};
+  std::thread thread_;
+};
+
+}  // namespace adit::daemon

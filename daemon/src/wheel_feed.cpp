@@ -1,0 +1,227 @@
+#include "adit/daemon/wheel_feed.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/drivers/can/candump.hpp"
+#include "adit/drivers/can/decoder.hpp"
+#include "adit/drivers/can/signal.hpp"
+#include "adit/drivers/can/socketcan.hpp"
+#include "adit/slam/wheel_odometry.hpp"
+#include "adit/slam/wheel_prior.hpp"
+
+namespace adit::daemon {
+namespace can = drivers::can;
+
+std::vector<can::MessageSpec> can_messages_of(const config::Config& c) {
+  if (!c.can.preset.empty())
+    throw InputError("", "can.preset", "aditd reads wheel signals from can.dbc or can.signals; presets are for adit can-decode");
+  std::vector<can::MessageSpec> messages;
+  if (!c.can.dbc.empty()) messages = can::load_dbc(c.can.dbc).messages;
+  for (const config::CanSignal& s : c.can.signals) {
+    can::SignalSpec spec;
+    spec.name = s.name;
+    spec.start_bit = static_cast<unsigned>(s.start_bit);
+    spec.length = static_cast<unsigned>(s.length);
+    spec.byte_order = s.byte_order == config::ByteOrder::motorola ? can::ByteOrder::motorola : can::ByteOrder::intel;
+    spec.is_signed = s.value_type == config::ValueType::signed_int;
+    spec.type = s.value_type == config::ValueType::ieee_float
+                    ? (s.length == 64 ? can::ValueType::float64 : can::ValueType::float32)
+                    : can::ValueType::integer;
+    spec.factor = s.factor;
+    spec.offset = s.offset;
+    spec.unit = s.unit;
+    can::add_inline_signal(messages, s.id, s.extended, spec);
+  }
+  return messages;
+}
+
+// --- WheelHistory ---------------------------------------------------------
+
+WheelHistory::WheelHistory(std::size_t capacity) : ring_(std::max<std::size_t>(capacity, 2)) {}
+
+void WheelHistory::push(const WheelSample& sample) {
+  if (size_ > 0 && !(sample.t > at(size_ - 1).t)) return;  // time must advance
+  if (size_ == ring_.size()) {
+    first_ = (first_ + 1) % ring_.size();
+    --size_;
+  }
+  ring_[(first_ + size_) % ring_.size()] = sample;
+  ++size_;
+}
+
+double WheelHistory::latest() const {
+  return size_ == 0 ? -std::numeric_limits<double>::infinity() : at(size_ - 1).t;
+}
+
+bool WheelHistory::interpolate(double t, slam::Pose2& pose, double& distance) const {
+  if (size_ < 2 || t < at(0).t || t > at(size_ - 1).t) return false;
+  // Binary search over the ring for the first sample at or after t.
+  std::size_t lo = 1;
+  std::size_t hi = size_ - 1;
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi) / 2;
+    if (at(mid).t < t) lo = mid + 1;
+    else hi = mid;
+  }
+  const WheelSample& a = at(lo - 1);
+  const WheelSample& b = at(lo);
+  const double u = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
+  pose = {a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
+          a.pose.theta + u * slam::wrap_angle(b.pose.theta - a.pose.theta)};
+  distance = a.distance + u * (b.distance - a.distance);
+  return true;
+}
+
+std::optional<slam::MotionPrior> WheelHistory::prior(double t0, double t1) const {
+  slam::Pose2 p0;
+  slam::Pose2 p1;
+  double d0 = 0.0;
+  double d1 = 0.0;
+  if (!(t1 > t0) || !interpolate(t0, p0, d0) || !interpolate(t1, p1, d1)) return std::nullopt;
+  return slam::wheel_motion_prior(p0, p1, d1 - d0);
+}
+
+// --- WheelFeed --------------------------------------------------------------
+
+struct WheelFeed::Impl {
+  config::Config config;
+  can::SignalDecoder decoder;
+  std::size_t left = 0;
+  std::size_t right = 0;
+  slam::WheelOdometry odometry;
+  std::optional<can::CandumpReader> log;
+  std::optional<can::CanSocket> socket;
+  std::optional<can::CandumpWriter> recorder;
+  std::vector<double> values;
+
+  static slam::WheelGeometry geometry_of(const config::WheelOdometrySection& w) {
+    slam::WheelGeometry g;
+    g.left_radius = w.left_radius_m;
+    g.right_radius = w.right_radius_m;
+    g.track_width = w.track_width_m;
+    g.skid_factor = w.model == config::DriveModel::skid_steer ? 1.5 : 1.0;
+    g.counts_per_revolution = w.counts_per_revolution;
+    g.counter_bits = static_cast<unsigned>(w.counter_bits);
+    return g;
+  }
+
+  explicit Impl(const config::Config& c)
+      : config(c),
+        decoder(can_messages_of(c), std::vector<std::string>{c.wheel_odometry.left_signal, c.wheel_odometry.right_signal},
+                c.wheel_odometry.quantity != config::WheelQuantity::counts),
+        odometry(geometry_of(c.wheel_odometry)) {
+    const int l = decoder.slot(c.wheel_odometry.left_signal);
+    const int r = decoder.slot(c.wheel_odometry.right_signal);
+    if (l < 0) throw InputError("", "wheel_odometry.left_signal", "no such signal in can.dbc / can.signals");
+    if (r < 0) throw InputError("", "wheel_odometry.right_signal", "no such signal in can.dbc / can.signals");
+    left = static_cast<std::size_t>(l);
+    right = static_cast<std::size_t>(r);
+    values.resize(decoder.slot_count());
+    if (c.can.source == config::CanSource::candump) {
+      log.emplace(c.can.log);
+    } else {
+      can::SocketOptions options;
+      options.interface = c.can.interface;
+      try {
+        socket.emplace(can::CanSocket::open(options));
+      } catch (const std::runtime_error& e) {
+        throw InputError(c.can.interface, "can.interface", e.what());
+      }
+    }
+  }
+};
+
+WheelFeed::WheelFeed(const config::Config& config)
+    : impl_(std::make_unique<Impl>(config)),
+      replay_(config.can.source == config::CanSource::candump),
+      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return WheelSample{}; }) {}
+
+WheelFeed::~WheelFeed() { stop(); }
+
+void WheelFeed::start(const std::filesystem::path& record_file) {
+  if (!record_file.empty()) impl_->recorder.emplace(record_file);
+  thread_ = std::thread([this] { run(); });
+}
+
+void WheelFeed::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  if (impl_->recorder) {
+    try {
+      impl_->recorder->flush();
+    } catch (const std::exception& e) {
+      log::error("CAN recording: {}", e.what());
+    }
+  }
+}
+
+void WheelFeed::drain_into(WheelHistory& history) {
+  while (WheelSample* s = samples_.take()) {
+    history.push(*s);
+    samples_.release(s);
+  }
+}
+
+void WheelFeed::run() {
+  Impl& i = *impl_;
+  const config::WheelOdometrySection& w = i.config.wheel_odometry;
+  double value_left = NAN;
+  double value_right = NAN;
+  can::Frame frame;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    beat_.beat();
+    if (i.log) {
+      if (!i.log->next(frame)) break;  // the replayed log has ended
+    } else if (i.socket->read(frame, 100) != can::ReadResult::frame) {
+      continue;
+    }
+    stats_.frames.fetch_add(1, std::memory_order_relaxed);
+    stats_.last_frame_us.store(frame.time_us, std::memory_order_relaxed);
+    if (i.recorder) {
+      i.recorder->write(frame);
+      stats_.recorded.fetch_add(1, std::memory_order_relaxed);
+    }
+    const can::DecodeResult r = i.decoder.decode(frame, i.values);
+    if (r.status != can::DecodeStatus::decoded) continue;
+    // Left and right may come in separate frames: a sample is taken when both
+    // have a value newer than the last sample.
+    const auto written = [&](std::size_t slot) {
+      return slot >= r.first && slot < r.first + r.count && !std::isnan(i.values[slot]);
+    };
+    if (written(i.left)) value_left = i.values[i.left];
+    if (written(i.right)) value_right = i.values[i.right];
+    if (std::isnan(value_left) || std::isnan(value_right)) continue;
+    const double t = 1e-6 * static_cast<double>(frame.time_us) - w.time_offset_s;
+    slam::WheelStep step = slam::WheelStep::integrated;
+    switch (w.quantity) {
+      case config::WheelQuantity::counts:
+        step = i.odometry.add_counts(t, static_cast<std::uint64_t>(static_cast<std::int64_t>(value_left)),
+                                     static_cast<std::uint64_t>(static_cast<std::int64_t>(value_right)));
+        break;
+      case config::WheelQuantity::angular_speed: step = i.odometry.add_wheel_rates(t, value_left, value_right); break;
+      case config::WheelQuantity::speed: step = i.odometry.add_speeds(t, value_left, value_right); break;
+    }
+    value_left = value_right = NAN;
+    if (step != slam::WheelStep::integrated && step != slam::WheelStep::first)
+      stats_.untrusted.fetch_add(1, std::memory_order_relaxed);
+    if (step == slam::WheelStep::time_backwards) continue;
+    WheelSample* out = nullptr;
+    while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {
+      beat_.beat();  // replay: the odometry thread has not caught up
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (out == nullptr) break;
+    *out = {t, i.odometry.pose(), i.odometry.distance()};
+    samples_.publish(out);
+    stats_.samples.fetch_add(1, std::memory_order_relaxed);
+  }
+  stats_.dropped.store(samples_.dropped());
+  finished_.store(true, std::memory_order_release);
+  beat_.finished.store(true);
+}
+
+}  // namespace adit::daemon
