@@ -8,16 +8,18 @@
 
 namespace {
 std::atomic<std::uint64_t> g_allocations{0};  // test instrumentation: counts every operator new
+}  // namespace
 
+std::uint64_t adit::test::allocations() { return g_allocations.load(std::memory_order_relaxed); }
+
+#if ADIT_COUNTING_ALLOCATIONS
+namespace {
 void* counted_alloc(std::size_t size) noexcept {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   return std::malloc(size == 0 ? 1 : size);
 }
 }  // namespace
 
-std::uint64_t adit::test::allocations() { return g_allocations.load(std::memory_order_relaxed); }
-
-#if ADIT_COUNTING_ALLOCATIONS
 void* operator new(std::size_t size) {
   if (void* p = counted_alloc(size)) return p;
   throw std::bad_alloc();

@@ -2,6 +2,8 @@
 // scans, as fast as possible or at a chosen pace; writes the trajectory and
 // prints the pipeline's figures (counters, odometry time, latency, memory).
 
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
@@ -31,7 +33,8 @@ int replay(const ReplayOptions& o) {
     throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
                      "a scan directory is replayed as fast as possible (the pipeline does not pace it)");
   daemon::PipelineOptions options;
-  options.trajectory_file = o.out;
+  // Absolute: the pipeline creates the file's folder, and a bare name has none.
+  if (!o.out.empty()) options.trajectory_file = std::filesystem::absolute(o.out);
   options.replay_speed = o.realtime ? 1.0 : o.speed;
   daemon::Pipeline pipeline(config, options);
   const PipelineFigures figures = run_pipeline(pipeline);
