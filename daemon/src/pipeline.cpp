@@ -179,11 +179,11 @@ struct Pipeline::Impl {
     if (!record_file.empty()) {
       if (!udp && !pcap)
         throw InputError(record_file.string(), "session.record_lidar", "only packet sources can be recorded");
-      std::filesystem::create_directories(record_file.parent_path());
+      if (record_file.has_parent_path()) std::filesystem::create_directories(record_file.parent_path());
       recorder.emplace(record_file);
     }
     if (!trajectory_file.empty()) {
-      std::filesystem::create_directories(trajectory_file.parent_path());
+      if (trajectory_file.has_parent_path()) std::filesystem::create_directories(trajectory_file.parent_path());
       trajectory.reset(std::fopen(trajectory_file.c_str(), "w"));
       if (!trajectory) throw InputError(trajectory_file.string(), "", "cannot write the trajectory");
     }
