@@ -62,6 +62,9 @@ void register_replay_commands(CLI::App& app, int& status) {
   auto* pcap = cmd->add_option("--pcap", o->inputs.pcap, "Capture to replay (sets lidar.source: pcap)");
   auto* scans = cmd->add_option("--scan-dir", o->inputs.scan_dir, "Directory of PCD or KITTI .bin scans (lidar.source: scan_dir)");
   pcap->excludes(scans);
+  cmd->add_option("--can-log", o->inputs.can_log,
+                  "Wheel encoders of this recording (candump -L; the config's can/wheel_odometry signals). Without "
+                  "it, --pcap/--scan-dir replay without wheels");
   cmd->add_option("--model", o->inputs.model, "Override lidar.model (VLP-16, PandarXT32, OS1-64, ...)");
   cmd->add_option("--calibration", o->inputs.calibration, "Override lidar.calibration");
   cmd->add_option("--out", o->out, "Write the trajectory here (TUM: one line per valid pose)");

@@ -21,6 +21,15 @@ config::Config load_pipeline_config(const PipelineInputs& in) {
     c.lidar.source = config::LidarSource::scan_dir;
     c.lidar.scan_dir = in.scan_dir;
   }
+  // Another recording than the config's: its own CAN log, or no wheels (the
+  // config's log belongs to its own recording).
+  if (!in.can_log.empty()) {
+    c.can.source = config::CanSource::candump;
+    c.can.log = in.can_log;
+  } else if (c.can.source == config::CanSource::candump && (!in.pcap.empty() || !in.scan_dir.empty())) {
+    c.can.enabled = false;
+    c.wheel_odometry.enabled = false;
+  }
   if (!in.model.empty()) c.lidar.model = in.model;
   if (!in.calibration.empty()) c.lidar.calibration = in.calibration;
   c.threads.lock_memory = false;

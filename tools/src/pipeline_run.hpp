@@ -21,6 +21,7 @@ struct PipelineInputs {
   std::string config_file = "firmware-config/default.yaml";
   std::string pcap;         // lidar.source: pcap
   std::string scan_dir;     // lidar.source: scan_dir
+  std::string can_log;      // candump -L log of the wheel encoders (can.source: candump)
   std::string model;        // lidar.model
   std::string calibration;  // lidar.calibration
 };
