@@ -357,13 +357,14 @@ struct Pipeline::Impl {
   std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns) {
     if (!wheels) return std::nullopt;
     const double t = 1e-9 * static_cast<double>(stamp_ns);
-    wheels->drain_into(wheel_history);
+    wheels->drain_into(wheel_history, t);
     while (wheels->replay() && wheel_history.latest() < t && !wheels->finished() &&
            !stop.load(std::memory_order_relaxed)) {
       odometry_beat.beat();
       wait_a_little();
-      wheels->drain_into(wheel_history);
+      wheels->drain_into(wheel_history, t);
     }
+    wheels->drain_into(wheel_history, t);  // what the feed handed over just before it finished
     const double previous = previous_odometry_stamp_s;
     previous_odometry_stamp_s = t;
     if (previous <= 0.0) return std::nullopt;

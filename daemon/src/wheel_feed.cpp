@@ -109,10 +109,23 @@ struct WheelFeed::Impl {
     return g;
   }
 
+  // The decoder of the two wheel signals; an unknown signal is named by its config key.
+  static can::SignalDecoder make_decoder(const config::Config& c) {
+    const config::WheelOdometrySection& w = c.wheel_odometry;
+    try {
+      return can::SignalDecoder(can_messages_of(c), std::vector<std::string>{w.left_signal, w.right_signal},
+                                w.quantity != config::WheelQuantity::counts);
+    } catch (const InputError& e) {
+      const std::string key = e.key() == w.left_signal    ? "wheel_odometry.left_signal"
+                              : e.key() == w.right_signal ? "wheel_odometry.right_signal"
+                                                          : e.key();
+      throw InputError(e.where(), key, e.reason());
+    }
+  }
+
   explicit Impl(const config::Config& c)
       : config(c),
-        decoder(can_messages_of(c), std::vector<std::string>{c.wheel_odometry.left_signal, c.wheel_odometry.right_signal},
-                c.wheel_odometry.quantity != config::WheelQuantity::counts),
+        decoder(make_decoder(c)),
         odometry(geometry_of(c.wheel_odometry)) {
     const int l = decoder.slot(c.wheel_odometry.left_signal);
     const int r = decoder.slot(c.wheel_odometry.right_signal);
@@ -159,8 +172,10 @@ void WheelFeed::stop() {
   }
 }
 
-void WheelFeed::drain_into(WheelHistory& history) {
-  while (WheelSample* s = samples_.take()) {
+void WheelFeed::drain_into(WheelHistory& history, double until_t) {
+  while (!(replay_ && history.latest() >= until_t)) {
+    WheelSample* s = samples_.take();
+    if (s == nullptr) return;
     history.push(*s);
     samples_.release(s);
   }

@@ -75,8 +75,11 @@ class WheelFeed {
   // Starts the thread; `record_file` (candump -L) may be empty.
   void start(const std::filesystem::path& record_file);
   void stop();
-  // Odometry thread: moves every available sample into `history`.
-  void drain_into(WheelHistory& history);
+  // Odometry thread: moves samples into `history`, oldest first, until one
+  // at or after `until_t` has moved (a replay: the rest waits in the
+  // hand-off, so the history keeps the window the next scans need) or none
+  // is left (live: everything).
+  void drain_into(WheelHistory& history, double until_t);
   // A replayed log has been read to its end and every sample handed over.
   bool finished() const { return finished_.load(std::memory_order_acquire); }
   bool replay() const { return replay_; }
