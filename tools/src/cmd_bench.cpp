@@ -109,8 +109,8 @@ int bench_odometry(const BenchOptions& o) {
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
     wheels = load_wheel_track(o.wheels_config);
-    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted)\n", wheels->t.size(),
-               wheels->distance.back(), wheels->rejected);
+    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted)\n", wheels->samples,
+               wheels->distance, wheels->rejected);
   }
   const double rss_before = resident_mb();
   slam::Odometry odometry(config);

@@ -41,6 +41,8 @@ class WheelHistory {
   void push(const WheelSample& sample);
   // Time of the newest sample; -infinity when empty.
   double latest() const;
+  // Distance travelled at the newest sample (0 when empty).
+  double latest_distance() const { return size_ == 0 ? 0.0 : at(size_ - 1).distance; }
   // The body motion from t0 to t1 by the wheels (interpolated), nullopt
   // when the samples do not cover [t0, t1].
   std::optional<slam::MotionPrior> prior(double t0, double t1) const;
