@@ -24,7 +24,8 @@ namespace adit::tools {
 namespace {
 
 constexpr double kLatencyTargetMs = 10.0;    // p99, issue #6
-constexpr std::int64_t kQuietNs = 500'000'000;  // after the last datagram: nothing more is coming
+constexpr std::int64_t kQuietNs = 500'000'000;   // everything sent arrived and nothing moved since: done
+constexpr std::int64_t kGiveUpNs = 5'000'000'000; // nothing moved for this long: the rest was lost
 
 struct BenchPipelineOptions {
   PipelineInputs inputs;
@@ -90,7 +91,11 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
       last_count = count;
       last_change_ns = now;
     }
-    return sent_all.load(std::memory_order_acquire) && now - last_change_ns > kQuietNs;
+    if (!sent_all.load(std::memory_order_acquire)) return false;
+    // A busy machine may not run the receiver for a while: wait for every
+    // datagram sent (or give up after a long silence, counting the rest lost).
+    const bool all_arrived = s.datagrams.load() >= run.sent.sent;
+    return (all_arrived && now - last_change_ns > kQuietNs) || now - last_change_ns > kGiveUpNs;
   };
   run.figures = run_pipeline(pipeline, hooks);
   stop_sending.store(true);
