@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   adit::tile_request_t request;
   if (!adit::protocol::checked_decode(data, size, request)) return 0;
   CountingSink sink;
-  adit::daemon::TilePublisher publisher({"rig1", {}, 1.0, 1.0e9, 0.0, 1}, sink);
+  adit::daemon::TilePublisher publisher({"rig1", {}, 1.0, 1.0e9, 0.0, 1, {}}, sink);
   publisher.reset("s1");
   std::vector<adit::protocol::MapPoint> points(64);
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = {0.1 * i, 0.2, 0.3, 1.0f, 0};
