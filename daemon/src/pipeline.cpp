@@ -14,6 +14,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/extrinsics.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/thread_settings.hpp"
 #include "adit/daemon/wheel_feed.hpp"
@@ -66,17 +67,6 @@ struct MapSlot {
   std::vector<float> intensities;
 };
 
-// The sensor's pose in the body frame, from the configuration.
-Eigen::Isometry3f extrinsic_of(const config::Transform& t) {
-  constexpr float kDeg = static_cast<float>(M_PI / 180.0);
-  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
-  T.linear() = (Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[2]) * kDeg, Eigen::Vector3f::UnitZ()) *
-                Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[1]) * kDeg, Eigen::Vector3f::UnitY()) *
-                Eigen::AngleAxisf(static_cast<float>(t.rpy_deg[0]) * kDeg, Eigen::Vector3f::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(t.xyz_m[0], t.xyz_m[1], t.xyz_m[2]).cast<float>();
-  return T;
-}
 
 void wait_a_little() { std::this_thread::sleep_for(std::chrono::microseconds(200)); }
 
@@ -107,7 +97,7 @@ struct Pipeline::Impl {
         options(o),
         overflow(c.lidar.source == config::LidarSource::udp ? Overflow::drop_oldest : Overflow::wait),
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
-        extrinsic(extrinsic_of(c.lidar.extrinsics)),
+        extrinsic(isometry_of(c.lidar.extrinsics).cast<float>()),
         map(map_config_of(c.map)),
         keyframe_selector({c.map.keyframe_distance_m, c.map.keyframe_angle_deg}) {
     options.odometry.min_range_m = static_cast<float>(c.lidar.min_range_m);

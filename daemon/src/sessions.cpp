@@ -6,7 +6,6 @@
 #include <cctype>
 #include <charconv>
 #include <iterator>
-#include <cstdio>
 #include <ctime>
 #include <fstream>
 
@@ -19,6 +18,7 @@
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/protocol/utime.hpp"
+#include "adit/slam/trajectory_io.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -50,12 +50,6 @@ std::vector<protocol::MapPoint> map_points_of(std::span<const slam::MapSample> s
   return out;
 }
 
-void write_tum_line(std::FILE* f, std::int64_t stamp_ns, const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.linear());
-  const Eigen::Vector3d& t = pose.translation();
-  fmt::print(f, "{:.9f} {:.6f} {:.6f} {:.6f} {:.9f} {:.9f} {:.9f} {:.9f}\n", 1e-9 * static_cast<double>(stamp_ns), t.x(),
-             t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-}
 
 std::int64_t disk_free_bytes(const std::filesystem::path& dir) {
   struct statvfs s {};
@@ -211,11 +205,13 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       protocol::write_map(file, *protocol::parse_map_format(name), all);
       files.push_back(file.filename().string());
     }
-    if (std::FILE* f = std::fopen((dir / "keyframes.tum").c_str(), "w")) {
-      for (const slam::Keyframe& k : pipeline->keyframes()) write_tum_line(f, k.stamp_ns, k.pose);
-      std::fclose(f);
-      files.push_back("keyframes.tum");
+    slam::Trajectory keyframes;
+    for (const slam::Keyframe& k : pipeline->keyframes()) {
+      keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
+      keyframes.poses.push_back(k.pose);
     }
+    slam::write_tum(dir / "keyframes.tum", keyframes);
+    files.push_back("keyframes.tum");
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
     if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {

@@ -6,30 +6,17 @@
 
 #include "adit/common/error.hpp"
 #include "adit/config/load.hpp"
+#include "adit/daemon/extrinsics.hpp"
 #include "adit/slam/lie.hpp"
 
 namespace adit::tools {
-namespace {
-
-Eigen::Isometry3d to_isometry(const config::Transform& t) {
-  const double k = M_PI / 180.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(t.rpy_deg[2] * k, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(t.rpy_deg[1] * k, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(t.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << t.xyz_m[0], t.xyz_m[1], t.xyz_m[2];
-  return T;
-}
-
-}  // namespace
 
 WheelTrack load_wheel_track(const std::string& config_file) {
   const config::Config c = config::load_config(config_file);
   if (!c.can.enabled || !c.wheel_odometry.enabled || c.can.source != config::CanSource::candump)
     throw InputError(config_file, "wheel_odometry", "needs can.enabled with source candump and wheel_odometry.enabled");
   WheelTrack track;
-  track.extrinsics = to_isometry(c.lidar.extrinsics);
+  track.extrinsics = daemon::isometry_of(c.lidar.extrinsics);
   daemon::WheelFeed feed(c);
   feed.start({});
   constexpr double kEverything = std::numeric_limits<double>::infinity();
