@@ -30,7 +30,8 @@ Odometry::Odometry(const OdometryConfig& config)
       downsampler_(config.max_scan_points),
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
   for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
-  filtered_times_.reserve(config.max_scan_points);
+  for (auto* buffer : {&filtered_times_, &frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
+  source_deskewed_.resize(config.max_scan_points);
   planes_.resize(config.max_scan_points);
 }
 
@@ -68,13 +69,20 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   const Eigen::Isometry3d predicted = pose_ * delta;
   const Vector6d scan_velocity = wheel && dt > 0.0 ? Vector6d(log_se3(wheel->delta) / dt) : velocity_;
 
-  deskewed_.resize(filtered_.size());
-  deskewer_.deskew(filtered_, filtered_times_, scan_velocity, deskewed_);
-  downsampler_.downsample(deskewed_, 0.5F * config_.map_voxel_m, frame_);
-  downsampler_.downsample(frame_, config_.registration_voxel_m, source_);
+  // Downsampled as measured (a sweep moves points by cm, voxels are dm);
+  // each kept point keeps its time, to be deskewed once the sweep's motion is known.
+  downsampler_.downsample(filtered_, filtered_times_, 0.5F * config_.map_voxel_m, frame_, frame_times_);
+  downsampler_.downsample(frame_, frame_times_, config_.registration_voxel_m, source_, source_times_);
   result.registration_points = source_.size();
+  // frame_ deskewed with `velocity` into deskewed_.
+  const auto deskew_frame = [&](const Vector6d& velocity) {
+    deskewed_.resize(frame_.size());
+    deskewer_.deskew(frame_, frame_times_, velocity, deskewed_);
+    result.sweep_velocity = velocity;
+  };
 
   if (source_.size() < config_.min_registration_points) {
+    deskew_frame(scan_velocity);
     reacquire_ = true;
     pose_ = predicted;
     last_stamp_ns_ = scan.stamp_ns;
@@ -85,7 +93,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   }
 
   if (!started_ || map_.empty()) {
-    transform_into(frame_, pose_, registered_);
+    deskew_frame(scan_velocity);
+    transform_into(deskewed_, pose_, registered_);
     map_.add(registered_);
     started_ = true;
     last_stamp_ns_ = scan.stamp_ns;
@@ -113,7 +122,16 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // After a gap or a lost scan the prediction is poor: search as widely as at the start.
   const double sigma = reacquire_ ? config_.initial_threshold_m / 3.0 : threshold_.sigma();
   reacquire_ = false;
-  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
+  SweepMotion sweep;
+  sweep.times_s = source_times_;
+  sweep.velocity = scan_velocity;
+  sweep.estimate = config_.estimate_sweep_velocity;
+  Vector6d sweep_information;
+  sweep_information.head<3>().setConstant(1.0 / (config_.sweep_velocity_sigma_mps * config_.sweep_velocity_sigma_mps));
+  sweep_information.tail<3>().setConstant(1.0 / (config_.sweep_velocity_sigma_radps * config_.sweep_velocity_sigma_radps));
+  sweep.information = sweep_information.asDiagonal();
+  sweep.deskewed = std::span(source_deskewed_).first(source_.size());
+  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, sweep);
   // Wheels that slipped (or a wrong encoder) put the prediction where the
   // scan no longer overlaps the map: far fewer correspondences than the last
   // scan had. Then the constant-velocity prediction is tried too, and the
@@ -122,8 +140,10 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     return static_cast<double>(r.correspondences) >= config_.min_correspondence_share * last_correspondences_;
   };
   if (wheel && !enough(result.registration)) {
+    SweepMotion constant_sweep = sweep;
+    constant_sweep.velocity = velocity_;
     const RegistrationResult alternative =
-        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_);
+        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, constant_sweep);
     if (alternative.correspondences > result.registration.correspondences) {
       result.registration = alternative;
       result.wheel_rejected = true;
@@ -137,7 +157,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   pose_ = corrected;
   last_stamp_ns_ = scan.stamp_ns;
 
-  transform_into(frame_, pose_, registered_);
+  deskew_frame(result.registration.sweep_velocity);
+  transform_into(deskewed_, pose_, registered_);
   map_.add(registered_);
   map_.remove_far(pose_.translation().cast<float>(), config_.max_range_m);
 

@@ -1,6 +1,7 @@
 #include "adit/slam/registration.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -16,9 +17,14 @@ double geman_mcclure_weight(double r2, double kappa2) {
   return kappa2 * kappa2 / (d * d);
 }
 
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+
 struct NormalEquations {
-  Matrix6d H = Matrix6d::Zero();
+  Matrix6d H = Matrix6d::Zero();  // pose block
   Vector6d g = Vector6d::Zero();
+  Matrix12d H12 = Matrix12d::Zero();  // pose and sweep velocity, when estimated
+  Vector12d g12 = Vector12d::Zero();
   double weight_sum = 0.0;
   double residual2_sum = 0.0;  // Σ w·r², robust-weighted
   int count = 0;
@@ -30,8 +36,9 @@ struct NormalEquations {
 // ∂r/∂[v; ω] = [n_b; p × n_b] (p in the body frame: lever arms are ranges).
 NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map, const Eigen::Isometry3d& T,
                       double max_distance_m, double kappa2, const RegistrationConfig& config,
-                      std::span<MapPlane> planes, bool associate) {
+                      std::span<MapPlane> planes, bool associate, std::span<const float> times_s) {
   NormalEquations ne;
+  const bool timed = times_s.size() == points.size();
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
   const bool cached = planes.size() >= points.size();
@@ -48,13 +55,45 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
     Vector6d J;
     J << n_b, p.cast<double>().cross(n_b);
     const double w = geman_mcclure_weight(r * r, kappa2);
-    ne.H.noalias() += w * J * J.transpose();
-    ne.g.noalias() += w * r * J;
+    if (timed) {
+      Vector12d J12;
+      J12 << J, static_cast<double>(times_s[i]) * J;
+      ne.H12.noalias() += w * J12 * J12.transpose();
+      ne.g12.noalias() += w * r * J12;
+    } else {
+      ne.H.noalias() += w * J * J.transpose();
+      ne.g.noalias() += w * r * J;
+    }
     ne.weight_sum += w;
     ne.residual2_sum += w * r * r;
     ++ne.count;
   }
+  if (timed) {
+    ne.H = ne.H12.topLeftCorner<6, 6>();
+    ne.g = ne.g12.head<6>();
+  }
   return ne;
+}
+
+// Deskews `points` (measured at `times_s` after the scan start) to the start
+// with constant body velocity ξ, T(t) = exp(t·ξ), tabulated at kSweepBins
+// instants (nearest taken): 128 bins over 0.1 s at 40°/s step by 0.03°.
+void deskew_sweep(std::span<const Eigen::Vector3f> points, std::span<const float> times_s, const Vector6d& velocity,
+                  float duration_s, std::span<Eigen::Vector3f> out) {
+  constexpr int kSweepBins = 128;
+  std::array<Eigen::Matrix3f, kSweepBins> rotations;
+  std::array<Eigen::Vector3f, kSweepBins> translations;
+  const float bin_width = duration_s / static_cast<float>(kSweepBins - 1);
+  for (int i = 0; i < kSweepBins; ++i) {
+    const Eigen::Isometry3d T = exp_se3(velocity * static_cast<double>(static_cast<float>(i) * bin_width));
+    rotations[static_cast<std::size_t>(i)] = T.linear().cast<float>();
+    translations[static_cast<std::size_t>(i)] = T.translation().cast<float>();
+  }
+  const float inverse_bin = bin_width > 0.0F ? 1.0F / bin_width : 0.0F;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const auto b = static_cast<std::size_t>(std::clamp(static_cast<int>(times_s[k] * inverse_bin + 0.5F), 0, kSweepBins - 1));
+    out[k] = rotations[b] * points[k] + translations[b];
+  }
 }
 
 struct Degeneracy {
@@ -118,7 +157,27 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config, std::span<MapPlane> planes) {
+  return register_scan(points, map, prior, max_distance_m, kernel_scale_m, config, planes, SweepMotion{});
+}
+
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes,
+                                 const SweepMotion& sweep) {
   RegistrationResult result;
+  // A sweep to deskew: the points are redone from `measured` whenever the velocity changes.
+  const bool timed = sweep.times_s.size() == measured.size() && sweep.deskewed.size() >= measured.size();
+  const bool estimate = timed && sweep.estimate;
+  float duration = 0.0F;
+  if (timed)
+    for (const float t : sweep.times_s) duration = std::max(duration, t);
+  Vector6d velocity = sweep.velocity;
+  std::span<const Eigen::Vector3f> points = measured;
+  if (timed) {
+    points = sweep.deskewed.first(measured.size());
+    deskew_sweep(measured, sweep.times_s, velocity, duration, sweep.deskewed);
+  }
+  result.sweep_velocity = velocity;
   result.pose = prior.mean;
   // Graduated kernel: start wide enough to pull in from the prediction's
   // error, halve the scale every iteration down to the floor set by the
@@ -132,29 +191,59 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
   // searched again only after the pose has moved enough to change them: the
   // search is most of the cost, and near convergence the pose moves by mm.
   Eigen::Isometry3d associated_at = result.pose;
+  Vector6d associated_velocity = velocity;
   for (int iteration = 1; iteration <= config.max_iterations; ++iteration) {
     const Eigen::Isometry3d moved = associated_at.inverse() * result.pose;
-    const bool associate = iteration == 1 || moved.translation().norm() > config.reassociate_m ||
-                           Eigen::AngleAxisd(moved.linear()).angle() > config.reassociate_rad;
-    if (associate) associated_at = result.pose;
-    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config, planes, associate);
+    // A change of sweep velocity moves the last points of the sweep by duration·Δξ.
+    const Vector6d sweep_moved = static_cast<double>(duration) * (velocity - associated_velocity);
+    const bool associate = iteration == 1 ||
+                           moved.translation().norm() + sweep_moved.head<3>().norm() > config.reassociate_m ||
+                           Eigen::AngleAxisd(moved.linear()).angle() + sweep_moved.tail<3>().norm() > config.reassociate_rad;
+    if (associate) {
+      associated_at = result.pose;
+      associated_velocity = velocity;
+    }
+    ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config, planes, associate,
+               estimate ? sweep.times_s : std::span<const float>{});
     degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
     // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
     // e(T·exp(δ)) ≈ e + δ to first order.
     const Vector6d e = log_se3(prior.mean.inverse() * result.pose);
-    const Matrix6d H = ne.H * data_scale + prior.information;
-    const Vector6d g = ne.g * data_scale + prior.information * e;
-    Vector6d delta = H.ldlt().solve(-g);
-    if (!delta.allFinite()) delta.setZero();
+    Vector6d delta;
+    Vector6d delta_velocity = Vector6d::Zero();
+    if (estimate) {
+      // Pose and sweep velocity together; the velocity prior's residual is ξ − ξ_prior.
+      Matrix12d H = ne.H12 * data_scale;
+      Vector12d g = ne.g12 * data_scale;
+      H.topLeftCorner<6, 6>() += prior.information;
+      g.head<6>() += prior.information * e;
+      H.bottomRightCorner<6, 6>() += sweep.information;
+      g.tail<6>() += sweep.information * (velocity - sweep.velocity);
+      Vector12d step = H.ldlt().solve(-g);
+      if (!step.allFinite()) step.setZero();
+      delta = step.head<6>();
+      delta_velocity = step.tail<6>();
+    } else {
+      const Matrix6d H = ne.H * data_scale + prior.information;
+      const Vector6d g = ne.g * data_scale + prior.information * e;
+      delta = H.ldlt().solve(-g);
+      if (!delta.allFinite()) delta.setZero();
+    }
     // Solution remapping: no update along directions the scan cannot see.
     delta.head<3>() = degeneracy.translation_projector * delta.head<3>();
     delta.tail<3>() = degeneracy.rotation_projector * delta.tail<3>();
     result.pose = result.pose * exp_se3(delta);
+    if (estimate) {
+      velocity += delta_velocity;
+      deskew_sweep(measured, sweep.times_s, velocity, duration, sweep.deskewed);
+    }
     result.iterations = iteration;
     const bool last_level = kappa <= config.min_kernel_scale_m;
-    if (last_level && delta.norm() < config.convergence_norm) break;
+    const double step_norm = std::sqrt(delta.squaredNorm() + static_cast<double>(duration * duration) * delta_velocity.squaredNorm());
+    if (last_level && step_norm < config.convergence_norm) break;
     kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
   }
+  result.sweep_velocity = velocity;
   result.correspondences = ne.count;
   result.inlier_ratio = points.empty() ? 0.0 : static_cast<double>(ne.count) / static_cast<double>(points.size());
   result.rmse_m = ne.weight_sum > 0.0 ? std::sqrt(ne.residual2_sum / ne.weight_sum) : 0.0;

@@ -42,6 +42,7 @@ struct BenchOptions {
   double degeneracy_threshold = slam::RegistrationConfig{}.degeneracy_threshold;
   double point_sigma_m = slam::RegistrationConfig{}.point_sigma_m;
   int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
+  bool fixed_sweep_velocity = false;  // deskew with the prediction's velocity only
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -105,6 +106,7 @@ int bench_odometry(const BenchOptions& o) {
   config.registration.degeneracy_threshold = o.degeneracy_threshold;
   config.registration.point_sigma_m = o.point_sigma_m;
   config.registration.plane_neighbors = o.plane_neighbors;
+  config.estimate_sweep_velocity = !o.fixed_sweep_velocity;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
@@ -213,6 +215,8 @@ void register_bench_commands(CLI::App& app, int& status) {
                        "σ of one point-to-plane residual, m: weighs the scan against the motion prior");
   odometry->add_option("--plane-neighbors", o->plane_neighbors, "Map points each local plane is fitted through (3-16)")
       ->check(CLI::Range(3, 16));
+  odometry->add_flag("--fixed-sweep-velocity", o->fixed_sweep_velocity,
+                     "Deskew with the prediction's velocity instead of estimating each sweep's (before continuous-time registration)");
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");

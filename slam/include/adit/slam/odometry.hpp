@@ -42,6 +42,12 @@ struct OdometryConfig {
   // A wheel prior whose registration matches fewer than this share of the
   // previous scan's correspondences is checked against constant velocity.
   double min_correspondence_share = 0.7;
+  // Estimate the body velocity over each sweep with the pose (continuous-time
+  // registration, see SweepMotion) instead of deskewing with the prediction's.
+  // The prior on it, per sweep: the prediction's velocity with these σ.
+  bool estimate_sweep_velocity = true;
+  double sweep_velocity_sigma_mps = 0.5;
+  double sweep_velocity_sigma_radps = 0.5;
   RegistrationConfig registration;
 };
 
@@ -75,6 +81,7 @@ struct OdometryResult {
   OdometryStatus status = OdometryStatus::ok;
   bool valid = false;       // the pose comes from registration
   bool wheel_rejected = false;  // the wheel prior disagreed with the scan; constant velocity was used
+  Vector6d sweep_velocity = Vector6d::Zero();  // body twist per second over the scan, as deskewed
   RegistrationResult registration;
   std::size_t input_points = 0;
   std::size_t registration_points = 0;
@@ -101,8 +108,11 @@ class Odometry {
   std::vector<Eigen::Vector3f> filtered_;   // in range, finite
   std::vector<float> filtered_times_;
   std::vector<Eigen::Vector3f> deskewed_;
-  std::vector<Eigen::Vector3f> frame_;       // map-resolution points
-  std::vector<Eigen::Vector3f> source_;      // registration-resolution points
+  std::vector<Eigen::Vector3f> frame_;       // map-resolution points, as measured
+  std::vector<float> frame_times_;
+  std::vector<Eigen::Vector3f> source_;      // registration-resolution points, as measured
+  std::vector<float> source_times_;
+  std::vector<Eigen::Vector3f> source_deskewed_;  // registration's scratch
   std::vector<Eigen::Vector3f> registered_;
   std::vector<MapPlane> planes_;             // registration's per-point planes
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();

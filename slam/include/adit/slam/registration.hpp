@@ -66,6 +66,24 @@ struct PosePrior {
   Matrix6d information = Matrix6d::Zero();
 };
 
+// Continuous-time registration (in the spirit of CT-ICP, Dellenbach et al.
+// 2022): a spinning sensor measures each point at its own time, so a scan
+// holds the sweep's motion as well as its pose. With `times_s`, `points` are
+// taken as measured (not deskewed), each is moved to the scan start by the
+// body velocity ξ over the sweep, T(t) = exp(t·ξ), and ξ is estimated with the
+// pose under a Gaussian prior. A bump that pitches the body at 30°/s turns it
+// 3° in one 0.1 s sweep: deskewed with the wheels' planar motion, such a scan
+// registers 1–2 sweeps' worth of rotation off at range.
+// Jacobian: T·exp(t(ξ+δξ))·p ≈ T·exp(tξ)·(p + t(δv + δω×p)) for small tξ, so
+// ∂r/∂δξ = t·∂r/∂δ (the pose's body-frame Jacobian scaled by the point's time).
+struct SweepMotion {
+  std::span<const float> times_s;          // per point, after the scan start; empty: points are deskewed
+  Vector6d velocity = Vector6d::Zero();    // the prior's mean and first guess: body twist per second [v; ω]
+  Matrix6d information = Matrix6d::Zero(); // of the velocity prior, per (m/s)² and (rad/s)²
+  bool estimate = false;                   // false: deskew with `velocity` as given
+  std::span<Eigen::Vector3f> deskewed;     // scratch of points.size(): the points deskewed with the final velocity
+};
+
 struct RegistrationResult {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   // Of the pose, [v; ω], for a world-frame (left) perturbation exp(ε)·pose.
@@ -77,6 +95,7 @@ struct RegistrationResult {
   bool degenerate = false;
   Vector6d weakest_direction = Vector6d::Zero();  // unit twist (body frame) of the least constrained direction
   double weakest_eigenvalue = 0.0;                // its normalised eigenvalue (the smaller is weaker)
+  Vector6d sweep_velocity = Vector6d::Zero();     // body twist per second over the sweep (the SweepMotion's when not estimated)
 };
 
 // `points` are in the body frame at the scan time (deskewed); `prior.mean`
@@ -91,5 +110,10 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config, std::span<MapPlane> planes);
+// The same on a scan as measured, deskewed (and its sweep velocity estimated) as `sweep` says.
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes,
+                                 const SweepMotion& sweep);
 
 }  // namespace adit::slam

@@ -23,6 +23,9 @@ class VoxelDownsampler {
   // Writes into `out` (which must have capacity, see reserve_output) one point
   // per occupied voxel of edge voxel_size_m, in input order; returns the count.
   std::size_t downsample(std::span<const Eigen::Vector3f> in, float voxel_size_m, std::vector<Eigen::Vector3f>& out);
+  // The same, carrying each kept point's time (`in_times` as long as `in`) into `out_times`.
+  std::size_t downsample(std::span<const Eigen::Vector3f> in, std::span<const float> in_times, float voxel_size_m,
+                         std::vector<Eigen::Vector3f>& out, std::vector<float>& out_times);
 
  private:
   struct Slot {
@@ -33,6 +36,7 @@ class VoxelDownsampler {
   std::size_t max_points_;
   std::uint32_t generation_ = 0;
   std::vector<Slot> slots_;
+  std::vector<float> times_unused_;  // the untimed overload's (empty) time output
 };
 
 }  // namespace adit::slam
