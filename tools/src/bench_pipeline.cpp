@@ -7,6 +7,8 @@
 #include "bench_pipeline.hpp"
 
 #include <atomic>
+#include <cerrno>
+#include <ctime>
 #include <exception>
 #include <thread>
 
@@ -16,6 +18,7 @@
 #include "adit/daemon/heartbeat.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/lidar/registry.hpp"
+#include "adit/drivers/pcap_reader.hpp"
 #include "adit/drivers/udp.hpp"
 #include "capture_sender.hpp"
 #include "pipeline_run.hpp"
@@ -48,6 +51,45 @@ std::uint16_t data_port_of(const config::Config& c) {
   return family->make_decoder(c.lidar.model, c.lidar.calibration)->default_port();
 }
 
+// The capture time of the first datagram to `port` (0 when there is none).
+std::int64_t first_capture_time_ns(const std::filesystem::path& pcap, int port) {
+  drivers::PcapReader reader(pcap);
+  drivers::UdpDatagram d;
+  while (reader.next(d))
+    if (d.dst_port == port) return d.capture_time_ns;
+  return 0;
+}
+
+std::int64_t realtime_now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+void sleep_until_realtime(std::int64_t ns) {
+  const timespec until{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &until, nullptr) == EINTR) {
+  }
+}
+
+// Over the network the pipeline stamps scans with the host clock, while a
+// recorded CAN log keeps its recording's times: the wheels would never line
+// up. Sending starts at a set instant, and the log is shifted by the
+// configured CAN-minus-LiDAR offset so that its first record and the
+// capture's meet there (at the recorded rate only; otherwise no wheels).
+std::int64_t align_recorded_wheels(config::Config& c, double speed, int capture_port) {
+  if (!c.can.enabled || !c.wheel_odometry.enabled || c.can.source != config::CanSource::candump) return 0;
+  if (speed != 1.0) {
+    fmt::print("wheels: off over loopback (a recorded CAN log follows the host clock only at --speed 1)\n");
+    c.can.enabled = false;
+    return 0;
+  }
+  constexpr std::int64_t kStartupNs = 1'500'000'000;  // pipeline construction and start, with room to spare
+  const std::int64_t send_at = realtime_now_ns() + kStartupNs;
+  c.wheel_odometry.time_offset_s += 1e-9 * static_cast<double>(first_capture_time_ns(c.lidar.pcap, capture_port) - send_at);
+  return send_at;
+}
+
 struct LoopbackRun {
   PipelineFigures figures;
   SendTotals sent;
@@ -61,6 +103,7 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
   c.lidar.port = free_loopback_port();
   c.lidar.interface.clear();
   c.lidar.multicast_group.clear();
+  const std::int64_t send_at_ns = align_recorded_wheels(c, speed, capture_port);
   daemon::Pipeline pipeline(c, {});
 
   LoopbackRun run;
@@ -74,6 +117,7 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
   hooks.started = [&] {
     sender = std::thread([&] {
       try {
+        if (send_at_ns != 0) sleep_until_realtime(send_at_ns);
         run.sent = send_capture(c.lidar.pcap, "127.0.0.1", static_cast<std::uint16_t>(c.lidar.port), speed,
                                 capture_port, stop_sending);
       } catch (...) {
