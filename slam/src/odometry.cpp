@@ -130,6 +130,13 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   sweep_information.head<3>().setConstant(1.0 / (config_.sweep_velocity_sigma_mps * config_.sweep_velocity_sigma_mps));
   sweep_information.tail<3>().setConstant(1.0 / (config_.sweep_velocity_sigma_radps * config_.sweep_velocity_sigma_radps));
   sweep.information = sweep_information.asDiagonal();
+  // The wheels know the planar part of the sweep's motion as well as the
+  // scan-to-scan motion: a velocity is the delta over dt, so its covariance
+  // is the delta's over dt² (the directions they do not see stay loose).
+  if (wheel && dt > 0.0) {
+    const Matrix6d wheel_information = (wheel->covariance / (dt * dt)).inverse();
+    if (wheel_information.allFinite()) sweep.information = wheel_information;
+  }
   sweep.deskewed = std::span(source_deskewed_).first(source_.size());
   result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, sweep);
   // Wheels that slipped (or a wrong encoder) put the prediction where the

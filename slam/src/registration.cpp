@@ -232,6 +232,9 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
     // Solution remapping: no update along directions the scan cannot see.
     delta.head<3>() = degeneracy.translation_projector * delta.head<3>();
     delta.tail<3>() = degeneracy.rotation_projector * delta.tail<3>();
+    // A direction the scan cannot see in the pose it cannot see in the sweep's motion either.
+    delta_velocity.head<3>() = degeneracy.translation_projector * delta_velocity.head<3>();
+    delta_velocity.tail<3>() = degeneracy.rotation_projector * delta_velocity.tail<3>();
     result.pose = result.pose * exp_se3(delta);
     if (estimate) {
       velocity += delta_velocity;
