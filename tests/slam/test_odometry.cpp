@@ -106,6 +106,24 @@ TEST(Odometry, AWheelPriorThatSlippedIsOverruledByTheScan) {
   }
 }
 
+// A wheel that spins claims a false turn while the scan may still overlap the
+// map; a claimed motion that no plausible change from the last one explains
+// makes the odometry try constant velocity too.
+TEST(Odometry, AWheelMotionNoPlausibleChangeExplainsIsSuspect) {
+  const OdometryConfig config;
+  Vector6d cruising = Vector6d::Zero();
+  cruising(0) = 1.0;  // 1 m/s straight ahead
+  const double dt = 0.1;
+  EXPECT_FALSE(wheel_motion_implausible(planar_pose(0.1, 0.0, 0.0), cruising, dt, config));
+  EXPECT_FALSE(wheel_motion_implausible(planar_pose(0.11, 0.0, 1.0 * M_PI / 180), cruising, dt, config))
+      << "a turn starting at 10°/s is plausible";
+  EXPECT_TRUE(wheel_motion_implausible(planar_pose(0.11, 0.0, 3.0 * M_PI / 180), cruising, dt, config))
+      << "3° of turn in one scan from straight driving: a wheel spun";
+  EXPECT_TRUE(wheel_motion_implausible(planar_pose(0.4, 0.0, 0.0), cruising, dt, config)) << "4 m/s in 0.1 s";
+  EXPECT_FALSE(wheel_motion_implausible(planar_pose(0.01, 0.0, 0.0), Vector6d::Zero(), dt, config))
+      << "starting from rest";
+}
+
 TEST(Odometry, AFeaturelessTunnelIsReportedDegenerateWithALooseAxis) {
   const auto tunnel = test::tunnel(400000, 24);
   Odometry odometry(OdometryConfig{});

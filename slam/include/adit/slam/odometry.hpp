@@ -42,6 +42,11 @@ struct OdometryConfig {
   // A wheel prior whose registration matches fewer than this share of the
   // previous scan's correspondences is checked against constant velocity.
   double min_correspondence_share = 0.7;
+  // A wheel prior this far from the constant-velocity prediction in one scan
+  // (a yaw acceleration of 150°/s² at 10 Hz, or 1.5 g) is checked against
+  // constant velocity too: a spinning wheel can keep the scan overlapping.
+  double max_wheel_disagreement_rad = 0.026;
+  double max_wheel_disagreement_m = 0.15;
   // Estimate the body velocity over each sweep with the pose (continuous-time
   // registration, see SweepMotion) instead of deskewing with the prediction's.
   // The prior on it, per sweep: the prediction's velocity with these σ.
@@ -86,6 +91,11 @@ struct OdometryResult {
   std::size_t input_points = 0;
   std::size_t registration_points = 0;
 };
+
+// Whether a wheel motion over dt departs from the constant-velocity
+// prediction by more than config.max_wheel_disagreement_* (a spinning wheel).
+bool wheel_motion_implausible(const Eigen::Isometry3d& wheel_delta, const Vector6d& velocity, double dt,
+                              const OdometryConfig& config);
 
 class Odometry {
  public:
