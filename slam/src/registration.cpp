@@ -167,10 +167,11 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
   RegistrationResult result;
   // A sweep to deskew: the points are redone from `measured` whenever the velocity changes.
   const bool timed = sweep.times_s.size() == measured.size() && sweep.deskewed.size() >= measured.size();
-  const bool estimate = timed && sweep.estimate;
   float duration = 0.0F;
   if (timed)
     for (const float t : sweep.times_s) duration = std::max(duration, t);
+  // Points all at one instant (a source without firing times) say nothing of the velocity.
+  const bool estimate = timed && sweep.estimate && duration > 0.0F;
   Vector6d velocity = sweep.velocity;
   std::span<const Eigen::Vector3f> points = measured;
   if (timed) {
