@@ -78,10 +78,10 @@ void TilePublisher::answer(const tile_request_t& request) {
 void TilePublisher::tick(Clock::time_point now) {
   if (!dirty_.empty() && now - last_broadcast_ >= std::chrono::duration<double>(options_.period_s)) {
     last_broadcast_ = now;
-    // The index of just the changed tiles: a full one costs 20 bytes per tile
-    // every second; clients ask for that once (want_index).
     // Listeners that followed the stream hold each tile at its last
-    // broadcast version: the segments changed since then bring them up to date.
+    // broadcast version: the segments changed since then bring them up to
+    // date. Then the index of just the changed tiles: a full one costs 20
+    // bytes per tile every second; clients ask for that once (want_index).
     std::vector<const EncodedTile*> changed;
     for (const std::int64_t id : dirty_) {
       changed.push_back(store_.find(id));
@@ -96,9 +96,10 @@ void TilePublisher::tick(Clock::time_point now) {
 }
 
 void TilePublisher::queue_segments(const EncodedTile& tile, std::int32_t base, std::int32_t only_segment) {
+  if (only_segment >= tile.n_segments()) return;  // no such segment (a request from the network)
   const auto first = static_cast<std::int32_t>(protocol::first_segment_after(tile.segments, base));
   const std::int32_t begin = only_segment >= 0 ? only_segment : first;
-  const std::int32_t end = only_segment >= 0 ? std::min(only_segment + 1, tile.n_segments()) : tile.n_segments();
+  const std::int32_t end = only_segment >= 0 ? only_segment + 1 : tile.n_segments();
   for (std::int32_t s = begin; s < end; ++s) {
     const SegmentRef ref{tile.id, s};
     const auto [it, added] = queued_.emplace(ref, base);

@@ -49,10 +49,18 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
     tile.wanted_segments = m.n_segments;
   }
   if (m.version > tile.pending_version) {
+    // Segments of the partial version below first_segment did not change
+    // since (base_version <= it): they are kept, so a slow link downloading
+    // a tile that keeps growing is not sent back to the start every second.
+    const std::size_t keep = tile.pending_version > 0 && m.base_version <= tile.pending_version
+                                 ? std::min(tile.parts.size(), static_cast<std::size_t>(m.first_segment))
+                                 : 0;
     tile.pending_version = m.version;
     tile.pending_first = -1;
-    tile.parts.assign(static_cast<std::size_t>(m.n_segments), {});
-    tile.have.assign(static_cast<std::size_t>(m.n_segments), false);
+    tile.parts.resize(keep);
+    tile.have.resize(keep);
+    tile.parts.resize(static_cast<std::size_t>(m.n_segments));
+    tile.have.resize(static_cast<std::size_t>(m.n_segments), false);
   }
   if (static_cast<std::size_t>(m.n_segments) != tile.parts.size()) {
     last_error_ = fmt::format("tile {} version {} changed its segment count", m.tile_id, m.version);

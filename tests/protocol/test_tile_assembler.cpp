@@ -162,6 +162,25 @@ TEST(TileAssembler, NewerVersionsReplacePartialOnesAndOldOnesAreStale) {
   EXPECT_EQ(a.points().size(), 6000u);
 }
 
+TEST(TileAssembler, APartlyReceivedVersionKeepsItsUnchangedSegmentsWhenTheTileGrows) {
+  Source tile = make_tile({0, 0, 0}, 5000);  // 5 segments, the last partly filled
+  TileAssembler a;
+  for (std::int32_t i = 0; i < 3; ++i) a.add_segment(tile.segment(i));  // a slow link: 3 of 5 so far
+  const std::int32_t partial = tile.version;
+  tile.grow(500);  // segment 4 fills up and 5 is new; 0..3 do not change
+  ASSERT_EQ(tile.n_segments(), 6);
+  EXPECT_EQ(a.add_segment(tile.segment(4, partial)), SegmentOutcome::stored);  // the broadcast: base 1, first 4
+  EXPECT_EQ(a.segments_have(), 4u) << "0..2 kept from version 1, and 4";
+  EXPECT_EQ(a.add_segment(tile.segment(0)), SegmentOutcome::duplicate);  // an answer (base 0) says what is lacking
+  const auto missing = a.missing(100);
+  ASSERT_EQ(missing.size(), 2u);
+  EXPECT_EQ(missing[0].segment, 3);
+  EXPECT_EQ(missing[1].segment, 5);
+  EXPECT_EQ(a.add_segment(tile.segment(3)), SegmentOutcome::stored);
+  EXPECT_EQ(a.add_segment(tile.segment(5)), SegmentOutcome::completed);
+  EXPECT_EQ(a.points().size(), 5500u);
+}
+
 TEST(TileAssembler, MalformedSegmentsAreCountedAndIgnored) {
   const Source t = make_tile({0, 0, 0}, 100);
   TileAssembler a;
