@@ -21,7 +21,7 @@
 #include "adit/protocol/command_gate.hpp"
 #include "adit/protocol/utime.hpp"
 #include "adit/status_t.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
 
@@ -127,7 +127,7 @@ struct LcmEndpoint::Impl final : TileSink {
     lcm.publish(channel(c), encode_buffer.data(), static_cast<unsigned>(size));
   }
 
-  void send(const tile_chunk_t& chunk) override { send(Channel::tile, chunk); }
+  void send(const tile_segment_t& segment) override { send(Channel::tile, segment); }
   void send(const tile_index_t& index) override { send(Channel::tile_index, index); }
 
   void run() {

@@ -36,9 +36,13 @@ std::string utc_id() {
                      utc.tm_min, utc.tm_sec);
 }
 
-protocol::TileParams tile_params_of(const config::MapSection& m) {
+// For the stored tiles/<id>.adt: they never change again, so they take the
+// largest segments, which compress best (a 112 000-point tunnel tile: 176 kB
+// against 229 kB in the stream's 1024-point segments; bench_tile_stream).
+protocol::TileParams stored_tile_params(const config::MapSection& m) {
   protocol::TileParams p;
   p.tile_size_m = m.tile_size_m;
+  p.segment_points = protocol::kMaxSegmentPoints;
   return p;
 }
 
@@ -189,7 +193,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     // The map files, from the tiles.
     std::vector<protocol::MapPoint> all;
     all.reserve(map.size());
-    const protocol::TileParams params = tile_params_of(config_.map);
+    const protocol::TileParams params = stored_tile_params(config_.map);
     std::filesystem::create_directories(dir / "tiles");
     for (const slam::TileCoord& c : map.tile_coords()) {
       const std::vector<protocol::MapPoint> points = map_points_of(map.tile(c));
@@ -279,6 +283,7 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
   std::error_code ec;
   if (!std::filesystem::is_directory(tiles, ec)) return fmt::format("no stored tiles for session '{}'", id);
   std::size_t bad = 0;
+  std::string first_problem;
   for (const auto& entry : std::filesystem::directory_iterator(tiles, ec)) {
     if (entry.path().extension() != ".adt") continue;
     std::int64_t tile_id = 0;
@@ -286,11 +291,13 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
     const auto [end, err] = std::from_chars(stem.data(), stem.data() + stem.size(), tile_id);
     std::ifstream in(entry.path(), std::ios::binary);
     std::vector<std::uint8_t> blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (err != std::errc{} || end != stem.data() + stem.size() ||
-        !into.insert_encoded(tile_id, std::move(blob), protocol::now_utime()))
-      ++bad;
+    const std::string problem = err != std::errc{} || end != stem.data() + stem.size()
+                                    ? "not named <tile id>.adt"
+                                    : into.insert_encoded(tile_id, blob, protocol::now_utime());
+    if (!problem.empty() && bad++ == 0) first_problem = entry.path().string() + ": " + problem;
   }
-  if (bad > 0) log::warn("session {}: {} stored tile files are unreadable and were skipped", id, bad);
+  if (bad > 0)
+    log::warn("session {}: {} stored tile files are unreadable and were skipped (first: {})", id, bad, first_problem);
   return "";
 }
 

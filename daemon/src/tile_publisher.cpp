@@ -30,12 +30,13 @@ void TilePublisher::reset(std::string session_id) {
   session_id_ = std::move(session_id);
   store_ = TileStore(options_.tiles);
   dirty_.clear();
+  broadcast_version_.clear();
   outgoing_.clear();
   queued_.clear();
 }
 
 void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime) {
-  dirty_.insert(store_.update(key, points, utime).id);
+  if (store_.update(key, points, utime)) dirty_.insert(protocol::tile_id(key));
 }
 
 void TilePublisher::answer(const tile_request_t& request) {
@@ -65,20 +66,28 @@ void TilePublisher::answer(const tile_request_t& request) {
   for (std::size_t i = 0; i < n; ++i) {
     const EncodedTile* tile = store_.find(request.tile_ids[i]);
     if (tile == nullptr) continue;
-    // A client asking for an older version gets the current one whole.
-    queue_tile(*tile, tile->version == request.versions[i] ? request.chunks[i] : -1);
+    // A version this daemon never had (another run's) counts as nothing held;
+    // so does any version in a schema-1 request (it named the version wanted).
+    const std::int32_t asked = request.schema >= 2 ? request.versions[i] : 0;
+    const std::int32_t held = asked > tile->version ? 0 : std::max(0, asked);
+    if (held == tile->version) continue;  // it has this version already
+    queue_segments(*tile, held, request.chunks[i]);
   }
 }
 
 void TilePublisher::tick(Clock::time_point now) {
   if (!dirty_.empty() && now - last_broadcast_ >= std::chrono::duration<double>(options_.period_s)) {
     last_broadcast_ = now;
-    // The index of just the changed tiles: a full one costs 20 bytes per tile
-    // every second; clients ask for that once (want_index).
+    // Listeners that followed the stream hold each tile at its last
+    // broadcast version: the segments changed since then bring them up to
+    // date. Then the index of just the changed tiles: a full one costs 20
+    // bytes per tile every second; clients ask for that once (want_index).
     std::vector<const EncodedTile*> changed;
     for (const std::int64_t id : dirty_) {
       changed.push_back(store_.find(id));
-      queue_tile(*changed.back(), -1);
+      std::int32_t& base = broadcast_version_[id];
+      queue_segments(*changed.back(), base, -1);
+      base = changed.back()->version;
     }
     dirty_.clear();
     send_index(changed, false, 0, "");
@@ -86,11 +95,16 @@ void TilePublisher::tick(Clock::time_point now) {
   send_chunks(now);
 }
 
-void TilePublisher::queue_tile(const EncodedTile& tile, std::int32_t only_chunk) {
-  for (std::int32_t c = 0; c < tile.n_chunks; ++c) {
-    if (only_chunk >= 0 && c != only_chunk) continue;
-    const ChunkRef ref{tile.id, tile.version, c};
-    if (queued_.insert(ref).second) outgoing_.push_back(ref);
+void TilePublisher::queue_segments(const EncodedTile& tile, std::int32_t base, std::int32_t only_segment) {
+  if (only_segment >= tile.n_segments()) return;  // no such segment (a request from the network)
+  const auto first = static_cast<std::int32_t>(protocol::first_segment_after(tile.segments, base));
+  const std::int32_t begin = only_segment >= 0 ? only_segment : first;
+  const std::int32_t end = only_segment >= 0 ? only_segment + 1 : tile.n_segments();
+  for (std::int32_t s = begin; s < end; ++s) {
+    const SegmentRef ref{tile.id, s};
+    const auto [it, added] = queued_.emplace(ref, base);
+    if (added) outgoing_.push_back(ref);
+    else it->second = std::min(it->second, base);
   }
 }
 
@@ -130,7 +144,7 @@ void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, boo
     for (std::size_t i = begin; i < end; ++i) {
       m.tile_ids.push_back(tiles[i]->id);
       m.versions.push_back(tiles[i]->version);
-      m.n_chunks.push_back(tiles[i]->n_chunks);
+      m.n_chunks.push_back(tiles[i]->n_segments());
       m.n_points.push_back(tiles[i]->n_points);
     }
     m.n_tiles = static_cast<std::int32_t>(m.tile_ids.size());
@@ -142,7 +156,7 @@ void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, boo
   }
 }
 
-// Sends queued chunks at options_.bytes_per_s: a burst of a whole map would
+// Sends queued segments at options_.bytes_per_s: a burst of a whole map would
 // overflow the receivers' socket buffers and the Wi-Fi link.
 void TilePublisher::send_chunks(Clock::time_point now) {
   const double elapsed =
@@ -150,27 +164,37 @@ void TilePublisher::send_chunks(Clock::time_point now) {
   last_budget_ = now;
   budget_bytes_ = std::min(budget_bytes_ + elapsed * options_.bytes_per_s, kBurstBytes);
   while (!outgoing_.empty() && budget_bytes_ > 0) {
-    const ChunkRef ref = outgoing_.front();
+    const SegmentRef ref = outgoing_.front();
     outgoing_.pop_front();
-    queued_.erase(ref);
+    const auto queued = queued_.find(ref);
+    std::int32_t base = queued->second;
+    queued_.erase(queued);
     const EncodedTile* tile = store_.find(ref.tile_id);
-    if (tile == nullptr || tile->version != ref.version) continue;  // superseded: the new version is queued
-    const auto piece = protocol::chunk_of(tile->blob, ref.chunk);
-    budget_bytes_ -= static_cast<double>(piece.size());
+    if (tile == nullptr || ref.segment >= tile->n_segments()) continue;
+    // The tile may have changed since this was queued: its current segment
+    // goes out, with what a holder of `base` lacks at the current version.
+    if (base >= tile->version) base = 0;
+    const protocol::TileSegment& segment = tile->segments[static_cast<std::size_t>(ref.segment)];
+    budget_bytes_ -= static_cast<double>(segment.frame.size());
     if (options_.drop_fraction > 0 && unit_(drop_rng_) < options_.drop_fraction) {
       ++counts_.chunks_dropped_by_hook;
       continue;
     }
-    tile_chunk_t m;
+    tile_segment_t m;
     m.utime = tile->utime;
-    m.schema = 1;
+    m.schema = 2;
     m.payload_id = options_.payload_id;
     m.session_id = session_id_;
     m.tile_id = tile->id;
     m.version = tile->version;
-    m.chunk = ref.chunk;
-    m.n_chunks = tile->n_chunks;
-    m.data.assign(piece.begin(), piece.end());
+    m.base_version = base;
+    m.first_segment = static_cast<std::int32_t>(protocol::first_segment_after(tile->segments, base));
+    m.segment = ref.segment;
+    m.n_segments = tile->n_segments();
+    m.n_points = tile->n_points;
+    m.tile_size_m = static_cast<float>(tile->params.tile_size_m);
+    m.quantum_m = static_cast<float>(tile->params.quantum_m);
+    m.data = segment.frame;
     m.size = static_cast<std::int32_t>(m.data.size());
     sink_.send(m);
     ++counts_.chunks_published;

@@ -101,7 +101,8 @@ const std::vector<Field>& layout(LcmType type) {
   static const std::vector<Field> index{I64, I16, STR, STR, I64, STR, F32, I8, I32, I32, I32,
                                         counted(Kind::i64, 10), counted(Kind::i32, 10), counted(Kind::i32, 10),
                                         counted(Kind::i32, 10), I64, {Kind::f32, 3}, {Kind::f32, 3}};
-  static const std::vector<Field> chunk{I64, I16, STR, STR, I64, I32, I32, I32, I32, counted(Kind::i8, 8)};
+  static const std::vector<Field> segment{I64, I16, STR, STR, I64, I32, I32, I32, I32, I32, I32, F32, F32, I32,
+                                          counted(Kind::i8, 13)};
   static const std::vector<Field> request{I64, I16, I64, STR, STR, I8, I32,
                                           counted(Kind::i64, 6), counted(Kind::i32, 6), counted(Kind::i32, 6)};
   switch (type) {
@@ -110,7 +111,7 @@ const std::vector<Field>& layout(LcmType type) {
     case LcmType::command: return command;
     case LcmType::command_ack: return ack;
     case LcmType::tile_index: return index;
-    case LcmType::tile_chunk: return chunk;
+    case LcmType::tile_segment: return segment;
     case LcmType::tile_request: return request;
   }
   return pose;

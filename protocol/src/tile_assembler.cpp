@@ -1,100 +1,122 @@
 #include "adit/protocol/tile_assembler.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "adit/protocol/tile_codec.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 
 namespace adit::protocol {
 
-void TileAssembler::note_index(std::int64_t id, std::int32_t version, std::int32_t n_chunks) {
-  if (version < 0 || n_chunks < 1 || n_chunks > kMaxChunksPerTile) return;
+void TileAssembler::note_index(std::int64_t id, std::int32_t version, std::int32_t n_segments) {
+  if (version < 1 || n_segments < 1 || n_segments > kMaxSegmentsPerTile) return;
   Tile& tile = tiles_[id];
   if (version > tile.wanted_version) {
     tile.wanted_version = version;
-    tile.wanted_chunks = n_chunks;
+    tile.wanted_segments = n_segments;
   }
 }
 
-ChunkOutcome TileAssembler::count(ChunkOutcome outcome) {
+SegmentOutcome TileAssembler::count(SegmentOutcome outcome) {
   switch (outcome) {
-    case ChunkOutcome::stored: ++counts_.stored; break;
-    case ChunkOutcome::completed: ++counts_.completed; break;
-    case ChunkOutcome::duplicate: ++counts_.duplicate; break;
-    case ChunkOutcome::stale: ++counts_.stale; break;
-    case ChunkOutcome::malformed: ++counts_.malformed; break;
-    case ChunkOutcome::corrupt: ++counts_.corrupt; break;
+    case SegmentOutcome::stored: ++counts_.stored; break;
+    case SegmentOutcome::completed: ++counts_.completed; break;
+    case SegmentOutcome::duplicate: ++counts_.duplicate; break;
+    case SegmentOutcome::stale: ++counts_.stale; break;
+    case SegmentOutcome::malformed: ++counts_.malformed; break;
+    case SegmentOutcome::corrupt: ++counts_.corrupt; break;
   }
   return outcome;
 }
 
-ChunkOutcome TileAssembler::add_chunk(const tile_chunk_t& chunk) {
-  const bool shape_ok = chunk.version >= 0 && chunk.n_chunks >= 1 && chunk.n_chunks <= kMaxChunksPerTile &&
-                        chunk.chunk >= 0 && chunk.chunk < chunk.n_chunks && chunk.size > 0 &&
-                        static_cast<std::size_t>(chunk.size) == chunk.data.size() &&
-                        chunk.data.size() <= kChunkPayloadBytes;
+SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
+  const bool shape_ok = m.version >= 1 && m.base_version >= 0 && m.base_version < m.version && m.n_segments >= 1 &&
+                        m.n_segments <= kMaxSegmentsPerTile && m.segment >= 0 && m.segment < m.n_segments &&
+                        m.first_segment >= 0 && m.first_segment <= m.n_segments &&
+                        (m.base_version > 0 || m.first_segment == 0) && m.n_points >= 0 &&
+                        static_cast<std::uint32_t>(m.n_points) <= kMaxTilePoints && m.size > 0 &&
+                        static_cast<std::size_t>(m.size) == m.data.size() && m.data.size() <= kChunkPayloadBytes;
   if (!shape_ok) {
-    last_error_ = fmt::format("tile {} chunk {}/{} of {} bytes is malformed", chunk.tile_id, chunk.chunk,
-                              chunk.n_chunks, chunk.size);
-    return count(ChunkOutcome::malformed);
+    last_error_ = fmt::format("tile {} version {} segment {}/{} (base {}, first {}) of {} bytes is malformed",
+                              m.tile_id, m.version, m.segment, m.n_segments, m.base_version, m.first_segment, m.size);
+    return count(SegmentOutcome::malformed);
   }
-  Tile& tile = tiles_[chunk.tile_id];
-  if (chunk.version <= tile.done_version || chunk.version < tile.partial_version) return count(ChunkOutcome::stale);
-  if (chunk.version > tile.wanted_version) {  // the live stream ran ahead of the index
-    tile.wanted_version = chunk.version;
-    tile.wanted_chunks = chunk.n_chunks;
+  Tile& tile = tiles_[m.tile_id];
+  if (m.version <= tile.done_version || m.version < tile.pending_version) return count(SegmentOutcome::stale);
+  if (m.version > tile.wanted_version) {  // the live stream ran ahead of the index
+    tile.wanted_version = m.version;
+    tile.wanted_segments = m.n_segments;
   }
-  if (chunk.version > tile.partial_version) {
-    tile.partial_version = chunk.version;
-    tile.parts.assign(static_cast<std::size_t>(chunk.n_chunks), {});
-    tile.parts_have = 0;
+  if (m.version > tile.pending_version) {
+    // Segments of the partial version below first_segment did not change
+    // since (base_version <= it): they are kept, so a slow link downloading
+    // a tile that keeps growing is not sent back to the start every second.
+    const std::size_t keep = tile.pending_version > 0 && m.base_version <= tile.pending_version
+                                 ? std::min(tile.parts.size(), static_cast<std::size_t>(m.first_segment))
+                                 : 0;
+    tile.pending_version = m.version;
+    tile.pending_first = -1;
+    tile.parts.resize(keep);
+    tile.have.resize(keep);
+    tile.parts.resize(static_cast<std::size_t>(m.n_segments));
+    tile.have.resize(static_cast<std::size_t>(m.n_segments), false);
   }
-  if (static_cast<std::size_t>(chunk.n_chunks) != tile.parts.size()) {
-    last_error_ = fmt::format("tile {} version {} changed its chunk count", chunk.tile_id, chunk.version);
-    return count(ChunkOutcome::malformed);
+  if (static_cast<std::size_t>(m.n_segments) != tile.parts.size()) {
+    last_error_ = fmt::format("tile {} version {} changed its segment count", m.tile_id, m.version);
+    return count(SegmentOutcome::malformed);
   }
-  auto& part = tile.parts[static_cast<std::size_t>(chunk.chunk)];
-  if (!part.empty()) return count(ChunkOutcome::duplicate);
-  part.assign(chunk.data.begin(), chunk.data.end());
-  ++tile.parts_have;
-  if (tile.parts_have < chunk.n_chunks) return count(ChunkOutcome::stored);
-  return count(finish(chunk.tile_id, tile, chunk.utime));
-}
-
-ChunkOutcome TileAssembler::finish(std::int64_t id, Tile& tile, std::int64_t utime) {
-  std::vector<std::uint8_t> blob;
-  for (const auto& part : tile.parts) blob.insert(blob.end(), part.begin(), part.end());
-  const std::int32_t version = tile.partial_version;
-  tile.parts.clear();
-  tile.parts_have = 0;
-  tile.partial_version = -1;
+  // Segments below first_segment did not change after base_version; holding
+  // a version at least that new, we have them. Of several such bases the
+  // largest first segment is the tightest (each is a valid bound).
+  if (m.base_version <= tile.done_version && static_cast<std::size_t>(m.first_segment) <= tile.segments.size())
+    tile.pending_first = std::max(tile.pending_first, m.first_segment);
+  const auto index = static_cast<std::size_t>(m.segment);
+  if (tile.have[index]) return count(finish_if_complete(tile) == SegmentOutcome::completed ? SegmentOutcome::completed
+                                                                                          : SegmentOutcome::duplicate);
   std::vector<MapPoint> points;
-  if (const std::string error = decode_tile(blob, tile_key(id), points); !error.empty()) {
-    // Asking again for the same bytes would not help; the version is skipped
-    // until a newer one arrives.
-    last_error_ = fmt::format("tile {} version {}: {}", id, version, error);
-    tile.done_version = version;
-    return ChunkOutcome::corrupt;
+  if (const std::string error =
+          decode_segment(m.data, tile_key(m.tile_id), m.tile_size_m, m.quantum_m, points);
+      !error.empty()) {
+    // Not kept: it is asked for again (a datagram damaged on the way is
+    // likely; a daemon serving bad bytes shows as this error repeating).
+    last_error_ = fmt::format("tile {} version {} segment {}: {}", m.tile_id, m.version, m.segment, error);
+    return count(SegmentOutcome::corrupt);
   }
-  for (MapPoint& p : points) p.time = static_cast<double>(utime) * 1e-6;
-  tile.points = std::move(points);
-  tile.done_version = version;
-  return ChunkOutcome::completed;
+  for (MapPoint& p : points) p.time = static_cast<double>(m.utime) * 1e-6;
+  tile.parts[index] = std::move(points);
+  tile.have[index] = true;
+  return count(finish_if_complete(tile));
 }
 
-std::vector<MissingChunk> TileAssembler::missing(std::size_t limit) const {
-  std::vector<MissingChunk> out;
+SegmentOutcome TileAssembler::finish_if_complete(Tile& tile) {
+  if (tile.pending_first < 0) return SegmentOutcome::stored;
+  const auto first = static_cast<std::size_t>(tile.pending_first);
+  for (std::size_t i = first; i < tile.have.size(); ++i)
+    if (!tile.have[i]) return SegmentOutcome::stored;
+  tile.segments.resize(tile.parts.size());  // the held ones below `first` stay
+  for (std::size_t i = first; i < tile.parts.size(); ++i) tile.segments[i] = std::move(tile.parts[i]);
+  tile.done_version = tile.pending_version;
+  tile.pending_version = 0;
+  tile.pending_first = -1;
+  tile.parts.clear();
+  tile.have.clear();
+  return SegmentOutcome::completed;
+}
+
+std::vector<MissingSegment> TileAssembler::missing(std::size_t limit) const {
+  std::vector<MissingSegment> out;
   for (const auto& [id, tile] : tiles_) {
     if (tile.wanted_version <= tile.done_version) continue;
-    if (tile.partial_version != tile.wanted_version) {
+    if (tile.pending_version != tile.wanted_version || tile.pending_first < 0) {
       if (out.size() >= limit) return out;
-      out.push_back({id, tile.wanted_version, -1});
+      out.push_back({id, tile.done_version, -1});
       continue;
     }
-    for (std::size_t i = 0; i < tile.parts.size(); ++i) {
-      if (!tile.parts[i].empty()) continue;
+    for (std::size_t i = static_cast<std::size_t>(tile.pending_first); i < tile.have.size(); ++i) {
+      if (tile.have[i]) continue;
       if (out.size() >= limit) return out;
-      out.push_back({id, tile.wanted_version, static_cast<std::int32_t>(i)});
+      out.push_back({id, tile.done_version, static_cast<std::int32_t>(i)});
     }
   }
   return out;
@@ -106,24 +128,30 @@ bool TileAssembler::complete() const {
   return true;
 }
 
-std::size_t TileAssembler::chunks_wanted() const {
+std::size_t TileAssembler::segments_wanted() const {
   std::size_t n = 0;
-  for (const auto& [id, tile] : tiles_) n += static_cast<std::size_t>(tile.wanted_chunks);
+  for (const auto& [id, tile] : tiles_) n += static_cast<std::size_t>(tile.wanted_segments);
   return n;
 }
 
-std::size_t TileAssembler::chunks_have() const {
+std::size_t TileAssembler::segments_have() const {
   std::size_t n = 0;
   for (const auto& [id, tile] : tiles_) {
-    if (tile.done_version >= tile.wanted_version) n += static_cast<std::size_t>(tile.wanted_chunks);
-    else if (tile.partial_version == tile.wanted_version) n += static_cast<std::size_t>(tile.parts_have);
+    if (tile.done_version >= tile.wanted_version) {
+      n += static_cast<std::size_t>(tile.wanted_segments);
+    } else if (tile.pending_version == tile.wanted_version) {
+      const std::size_t first = tile.pending_first < 0 ? 0 : static_cast<std::size_t>(tile.pending_first);
+      n += first + static_cast<std::size_t>(std::count(tile.have.begin() + static_cast<std::ptrdiff_t>(first),
+                                                        tile.have.end(), true));
+    }
   }
   return n;
 }
 
 std::vector<MapPoint> TileAssembler::points() const {
   std::vector<MapPoint> out;
-  for (const auto& [id, tile] : tiles_) out.insert(out.end(), tile.points.begin(), tile.points.end());
+  for (const auto& [id, tile] : tiles_)
+    for (const auto& segment : tile.segments) out.insert(out.end(), segment.begin(), segment.end());
   return out;
 }
 

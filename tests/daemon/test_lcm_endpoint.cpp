@@ -21,7 +21,7 @@
 #include "adit/daemon/lcm_endpoint.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/channels.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 #include "map_readers.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
@@ -40,7 +40,7 @@ std::string unique_url() {
 
 // A floor and two walls of a 40 m x 20 m room on a 5 cm grid with up to 1 cm
 // of roughness (in whole millimetres), binned into 20 m tiles: two tiles of
-// ~180 000 points, a dozen chunks each.
+// ~180 000 points, ~180 segments each.
 std::map<protocol::TileKey, std::vector<MapPoint>> room() {
   std::map<protocol::TileKey, std::vector<MapPoint>> tiles;
   std::uint32_t state = 1;
@@ -133,7 +133,7 @@ struct Sniffer {
       command_ack_t ack;
       if (ack.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) acks.push_back(ack);
     } else if (channel.ends_with("/TILE")) {
-      tile_chunk_t c;
+      tile_segment_t c;
       if (c.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) chunk_versions.emplace_back(c.tile_id, c.version);
     }
   }
@@ -274,8 +274,8 @@ TEST(LcmEndpoint, DownloadAssemblesTheWholeMapDespite20PercentDroppedChunks) {
   }
   std::filesystem::remove_all(dir);
   const auto& c = h.endpoint->counters();
-  // The hook drops each chunk with p = 0.2: over ~40 chunk sends that is
-  // 8 expected; at least 3 and a fraction near 0.2 show it was exercised.
+  // The hook drops each segment with p = 0.2: over ~400 sends that is
+  // ~80 expected; at least 3 and a fraction near 0.2 show it was exercised.
   const double dropped = static_cast<double>(c.chunks_dropped_by_hook.load());
   const double attempts = dropped + static_cast<double>(c.chunks_published.load());
   EXPECT_GE(dropped, 3.0);

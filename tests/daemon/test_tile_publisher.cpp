@@ -1,7 +1,8 @@
-// The tile stream's daemon side on a simulated clock: rate limit, answers with
-// only what was asked for, pacing.
+// The tile stream's daemon side on a simulated clock: rate limit, only the
+// segments that changed, answers with only what was asked for, pacing.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 #include <set>
 
@@ -14,9 +15,14 @@ using namespace std::chrono_literals;
 using Clock = TilePublisher::Clock;
 
 struct RecordingSink : TileSink {
-  std::vector<tile_chunk_t> chunks;
+  std::vector<tile_segment_t> chunks;
   std::vector<tile_index_t> indexes;
-  void send(const tile_chunk_t& c) override { chunks.push_back(c); }
+  void send(const tile_segment_t& c) override { chunks.push_back(c); }
+  std::size_t bytes() const {
+    std::size_t n = 0;
+    for (const auto& c : chunks) n += static_cast<std::size_t>(c.getEncodedSize());
+    return n;
+  }
   void send(const tile_index_t& i) override { indexes.push_back(i); }
 };
 
@@ -59,50 +65,54 @@ TEST_F(TilePublisherTest, ChangedTilesGoOutAtMostOncePerPeriod) {
 TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   publisher.reset("s1");
   Clock::time_point now = t0;
-  publisher.update({0, 0, 0}, random_points(40000, 2), 1);  // ~320 kB: 7 chunks
+  publisher.update({0, 0, 0}, random_points(40000, 2), 1);  // ~320 kB: 40 segments
   publisher.update({1, 0, 0}, random_points(10, 3), 1);
   run_for(now, 1.0);
   const std::int64_t big = protocol::tile_id({0, 0, 0});
-  const std::int32_t n_chunks = publisher.store().find(big)->n_chunks;
-  ASSERT_GE(n_chunks, 5);
-  ASSERT_EQ(sink.chunks.size(), static_cast<std::size_t>(n_chunks) + 1);
+  const std::int32_t n_segments = publisher.store().find(big)->n_segments();
+  ASSERT_EQ(n_segments, 40);
+  ASSERT_EQ(sink.chunks.size(), static_cast<std::size_t>(n_segments) + 1);
   sink.chunks.clear();
   sink.indexes.clear();
 
   tile_request_t r{};
   r.request_id = 77;
+  r.schema = 2;
   r.session_id = "s1";
-  r.tile_ids = {big, big, protocol::tile_id({5, 5, 5})};
-  r.versions = {1, 1, 1};
-  r.chunks = {2, 4, -1};  // two chunks, and a tile the daemon does not have
-  r.n_entries = 3;
+  r.tile_ids = {big, big, protocol::tile_id({5, 5, 5}), protocol::tile_id({1, 0, 0})};
+  r.versions = {0, 0, 0, 1};
+  r.chunks = {2, 4, -1, -1};  // two segments, a tile the daemon does not have, one the client has
+  r.n_entries = 4;
   publisher.answer(r);
   run_for(now, 0.5);
   ASSERT_EQ(sink.chunks.size(), 2u);
-  EXPECT_EQ(sink.chunks[0].chunk, 2);
-  EXPECT_EQ(sink.chunks[1].chunk, 4);
+  EXPECT_EQ(sink.chunks[0].segment, 2);
+  EXPECT_EQ(sink.chunks[1].segment, 4);
+  EXPECT_EQ(sink.chunks[0].base_version, 0);
   EXPECT_TRUE(sink.indexes.empty());
 
   sink.chunks.clear();
-  publisher.update({0, 0, 0}, random_points(40000, 4), 2);  // version 2 now
+  publisher.update({0, 0, 0}, random_points(40000, 4), 2);  // version 2: every point differs
   r.tile_ids = {big};
   r.versions = {1};
-  r.chunks = {3};
+  r.chunks = {-1};
   r.n_entries = 1;
   r.want_index = true;
-  publisher.answer(r);  // asks for an outdated version: gets version 2 whole
+  publisher.answer(r);  // holds version 1: gets every segment changed since, i.e. all
   ASSERT_EQ(sink.indexes.size(), 1u);
   EXPECT_TRUE(sink.indexes[0].full);
   EXPECT_EQ(sink.indexes[0].request_id, 77) << "an answer names its request";
   EXPECT_EQ(sink.indexes[0].n_tiles, 2);
   run_for(now, 0.5);  // (the broadcast of version 2 is merged with the answer)
-  std::set<std::int32_t> chunks;
+  std::set<std::int32_t> segments;
   for (const auto& c : sink.chunks) {
     EXPECT_EQ(c.version, 2);
-    chunks.insert(c.chunk);
+    EXPECT_EQ(c.base_version, 1);
+    EXPECT_EQ(c.first_segment, 0);
+    segments.insert(c.segment);
   }
-  EXPECT_EQ(chunks.size(), static_cast<std::size_t>(publisher.store().find(big)->n_chunks));
-  EXPECT_EQ(sink.chunks.size(), chunks.size()) << "no chunk twice";
+  EXPECT_EQ(segments.size(), static_cast<std::size_t>(publisher.store().find(big)->n_segments()));
+  EXPECT_EQ(sink.chunks.size(), segments.size()) << "no segment twice";
 
   r.session_id = "s0";
   sink.indexes.clear();
@@ -112,17 +122,106 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   EXPECT_EQ(sink.indexes[0].request_id, 77);
 }
 
-TEST_F(TilePublisherTest, ChunksArePaced) {
+// Points on a 5 cm grid over a floor and a wall, in the order a mapper
+// appends them: what a tunnel's tile looks like (compressible, unlike random
+// points).
+std::vector<protocol::MapPoint> surface_points(std::size_t from, std::size_t n) {
+  std::vector<protocol::MapPoint> points;
+  for (std::size_t i = from; i < from + n; ++i) {
+    const double a = 0.025 + 0.05 * static_cast<double>(i % 300);
+    const double b = 0.025 + 0.05 * static_cast<double>(i / 300 % 300);
+    if (i % 2 == 0) points.push_back({a, b, 0.5, 40.0f, 0});
+    else points.push_back({a, 2.0, b, 60.0f, 0});
+  }
+  return points;
+}
+
+TEST_F(TilePublisherTest, AnAppendedTileCostsOnlyItsNewSegments) {
+  publisher.reset("s1");
+  Clock::time_point now = t0;
+  auto points = surface_points(0, 50'000);
+  publisher.update({0, 0, 0}, points, 1);
+  run_for(now, 1.0);
+  const std::size_t whole = sink.bytes();
+  const std::int64_t id = protocol::tile_id({0, 0, 0});
+  const EncodedTile& v1 = *publisher.store().find(id);
+  ASSERT_EQ(v1.n_segments(), 49);  // 48 full segments of 1024 and one of 848
+  ASSERT_EQ(sink.chunks.size(), 49u);
+  std::size_t frames = 0;
+  for (const auto& s : v1.segments) frames += s.frame.size();
+  sink.chunks.clear();
+
+  const auto more = surface_points(50'000, 300);  // the mapper appends 300 points
+  points.insert(points.end(), more.begin(), more.end());
+  publisher.update({0, 0, 0}, points, 2);
+  run_for(now, 1.0);
+  // The partial segment 48 is now full (1024) and segment 49 holds 124:
+  // those two go out, nothing else.
+  ASSERT_EQ(sink.chunks.size(), 2u);
+  EXPECT_EQ(sink.chunks[0].segment, 48);
+  EXPECT_EQ(sink.chunks[1].segment, 49);
+  for (const auto& c : sink.chunks) {
+    EXPECT_EQ(c.version, 2);
+    EXPECT_EQ(c.base_version, 1);
+    EXPECT_EQ(c.first_segment, 48);
+    EXPECT_EQ(c.n_segments, 50);
+  }
+  const std::size_t delta = sink.bytes();
+  const EncodedTile& v2 = *publisher.store().find(id);
+  const std::size_t new_frames = v2.segments[48].frame.size() + v2.segments[49].frame.size();
+  std::printf("whole tile: %zu B on the wire (%zu B of frames); after appending 300 points: %zu B (%.1f %%)\n", whole,
+              frames, delta, 100.0 * static_cast<double>(delta) / static_cast<double>(whole));
+  EXPECT_LT(delta, new_frames + 2 * 200) << "the two segments' frames plus message headers";
+  EXPECT_LT(delta * 20, whole) << "an append of 0.6 % of the points costs well under 5 % of the tile";
+
+  // A client holding version 1 that missed version 2 asks and gets the same
+  // two segments; one holding nothing gets everything.
+  sink.chunks.clear();
+  tile_request_t r{};
+  r.request_id = 9;
+  r.schema = 2;
+  r.session_id = "s1";
+  r.tile_ids = {id};
+  r.versions = {1};
+  r.chunks = {-1};
+  r.n_entries = 1;
+  publisher.answer(r);
+  run_for(now, 0.5);
+  ASSERT_EQ(sink.chunks.size(), 2u);
+  EXPECT_EQ(sink.chunks[0].segment, 48);
+  sink.chunks.clear();
+  r.versions = {0};
+  publisher.answer(r);
+  run_for(now, 0.5);
+  EXPECT_EQ(sink.chunks.size(), 50u);
+  EXPECT_EQ(sink.chunks[0].base_version, 0);
+  EXPECT_EQ(sink.chunks[0].first_segment, 0);
+
+  // Handing over the same content again is no new version.
+  sink.chunks.clear();
+  publisher.update({0, 0, 0}, points, 3);
+  run_for(now, 1.0);
+  EXPECT_TRUE(sink.chunks.empty());
+  EXPECT_EQ(publisher.store().find(id)->version, 2);
+}
+
+TEST_F(TilePublisherTest, SegmentsArePaced) {
   RecordingSink paced_sink;
-  TilePublisher paced({"rig1", {}, 1.0, 96000.0, 0.0, 1, {}}, paced_sink);  // two chunks per second
+  TilePublisher paced({"rig1", {}, 1.0, 96000.0, 0.0, 1, {}}, paced_sink);  // 96 kB/s
   paced.reset("s1");
-  paced.update({0, 0, 0}, random_points(60000, 5), 1);  // ~480 kB: 10 chunks
+  paced.update({0, 0, 0}, random_points(60000, 5), 1);  // ~480 kB in 59 segments of ~8 kB
   Clock::time_point now = t0;
   paced.tick(now);
-  EXPECT_LE(paced_sink.chunks.size(), 2u);  // the burst allowance
+  const auto frame_bytes = [&] {
+    std::size_t n = 0;
+    for (const auto& c : paced_sink.chunks) n += c.data.size();
+    return n;
+  };
+  EXPECT_LE(frame_bytes(), 96000u + 8300u);  // the burst allowance (two 48 kB payloads)
+  EXPECT_GE(frame_bytes(), 96000u);
   for (int i = 0; i < 20; ++i) paced.tick(now += 100ms);
-  EXPECT_GE(paced_sink.chunks.size(), 5u);
-  EXPECT_LE(paced_sink.chunks.size(), 6u);  // 2 + 2 s x 2 chunks/s
+  EXPECT_GE(frame_bytes(), 96000u + 2 * 96000u - 8300u);
+  EXPECT_LE(frame_bytes(), 96000u + 2 * 96000u + 8300u);  // + 2 s x 96 kB/s
 }
 
 }  // namespace
@@ -134,13 +233,21 @@ namespace {
 TEST(TilePublisherStored, AnotherSessionIsServedFromTheLoaderOrRefusedWithItsReason) {
   RecordingSink sink;
   const std::vector<std::uint8_t> blob = protocol::encode_tile({0, 0, 0}, random_points(500, 9), {});
+  std::vector<protocol::MapPoint> old_points = random_points(1500, 10);
+  for (auto& p : old_points) p.x += 40.0;  // tile (2, 0, 0)
+  const std::vector<std::uint8_t> old_blob = protocol::encode_tile_format1({2, 0, 0}, old_points, {});
   std::vector<std::string> asked;
   TilePublisherOptions options{"rig1", {}, 1.0, 4.0e6, 0.0, 1, {}};
   options.load_session = [&](const std::string& session, TileStore& into) -> std::string {
     asked.push_back(session);
     if (session != "old") return "no stored tiles for session '" + session + "'";
-    EXPECT_TRUE(into.insert_encoded(protocol::tile_id({0, 0, 0}), blob, 1));
-    EXPECT_FALSE(into.insert_encoded(protocol::tile_id({1, 0, 0}), {1, 2, 3}, 1));  // not a tile
+    EXPECT_EQ(into.insert_encoded(protocol::tile_id({0, 0, 0}), blob, 1), "");
+    EXPECT_EQ(into.insert_encoded(protocol::tile_id({2, 0, 0}), old_blob, 1), "");  // format 1: still served
+    EXPECT_EQ(into.insert_encoded(protocol::tile_id({1, 0, 0}), std::vector<std::uint8_t>{1, 2, 3}, 1),
+              "tile shorter than its header");
+    auto future = blob;
+    future[4] = 3;  // a format this daemon does not know
+    EXPECT_EQ(into.insert_encoded(protocol::tile_id({3, 0, 0}), future, 1), "tile format 3 is not 1 or 2");
     return "";
   };
   TilePublisher publisher(options, sink);
@@ -160,9 +267,10 @@ TEST(TilePublisherStored, AnotherSessionIsServedFromTheLoaderOrRefusedWithItsRea
   ASSERT_EQ(sink.indexes.size(), 2u);
   EXPECT_EQ(sink.indexes[1].error, "");
   EXPECT_EQ(sink.indexes[1].session_id, "old");
-  EXPECT_EQ(sink.indexes[1].n_tiles, 1);
+  EXPECT_EQ(sink.indexes[1].n_tiles, 2);
   EXPECT_EQ(publisher.session_id(), "old");
-  EXPECT_EQ(publisher.store().total_points(), 500);
+  EXPECT_EQ(publisher.store().total_points(), 2000);
+  EXPECT_EQ(publisher.store().find(protocol::tile_id({2, 0, 0}))->n_segments(), 2);
   EXPECT_EQ(asked, (std::vector<std::string>{"nope", "old"}));
 }
 

@@ -1,6 +1,6 @@
 // Fuzzes the daemon's answer to tile requests from the network: any bytes on
 // ADIT/<id>/TILE_REQUEST are decoded (or refused) and answered from a small
-// tile store without a crash, and never with more chunks than exist.
+// tile store without a crash, and never with more segments than exist.
 
 #include <cstddef>
 #include <cstdint>
@@ -14,7 +14,7 @@ namespace {
 
 struct CountingSink : adit::daemon::TileSink {
   std::size_t chunks = 0;
-  void send(const adit::tile_chunk_t&) override { ++chunks; }
+  void send(const adit::tile_segment_t&) override { ++chunks; }
   void send(const adit::tile_index_t&) override {}
 };
 
@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   publisher.answer(request);
   auto now = adit::daemon::TilePublisher::Clock::now();
   for (int i = 0; i < 4; ++i) publisher.tick(now += std::chrono::seconds(1));
-  // Two one-chunk tiles: the broadcast sends each once, an answer at most once more.
+  // Two one-segment tiles: the broadcast sends each once, an answer at most once more.
   if (sink.chunks > 4) std::abort();
   return 0;
 }

@@ -74,10 +74,10 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   index.n_tiles = 3;
   expect_round_trip(index);
 
-  tile_chunk_t chunk{};
-  chunk.data = {9, 8, 7, 6};
-  chunk.size = 4;
-  expect_round_trip(chunk);
+  tile_segment_t segment{};
+  segment.data = {9, 8, 7, 6};
+  segment.size = 4;
+  expect_round_trip(segment);
 
   tile_request_t request{};
   request.tile_ids = {5, 6};
@@ -108,7 +108,7 @@ TEST(CheckedDecode, CountsAndLengthsThatDoNotFitAreRefused) {
   auto no_nul = good;
   no_nul[26 + 4 + 4] = 'x';  // the payload id's terminating NUL
   EXPECT_FALSE(checked_decode(no_nul.data(), no_nul.size(), out));
-  auto other_type = encoded(tile_chunk_t{});
+  auto other_type = encoded(tile_segment_t{});
   EXPECT_FALSE(checked_decode(other_type.data(), other_type.size(), out));
 }
 

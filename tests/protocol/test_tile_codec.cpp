@@ -1,4 +1,4 @@
-// Tile ids, quantisation, compression and chunking.
+// Tile ids, quantisation, compression, segments and the stored formats.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +8,7 @@
 
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/tile_codec.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 
 namespace adit::protocol {
 namespace {
@@ -70,19 +70,117 @@ TEST(TileCodec, RoundTripIsWithinHalfAQuantum) {
   EXPECT_LT(blob.size(), points.size() * kBytesPerQuantisedPoint + 200);
 }
 
-TEST(TileCodec, TheEncodingDoesNotDependOnThePointOrder) {
+TEST(TileCodec, TheOrderInsideASegmentDoesNotMatter) {
   const TileKey key{0, 0, 0};
+  const TileParams params;
   auto points = random_points(key, 20.0, 2000, 4);
-  const auto blob = encode_tile(key, points, {});
-  std::reverse(points.begin(), points.end());
-  EXPECT_EQ(encode_tile(key, points, {}), blob);
+  const auto blob = encode_tile(key, points, params);
+  std::reverse(points.begin(), points.begin() + params.segment_points);  // within segment 0
+  EXPECT_EQ(encode_tile(key, points, params), blob);
+  std::swap(points.front(), points.back());  // across segments: another tile in append order
+  EXPECT_NE(encode_tile(key, points, params), blob);
+}
+
+TEST(TileSegments, AppendingChangesOnlyTheLastSegmentAndAddsNewOnes) {
+  const TileKey key{1, 0, -1};
+  const TileParams params;
+  const std::size_t S = params.segment_points;
+  auto points = random_points(key, 20.0, 3 * S + 100, 5);
+  std::vector<TileSegment> segments;
+  EXPECT_EQ(update_segments(key, points, params, 1, segments), 0u);
+  ASSERT_EQ(segments.size(), 4u);
+  EXPECT_EQ(segments[3].n_points, 100u);
+  const auto before = segments;
+  const auto more = random_points(key, 20.0, 2 * S, 6);
+  points.insert(points.end(), more.begin(), more.end());
+  EXPECT_EQ(update_segments(key, points, params, 2, segments), 3u);
+  ASSERT_EQ(segments.size(), 6u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(segments[i].frame, before[i].frame) << i;
+    EXPECT_EQ(segments[i].version, 1);
+  }
+  for (std::size_t i = 3; i < 6; ++i) EXPECT_EQ(segments[i].version, 2) << i;
+  EXPECT_EQ(first_segment_after(segments, 1), 3u);
+  EXPECT_EQ(first_segment_after(segments, 2), 6u);
+  EXPECT_EQ(first_segment_after(segments, 0), 0u);
+  // The same content again: nothing changes.
+  EXPECT_EQ(update_segments(key, points, params, 3, segments), segments.size());
+  EXPECT_EQ(first_segment_after(segments, 2), 6u);
+}
+
+TEST(TileSegments, AChangedOldPointRestampsItsSegmentAndEveryLaterOne) {
+  const TileKey key{0, 0, 0};
+  const TileParams params;
+  auto points = random_points(key, 20.0, 4 * params.segment_points, 7);
+  std::vector<TileSegment> segments;
+  update_segments(key, points, params, 1, segments);
+  points[params.segment_points + 5].x += 0.5;  // in segment 1
+  EXPECT_EQ(update_segments(key, points, params, 2, segments), 1u);
+  EXPECT_EQ(segments[0].version, 1);
+  for (std::size_t i = 1; i < segments.size(); ++i) EXPECT_EQ(segments[i].version, 2);
+  // Fewer segments, the rest unchanged: the new last one is restamped so
+  // clients learn the new count.
+  points.resize(2 * params.segment_points);
+  EXPECT_EQ(update_segments(key, points, params, 3, segments), 1u);
+  EXPECT_EQ(segments.size(), 2u);
+  EXPECT_EQ(segments[1].version, 3);
+}
+
+TEST(TileSegments, DecodeToTheTilesPointsInAnyCombination) {
+  const TileKey key{-2, 3, 0};
+  const TileParams params;
+  const auto points = random_points(key, 20.0, 2 * params.segment_points + 17, 8);
+  std::vector<TileSegment> segments;
+  update_segments(key, points, params, 1, segments);
+  std::vector<MapPoint> back;
+  for (const TileSegment& s : segments)
+    ASSERT_EQ(decode_segment(s.frame, key, params.tile_size_m, params.quantum_m, back), "");
+  ASSERT_EQ(back.size(), points.size());
+  const auto a = sorted_by_mm(points);
+  const auto b = sorted_by_mm(back);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(b[i].x, a[i].x, 0.5 * params.quantum_m + 1e-6);
+  auto bad = segments[0].frame;
+  bad[bad.size() / 2] ^= 0xff;
+  std::vector<MapPoint> out;
+  EXPECT_NE(decode_segment(bad, key, params.tile_size_m, params.quantum_m, out), "");  // zstd's checksum
+  EXPECT_NE(decode_segment(std::span(segments[0].frame).first(3), key, 20.0, 0.001, out), "");
+  EXPECT_NE(decode_segment(segments[0].frame, key, 100.0, 0.001, out), "");  // 100 m / 1 mm > uint16
+}
+
+TEST(TileCodec, StoredTilesOfTheOldFormatStillLoad) {
+  const TileKey key{4, 4, 0};
+  const TileParams params;
+  const auto points = random_points(key, 20.0, 3000, 9);
+  const auto old_blob = encode_tile_format1(key, points, params);
+  ASSERT_EQ(old_blob[4], 1);  // format 1
+  std::vector<MapPoint> from_old;
+  ASSERT_EQ(decode_tile(old_blob, key, from_old), "");
+  std::vector<MapPoint> from_new;
+  ASSERT_EQ(decode_tile(encode_tile(key, points, params), key, from_new), "");
+  const auto a = sorted_by_mm(from_old);
+  const auto b = sorted_by_mm(from_new);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(b[i].x, a[i].x);
+  // Served to clients as segments (re-cut on load).
+  TileParams read = params;
+  std::vector<TileSegment> segments;
+  ASSERT_EQ(unpack_tile(old_blob, key, read, segments), "");
+  EXPECT_EQ(segments.size(), 3u);
+  std::vector<MapPoint> joined;
+  for (const TileSegment& s : segments) ASSERT_EQ(decode_segment(s.frame, key, 20.0, 0.001, joined), "");
+  EXPECT_EQ(joined.size(), points.size());
+  auto future = old_blob;
+  future[4] = 3;
+  EXPECT_EQ(decode_tile(future, key, from_old), "tile format 3 is not 1 or 2");
 }
 
 TEST(TileCodec, RejectsParametersThatDoNotFitUint16) {
   EXPECT_EQ(tile_params_problem({}), "");
-  EXPECT_NE(tile_params_problem({100.0, 0.001, 3}), "");
-  EXPECT_NE(tile_params_problem({20.0, 0.0, 3}), "");
-  EXPECT_THROW(encode_tile({}, {}, {100.0, 0.001, 3}), std::invalid_argument);
+  EXPECT_NE(tile_params_problem({100.0, 0.001, 3, 1024}), "");
+  EXPECT_NE(tile_params_problem({20.0, 0.0, 3, 1024}), "");
+  EXPECT_NE(tile_params_problem({20.0, 0.001, 3, kMaxSegmentPoints + 1}), "");
+  EXPECT_NE(tile_params_problem({20.0, 0.001, 3, 0}), "");
+  EXPECT_THROW(encode_tile({}, {}, {100.0, 0.001, 3, 1024}), std::invalid_argument);
 }
 
 TEST(TileCodec, CorruptBlobsAreRejectedWithAReason) {
@@ -102,29 +200,39 @@ TEST(TileCodec, CorruptBlobsAreRejectedWithAReason) {
   auto truncated = blob;
   truncated.resize(blob.size() - 5);
   EXPECT_NE(decode_tile(truncated, key, out), "");
+  auto bad_segments = blob;
+  bad_segments[24] = 7;  // segment count disagrees with the point count
+  EXPECT_NE(decode_tile(bad_segments, key, out), "");
+  auto bad_table = blob;
+  bad_table[28] ^= 0x10;  // segment 0's byte count
+  EXPECT_NE(decode_tile(bad_table, key, out), "");
+  auto short_table = blob;
+  short_table.resize(kTileHeaderBytesFormat2 + 2);
+  EXPECT_NE(decode_tile(short_table, key, out), "");
   EXPECT_TRUE(out.empty());
 }
 
-TEST(TileChunks, EveryChunkMessageStaysBelow60KB) {
+TEST(TileSegments, EverySegmentMessageStaysBelow60KB) {
   const TileKey key{0, 0, 0};
-  const auto blob = encode_tile(key, random_points(key, 20.0, 40000, 3), {});  // ~320 KB
-  const std::int32_t n = chunk_count(blob.size());
-  ASSERT_GE(n, 6);
-  std::vector<std::uint8_t> joined;
-  for (std::int32_t i = 0; i < n; ++i) {
-    const auto piece = chunk_of(blob, i);
-    tile_chunk_t m;
+  TileParams params;
+  params.segment_points = kMaxSegmentPoints;  // the largest, of random points (barely compressible)
+  const auto points = random_points(key, 20.0, 40000, 3);
+  std::vector<TileSegment> segments;
+  update_segments(key, points, params, 1, segments);
+  ASSERT_EQ(segments.size(), 10u);
+  for (const TileSegment& s : segments) {
+    ASSERT_LE(s.frame.size(), kChunkPayloadBytes);
+    tile_segment_t m{};
     m.payload_id = std::string(kMaxPayloadIdLength, 'p');
     m.session_id = std::string(64, 's');
-    m.n_chunks = n;
-    m.chunk = i;
-    m.data.assign(piece.begin(), piece.end());
+    m.data = s.frame;
     m.size = static_cast<std::int32_t>(m.data.size());
     EXPECT_LT(static_cast<std::size_t>(m.getEncodedSize()), kMaxMessageBytes);
-    joined.insert(joined.end(), piece.begin(), piece.end());
   }
-  EXPECT_EQ(joined, blob);
-  EXPECT_EQ(chunk_count(0), 1);
+  std::vector<TileSegment> empty;
+  update_segments(key, {}, params, 1, empty);
+  EXPECT_EQ(empty.size(), 1u);  // an empty tile is one empty segment
+  EXPECT_EQ(empty[0].n_points, 0u);
 }
 
 TEST(Channels, CarryThePayloadPrefixAndFitLcmsLimit) {

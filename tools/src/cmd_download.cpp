@@ -26,7 +26,7 @@ void draw_progress(std::size_t have, std::size_t wanted) {
   constexpr int kWidth = 30;
   const double fraction = wanted == 0 ? 0.0 : static_cast<double>(have) / static_cast<double>(wanted);
   const int filled = static_cast<int>(fraction * kWidth);
-  fmt::print(stderr, "\r[{}{}] {:3.0f}% {}/{} chunks", std::string(static_cast<std::size_t>(filled), '#'),
+  fmt::print(stderr, "\r[{}{}] {:3.0f}% {}/{} segments", std::string(static_cast<std::size_t>(filled), '#'),
              std::string(static_cast<std::size_t>(kWidth - filled), ' '), 100 * fraction, have, wanted);
 }
 
@@ -48,7 +48,7 @@ void register_download_commands(CLI::App& app, int& status) {
     protocol::TileAssembler tiles;
     std::size_t drawn = 0;
     const auto result = client.download(o->session, tiles, [&](std::size_t have, std::size_t wanted) {
-      if (o->quiet || (have != wanted && have < drawn + 8)) return;  // redraw every few chunks
+      if (o->quiet || (have != wanted && have < drawn + 8)) return;  // redraw every few segments
       drawn = have;
       draw_progress(have, wanted);
     });
@@ -61,7 +61,7 @@ void register_download_commands(CLI::App& app, int& status) {
     const auto points = tiles.points();
     protocol::write_map(o->out, format, points);
     const auto& c = tiles.counts();
-    fmt::print("{} points in {} tiles written to {} ({} requests, {} duplicate and {} stale chunks ignored)\n",
+    fmt::print("{} points in {} tiles written to {} ({} requests, {} duplicate and {} stale segments ignored)\n",
                points.size(), tiles.tile_count(), o->out, result.requests, c.duplicate, c.stale);
     status = kExitOk;
   });

@@ -13,7 +13,7 @@
 #include "adit/common/error.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
 
@@ -163,19 +163,19 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
   });
   auto last_chunk = Clock::now();
   const Listen chunks(impl_->lcm, impl_->channel(Channel::tile), [&](const lcm::ReceiveBuffer* rbuf) {
-    const auto m = decode<tile_chunk_t>(rbuf);
+    const auto m = decode<tile_segment_t>(rbuf);
     if (!m || locked.empty() || m->session_id != locked) return;
-    const auto outcome = tiles.add_chunk(*m);
+    const auto outcome = tiles.add_segment(*m);
     last_chunk = Clock::now();
-    if (outcome == protocol::ChunkOutcome::stored || outcome == protocol::ChunkOutcome::completed) {
+    if (outcome == protocol::SegmentOutcome::stored || outcome == protocol::SegmentOutcome::completed) {
       last_progress = last_chunk;
-      progress(tiles.chunks_have(), tiles.chunks_wanted());
+      progress(tiles.segments_have(), tiles.segments_wanted());
     }
   });
   const auto index_complete = [&] { return n_parts > 0 && static_cast<std::int32_t>(parts.size()) >= n_parts; };
 
   tile_request_t request;
-  request.schema = 1;
+  request.schema = 2;  // versions[] are the versions held
   request.payload_id = impl_->options.payload_id;
   request.session_id = session;
   auto last_send = Clock::now() - std::chrono::seconds(10);
@@ -186,8 +186,8 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
     }
     if (seconds_since(last_progress) > impl_->options.timeout_s) {
       result.error = index_complete()
-                         ? fmt::format("no tile data for {} s ({} of {} chunks)", impl_->options.timeout_s,
-                                       tiles.chunks_have(), tiles.chunks_wanted())
+                         ? fmt::format("no tile data for {} s ({} of {} segments)", impl_->options.timeout_s,
+                                       tiles.segments_have(), tiles.segments_wanted())
                          : fmt::format("no payload '{}' answered within {} s", impl_->options.payload_id,
                                        impl_->options.timeout_s);
       break;
@@ -211,8 +211,8 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
       request.chunks.clear();
       for (const auto& m : missing) {
         request.tile_ids.push_back(m.tile_id);
-        request.versions.push_back(m.version);
-        request.chunks.push_back(m.chunk);
+        request.versions.push_back(m.held_version);
+        request.chunks.push_back(m.segment);
       }
       request.n_entries = static_cast<std::int32_t>(missing.size());
       impl_->lcm.publish(impl_->channel(Channel::tile_request), &request);

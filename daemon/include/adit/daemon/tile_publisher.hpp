@@ -1,30 +1,32 @@
 #pragma once
 // The daemon's side of the tile stream, without sockets: keeps the session's
-// encoded tiles, broadcasts changed tiles at most once per period, answers
-// tile requests with exactly the chunks asked for (a tile whose version moved
-// on goes out whole), and paces chunks so receivers keep up. Messages leave
-// through a TileSink (the LCM endpoint, or a test).
+// encoded tiles, broadcasts at most once per period the segments of each
+// changed tile that changed since its last broadcast, answers tile requests
+// (tile, version held, segment or -1) with the segments changed after the
+// version held (or the one asked for), and paces segments so receivers keep
+// up. Messages leave through a TileSink (the LCM endpoint, or a test).
 
 #include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
 #include <span>
 #include <string>
 
 #include "adit/daemon/tile_store.hpp"
-#include "adit/tile_chunk_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
+#include "adit/tile_segment_t.hpp"
 
 namespace adit::daemon {
 
 class TileSink {
  public:
   virtual ~TileSink() = default;
-  virtual void send(const tile_chunk_t& chunk) = 0;
+  virtual void send(const tile_segment_t& segment) = 0;
   virtual void send(const tile_index_t& index) = 0;
 };
 
@@ -32,8 +34,8 @@ struct TilePublisherOptions {
   std::string payload_id;
   protocol::TileParams tiles;
   double period_s = 1.0;        // changed tiles go out at most this often
-  double bytes_per_s = 4.0e6;   // chunk pacing
-  double drop_fraction = 0;     // test hook: chunks silently not sent
+  double bytes_per_s = 4.0e6;   // segment pacing
+  double drop_fraction = 0;     // test hook: segments silently not sent
   std::uint32_t drop_seed = 1;
   // Fills `into` with a stored session's tiles when a client asks for a
   // session other than the one held; returns "" or why it cannot (unknown
@@ -41,10 +43,11 @@ struct TilePublisherOptions {
   std::function<std::string(const std::string& session, TileStore& into)> load_session;
 };
 
+// "Chunks" are tile_segment_t messages (the names predate segments).
 struct TilePublisherCounts {
   std::uint64_t chunks_published = 0;
   std::uint64_t chunks_dropped_by_hook = 0;
-  std::uint64_t chunk_bytes_published = 0;  // encoded tile_chunk_t bytes
+  std::uint64_t chunk_bytes_published = 0;  // encoded tile_segment_t bytes
   std::uint64_t index_published = 0;
 };
 
@@ -56,7 +59,8 @@ class TilePublisher {
 
   // A new session: forgets every tile and everything queued.
   void reset(std::string session_id);
-  // The whole new content of tile `key` (its version goes up by one).
+  // The whole new content of tile `key`, append order (its version goes up
+  // by one when it changed).
   void update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
   // A client's request (payload already checked by the caller).
   void answer(const tile_request_t& request);
@@ -66,16 +70,16 @@ class TilePublisher {
   const TileStore& store() const { return store_; }
   const std::string& session_id() const { return session_id_; }
   const TilePublisherCounts& counts() const { return counts_; }
-  std::size_t queued_chunks() const { return outgoing_.size(); }
+  std::size_t queued_segments() const { return outgoing_.size(); }
 
  private:
-  struct ChunkRef {
+  struct SegmentRef {
     std::int64_t tile_id;
-    std::int32_t version;
-    std::int32_t chunk;
-    auto operator<=>(const ChunkRef&) const = default;
+    std::int32_t segment;
+    auto operator<=>(const SegmentRef&) const = default;
   };
-  void queue_tile(const EncodedTile& tile, std::int32_t only_chunk);
+  // Queues segments [first_segment_after(base), n) of `tile`, or only `only_segment`.
+  void queue_segments(const EncodedTile& tile, std::int32_t base, std::int32_t only_segment);
   void send_index(const std::vector<const EncodedTile*>& tiles, bool full, std::int64_t request_id,
                   const std::string& error);
   void send_chunks(Clock::time_point now);
@@ -85,8 +89,12 @@ class TilePublisher {
   std::string session_id_;
   TileStore store_;
   std::set<std::int64_t> dirty_;
-  std::deque<ChunkRef> outgoing_;
-  std::set<ChunkRef> queued_;
+  // The version of each tile at its last broadcast: the base of the next one.
+  std::map<std::int64_t, std::int32_t> broadcast_version_;
+  std::deque<SegmentRef> outgoing_;
+  // Queued segments and the base to send each with: the oldest asked for, so
+  // that the message serves every client that asked.
+  std::map<SegmentRef, std::int32_t> queued_;
   double budget_bytes_;
   Clock::time_point last_budget_{};
   Clock::time_point last_broadcast_{};

@@ -15,7 +15,7 @@
 #include "adit/command_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/status_t.hpp"
-#include "adit/tile_chunk_t.hpp"
+#include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
 
@@ -23,7 +23,7 @@ namespace adit::protocol {
 
 // Layout of each received type (must follow protocol/lcm/*.lcm; the tests
 // check it against encoded messages).
-enum class LcmType { pose, status, command, command_ack, tile_index, tile_chunk, tile_request };
+enum class LcmType { pose, status, command, command_ack, tile_index, tile_segment, tile_request };
 
 // True when `bytes` (hash included) has exactly the layout of `type`.
 bool lcm_layout_ok(LcmType type, std::span<const std::uint8_t> bytes);
@@ -33,7 +33,7 @@ inline constexpr LcmType lcm_type_of(const status_t*) { return LcmType::status; 
 inline constexpr LcmType lcm_type_of(const command_t*) { return LcmType::command; }
 inline constexpr LcmType lcm_type_of(const command_ack_t*) { return LcmType::command_ack; }
 inline constexpr LcmType lcm_type_of(const tile_index_t*) { return LcmType::tile_index; }
-inline constexpr LcmType lcm_type_of(const tile_chunk_t*) { return LcmType::tile_chunk; }
+inline constexpr LcmType lcm_type_of(const tile_segment_t*) { return LcmType::tile_segment; }
 inline constexpr LcmType lcm_type_of(const tile_request_t*) { return LcmType::tile_request; }
 
 // Decodes `size` bytes into `out`; false (and `out` unspecified) for anything

@@ -1,7 +1,10 @@
 #pragma once
-// The receiving side of the tile stream: collects chunks per tile version,
-// decodes a tile once all its chunks are in, and says what is still missing
-// (only that) so a client can ask for it with a tile_request_t.
+// The receiving side of the tile stream: keeps each tile's segments at the
+// newest version it holds complete, collects the segments of a newer version
+// (only those changed since, tile_segment_t's base_version / first_segment),
+// and says what is still missing (only that) so a client can ask for it with
+// a tile_request_t: (tile, version held, segment or -1 for "every segment
+// changed after the version I hold").
 
 #include <cstddef>
 #include <cstdint>
@@ -12,17 +15,18 @@
 #include "adit/protocol/map_point.hpp"
 
 namespace adit {
-class tile_chunk_t;
+class tile_segment_t;
 }
 
 namespace adit::protocol {
 
-enum class ChunkOutcome { stored, completed, duplicate, stale, malformed, corrupt };
+enum class SegmentOutcome { stored, completed, duplicate, stale, malformed, corrupt };
 
-struct MissingChunk {
+// One tile_request_t entry.
+struct MissingSegment {
   std::int64_t tile_id = 0;
-  std::int32_t version = 0;
-  std::int32_t chunk = -1;  // -1: every chunk of that version
+  std::int32_t held_version = 0;  // the version held complete; 0 = nothing
+  std::int32_t segment = -1;      // -1: every segment changed after held_version
 };
 
 struct AssemblerCounts {
@@ -31,21 +35,21 @@ struct AssemblerCounts {
 
 class TileAssembler {
  public:
-  // From the tile index: tile `id` exists at `version` in `n_chunks` chunks.
-  void note_index(std::int64_t id, std::int32_t version, std::int32_t n_chunks);
+  // From the tile index: tile `id` exists at `version` in `n_segments` segments.
+  void note_index(std::int64_t id, std::int32_t version, std::int32_t n_segments);
 
-  ChunkOutcome add_chunk(const tile_chunk_t& chunk);
+  SegmentOutcome add_segment(const tile_segment_t& segment);
 
   // What is lacking for every known tile to reach its newest known version,
-  // at most `limit` entries; a tile with no chunk of that version yet is one
-  // entry with chunk -1.
-  std::vector<MissingChunk> missing(std::size_t limit) const;
+  // at most `limit` entries; a tile whose lacking segments are not known yet
+  // is one entry with segment -1.
+  std::vector<MissingSegment> missing(std::size_t limit) const;
   bool complete() const;
-  // Chunks in hand and chunks wanted, over the newest known versions (progress).
-  std::size_t chunks_have() const;
-  std::size_t chunks_wanted() const;
+  // Segments in hand and segments wanted, over the newest known versions (progress).
+  std::size_t segments_have() const;
+  std::size_t segments_wanted() const;
 
-  // Every decoded tile's points, in tile id order.
+  // Every complete tile's points, in tile id order.
   std::vector<MapPoint> points() const;
   std::size_t tile_count() const { return tiles_.size(); }
   const AssemblerCounts& counts() const { return counts_; }
@@ -53,16 +57,17 @@ class TileAssembler {
 
  private:
   struct Tile {
-    std::int32_t wanted_version = -1;
-    std::int32_t wanted_chunks = 0;
-    std::int32_t partial_version = -1;
-    std::vector<std::vector<std::uint8_t>> parts;
-    std::int32_t parts_have = 0;
-    std::int32_t done_version = -1;
-    std::vector<MapPoint> points;
+    std::int32_t wanted_version = 0;
+    std::int32_t wanted_segments = 0;
+    std::int32_t done_version = 0;                // 0: nothing held yet
+    std::vector<std::vector<MapPoint>> segments;  // complete at done_version
+    std::int32_t pending_version = 0;             // the version being collected, 0: none
+    std::int32_t pending_first = -1;              // its first segment we lack, -1: not known yet
+    std::vector<std::vector<MapPoint>> parts;     // its segments received
+    std::vector<bool> have;
   };
-  ChunkOutcome finish(std::int64_t id, Tile& tile, std::int64_t utime);
-  ChunkOutcome count(ChunkOutcome outcome);
+  SegmentOutcome finish_if_complete(Tile& tile);
+  SegmentOutcome count(SegmentOutcome outcome);
 
   std::map<std::int64_t, Tile> tiles_;
   AssemblerCounts counts_;

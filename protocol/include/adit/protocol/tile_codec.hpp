@@ -1,15 +1,27 @@
 #pragma once
 // Map tiles: fixed-size cubes of the map addressed by integer coordinates.
-// Points are quantised to a grid inside their tile (uint16 offsets), stored as
-// columns (x, y, z, intensity) and compressed as one zstd frame; the frame is
-// cut into chunks small enough for one LCM message each.
+// Points are quantised to a grid inside their tile (uint16 offsets) and
+// stored as columns (x, y, z, intensity) in zstd frames.
 //
-// Encoded tile ("blob"), little-endian:
-//   char[4] "ADT1", u16 format (1), u16 flags (0), u32 n_points,
-//   f32 tile_size_m, f32 quantum_m, then a zstd frame (with its content
-//   checksum) holding
-//   u16 qx[n], u16 qy[n], u16 qz[n], u16 intensity[n], sorted by (qx, qy, qz).
-// A point is  origin + q * quantum, origin = tile coordinate * tile_size.
+// Tiles only grow: the mapper appends confirmed points and never moves old
+// ones. So a tile's points, in the order they were appended, are cut into
+// *segments* of a fixed point count (TileParams::segment_points); each
+// segment is one independently compressed zstd frame, sorted inside (order
+// carries no meaning there, and sorted columns compress several times better).
+// Appending points changes only the last segment (and adds new ones), so the
+// stream sends a changed tile's new segments, not the whole tile.
+//
+// Segment frame: zstd frame (with its content checksum) holding
+//   u16 qx[n], u16 qy[n], u16 qz[n], u16 intensity[n], sorted by (qx, qy, qz);
+// n = segment_points except for the last segment. A point is
+// origin + q * quantum, origin = tile coordinate * tile_size.
+//
+// Encoded tile ("blob", tiles/<id>.adt), little-endian, format 2:
+//   char[4] "ADT1", u16 format (2), u16 flags (0), u32 n_points,
+//   f32 tile_size_m, f32 quantum_m, u32 segment_points, u32 n_segments,
+//   u32 frame_bytes[n_segments], then the segments' frames in order.
+// Format 1 (before segments; still decoded): the same first 20 bytes with
+// format 1, then one zstd frame of every point sorted.
 
 #include <cstddef>
 #include <cstdint>
@@ -36,32 +48,81 @@ TileKey tile_key(std::int64_t id);
 // The tile holding a point; coordinates beyond the limit are clamped.
 TileKey tile_of(double x, double y, double z, double tile_size_m);
 
+inline constexpr std::size_t kBytesPerQuantisedPoint = 8;
+// A segment of at most 4096 points is at most 32 KB raw (zstd's bound adds
+// < 1 %), so it always fits one message's 48 000-byte payload.
+inline constexpr std::uint32_t kMaxSegmentPoints = 4096;
+inline constexpr std::uint32_t kMinSegmentPoints = 64;
+
 struct TileParams {
   double tile_size_m = 20.0;
   double quantum_m = 0.001;  // 1 mm: far below a 5 cm voxel; 20 m / 1 mm fits uint16
   int zstd_level = 3;
+  // Points per segment: the stream re-sends a changed tile's last segment
+  // whole, so smaller is cheaper per update, larger compresses better
+  // (bench_tile_stream measures the trade-off; 1024 was the cheapest).
+  std::uint32_t segment_points = 1024;
 };
-// "" when usable, else why not (tile_size / quantum must fit uint16).
+// "" when usable, else why not (tile_size / quantum must fit uint16, segment size in range).
 std::string tile_params_problem(const TileParams& params);
 
-inline constexpr std::size_t kTileHeaderBytes = 20;
-inline constexpr std::size_t kBytesPerQuantisedPoint = 8;
+inline constexpr std::size_t kTileHeaderBytes = 20;        // format 1 and the start of format 2
+inline constexpr std::size_t kTileHeaderBytesFormat2 = 28;  // + segment_points, n_segments
+inline constexpr std::uint16_t kTileFormat = 2;
 // A 20 m tile of 5 cm voxels holds ~1 M surface points; 4 M bounds the memory
 // a hostile or corrupt header can make a decoder allocate (32 MB).
 inline constexpr std::uint32_t kMaxTilePoints = 4'000'000;
-// Chunk payload: 48 000 bytes + LCM and message header stays far below 60 KB.
+// Segment payload per message: 48 000 bytes + LCM and message header stays far below 60 KB.
 inline constexpr std::size_t kChunkPayloadBytes = 48'000;
-inline constexpr std::int32_t kMaxChunksPerTile = 4096;
+// Segments of a tile: kMaxTilePoints / kMinSegmentPoints.
+inline constexpr std::int32_t kMaxSegmentsPerTile = 62'500;
 
-// Encodes the points of tile `key`; points outside the tile are clamped to its
-// faces (the caller bins points with tile_of). `params` must be valid.
+// One segment of a tile: points [index * segment_points, + n_points) of the
+// tile's append order, as one zstd frame.
+struct TileSegment {
+  std::int32_t version = 0;        // the tile version at which this segment last changed
+  std::uint64_t content_hash = 0;  // of its quantised points in append order: change detection
+  std::uint32_t n_points = 0;
+  std::vector<std::uint8_t> frame;
+};
+
+// Brings `segments` (those of tile `key`'s previous content, or empty) to the
+// new content `points` (append order) at tile version `version`. Segments
+// whose quantised points are unchanged are kept as they are; from the first
+// changed one on, every segment is re-encoded and stamped `version`, so the
+// segments changed after any version form a suffix (what a client lacks is
+// always segments [first, n)). Returns that first changed index (== size when
+// nothing changed). Points outside the tile are clamped to its faces.
+// `params` must be valid; throws std::invalid_argument for too many points.
+std::size_t update_segments(TileKey key, std::span<const MapPoint> points, const TileParams& params,
+                            std::int32_t version, std::vector<TileSegment>& segments);
+
+// The first segment changed after `held_version`: a client holding the tile
+// complete at that version lacks exactly segments [first, size).
+std::size_t first_segment_after(std::span<const TileSegment> segments, std::int32_t held_version);
+
+// Decodes one segment frame of tile `key` and appends its points to `out`.
+// Returns "" or the reason the frame is unusable; never throws on bad bytes.
+std::string decode_segment(std::span<const std::uint8_t> frame, TileKey key, double tile_size_m, double quantum_m,
+                           std::vector<MapPoint>& out);
+
+// The blob of a tile (format 2) from its segments.
+std::vector<std::uint8_t> pack_tile(const TileParams& params, std::span<const TileSegment> segments);
+// Encodes the points of tile `key` (append order) as a format-2 blob.
 std::vector<std::uint8_t> encode_tile(TileKey key, std::span<const MapPoint> points, const TileParams& params);
+// The old whole-tile format 1 (one frame of every point sorted): kept to test
+// that stored sessions of that format still load, and as the bandwidth baseline.
+std::vector<std::uint8_t> encode_tile_format1(TileKey key, std::span<const MapPoint> points, const TileParams& params);
 
-// Decodes a blob of tile `key` into `out` (replaced). Returns "" or the reason
-// the blob is unusable; never throws on bad bytes.
+// Splits a blob of tile `key` into its segments (every segment version 1) and
+// reads its tile size and quantum into `params`. A format-1 blob is decoded
+// and re-cut into segments of `params.segment_points`. Returns "" or the
+// reason the blob is unusable; never throws on bad bytes.
+std::string unpack_tile(std::span<const std::uint8_t> blob, TileKey key, TileParams& params,
+                        std::vector<TileSegment>& segments);
+
+// Decodes a blob (format 1 or 2) of tile `key` into `out` (replaced).
+// Returns "" or the reason the blob is unusable; never throws on bad bytes.
 std::string decode_tile(std::span<const std::uint8_t> blob, TileKey key, std::vector<MapPoint>& out);
-
-std::int32_t chunk_count(std::size_t blob_size);
-std::span<const std::uint8_t> chunk_of(std::span<const std::uint8_t> blob, std::int32_t index);
 
 }  // namespace adit::protocol
