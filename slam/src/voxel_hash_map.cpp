@@ -146,6 +146,13 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
   return plane;
 }
 
+void VoxelHashMap::prefetch_around(const Eigen::Vector3f& query) const {
+  const VoxelKey c = key_of(query);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) __builtin_prefetch(&slots_[home_of({c.x + dx, c.y + dy, c.z + dz})]);
+}
+
 void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {
   const float max_sq = max_distance_m * max_distance_m;
   // Collect keys, not slot indices: each erase shifts later slots back.
