@@ -47,7 +47,12 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
     const Eigen::Vector3f q = R * p + t;
     MapPlane local;
     MapPlane& plane = cached ? planes[i] : local;
-    if (associate || !cached) plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
+    if (associate || !cached) {
+      // Three queries ahead: their slots arrive while this one is searched.
+      constexpr std::size_t kPrefetchAhead = 3;
+      if (i + kPrefetchAhead < points.size()) map.prefetch_around(R * points[i + kPrefetchAhead] + t);
+      plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
+    }
     if (!plane.found) continue;
     const double r = plane.normal.dot(q - plane.point);
     if (std::abs(r) > max_distance_m) continue;

@@ -1,5 +1,6 @@
 #include "adit/slam/voxel_downsample.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -25,12 +26,25 @@ std::size_t VoxelDownsampler::downsample(std::span<const Eigen::Vector3f> in, st
     for (Slot& s : slots_) s.generation = 0;
     generation_ = 1;
   }
+  // Only the first bit_ceil(2·n) slots are used (load factor ≤ 1/2 still):
+  // a 120 k-point scan then probes 4 MB of table, not the 16 MB sized for
+  // max_points, and far more of it stays in cache. The slots beyond carry
+  // older generations, which read as empty whatever mask a later call uses.
+  const std::size_t mask =
+      std::min(mask_, std::bit_ceil(std::max<std::size_t>(2 * std::min(in.size(), max_points_), 16)) - 1);
   const float inverse = 1.0F / voxel_size_m;
+  // Consecutive points of a scan often fall in one voxel: the previous point
+  // already took it (or found it taken), so the lookup can be skipped.
+  VoxelKey previous{};
+  bool has_previous = false;
   for (std::size_t k = 0; k < in.size(); ++k) {
     const Eigen::Vector3f& p = in[k];
     if (out.size() >= max_points_) break;
     const VoxelKey key = voxel_key(p, inverse);
-    for (std::size_t i = voxel_hash(key) & mask_;; i = (i + 1) & mask_) {
+    if (has_previous && key == previous) continue;
+    previous = key;
+    has_previous = true;
+    for (std::size_t i = voxel_hash(key) & mask;; i = (i + 1) & mask) {
       Slot& slot = slots_[i];
       if (slot.generation != generation_) {
         slot = {key, generation_};

@@ -1,5 +1,6 @@
 #include "adit/slam/voxel_hash_map.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -145,12 +146,38 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
   return plane;
 }
 
+void VoxelHashMap::prefetch_around(const Eigen::Vector3f& query) const {
+  const VoxelKey c = key_of(query);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) __builtin_prefetch(&slots_[home_of({c.x + dx, c.y + dy, c.z + dz})]);
+}
+
 void VoxelHashMap::remove_far(const Eigen::Vector3f& origin, float max_distance_m) {
   const float max_sq = max_distance_m * max_distance_m;
   // Collect keys, not slot indices: each erase shifts later slots back.
   doomed_.clear();
-  for (std::size_t s = 0; s < slots_.size(); ++s)
-    if (slots_[s].count > 0 && (voxels_[s].points[0] - origin).squaredNorm() > max_sq) doomed_.push_back(slots_[s].key);
+  // The voxel's box decides for all but the voxels the sphere cuts through:
+  // entirely outside, the first point is too; entirely inside, it is not.
+  // Only the rest read their first point (the slots are one compact table;
+  // the points are 30 MB). The margin absorbs float rounding at the box edges.
+  const float margin = 1e-3F * voxel_size_ + 1e-3F;
+  const float outside_sq = (max_distance_m + margin) * (max_distance_m + margin);
+  const float inside = std::max(max_distance_m - margin, 0.0F);
+  const float inside_sq = inside * inside;
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (slots_[s].count == 0) continue;
+    const VoxelKey& key = slots_[s].key;
+    const Eigen::Vector3f low =
+        Eigen::Vector3f(static_cast<float>(key.x), static_cast<float>(key.y), static_cast<float>(key.z)) * voxel_size_ -
+        origin;
+    const Eigen::Vector3f high = low + Eigen::Vector3f::Constant(voxel_size_);
+    const Eigen::Vector3f gap = low.cwiseMax(-high).cwiseMax(0.0F);          // per axis, 0 when the origin is inside
+    const Eigen::Vector3f reach = low.cwiseAbs().cwiseMax(high.cwiseAbs());  // the farthest corner, per axis
+    const bool far = gap.squaredNorm() > outside_sq ||
+                     (reach.squaredNorm() >= inside_sq && (voxels_[s].points[0] - origin).squaredNorm() > max_sq);
+    if (far) doomed_.push_back(key);
+  }
   for (const VoxelKey& key : doomed_) erase_at(index_of(key));
 }
 

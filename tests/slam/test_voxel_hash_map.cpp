@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
+#include <tuple>
 
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -116,6 +118,40 @@ TEST(VoxelHashMap, RemoveFarKeepsEveryNearVoxelFindable) {
   map.for_each_point([&](const Eigen::Vector3f& p) { EXPECT_LE((p - origin).norm(), 8.0F + 0.87F); });
 }
 
+// remove_far decides most voxels from their box alone: it must still remove
+// exactly the voxels whose first point is beyond the distance, also for the
+// voxels the sphere cuts through (brute force on the insertion order).
+TEST(VoxelHashMap, RemoveFarRemovesExactlyTheVoxelsWhoseFirstPointIsFar) {
+  VoxelHashMap map(0.5F, 1 << 16);
+  const auto points = random_points(30000, 9.0F, 3);
+  map.add(points);
+  ASSERT_EQ(map.dropped_points(), 0U);
+  const Eigen::Vector3f origin(0.37F, -0.21F, 0.13F);
+  const float max_distance = 6.1F;
+  std::map<std::tuple<int, int, int>, Eigen::Vector3f> first;
+  for (const auto& p : points) {
+    const VoxelKey k = map.key_of(p);
+    first.try_emplace({k.x, k.y, k.z}, p);
+  }
+  std::size_t kept_expected = 0;
+  std::size_t straddling = 0;
+  for (const auto& p : points) {
+    const VoxelKey k = map.key_of(p);
+    const Eigen::Vector3f& f = first.at({k.x, k.y, k.z});
+    if ((f - origin).norm() <= max_distance) ++kept_expected;
+    const Eigen::Vector3f centre =
+        (Eigen::Vector3i(k.x, k.y, k.z).cast<float>() + Eigen::Vector3f::Constant(0.5F)) * 0.5F;
+    if (std::abs((centre - origin).norm() - max_distance) < 0.43F) ++straddling;
+  }
+  ASSERT_GT(straddling, 1000U);  // the boundary case is exercised
+  map.remove_far(origin, max_distance);
+  EXPECT_EQ(map.point_count(), kept_expected);
+  map.for_each_point([&](const Eigen::Vector3f& p) {
+    const VoxelKey k = map.key_of(p);
+    EXPECT_LE((first.at({k.x, k.y, k.z}) - origin).norm(), max_distance);
+  });
+}
+
 TEST(VoxelHashMap, ClearEmptiesTheMap) {
   VoxelHashMap map(1.0F, 256);
   map.add(random_points(100, 5.0F, 1));
@@ -146,6 +182,28 @@ TEST(VoxelDownsampler, CallsAreIndependentAndBoundedByMaxPoints) {
   const std::vector<Eigen::Vector3f> one{{0.0F, 0.0F, 0.0F}};
   EXPECT_EQ(downsampler.downsample(one, 0.1F, out), 1U);
   EXPECT_EQ(downsampler.downsample(one, 0.1F, out), 1U);  // not remembered from the previous call
+}
+
+// Against brute force (first point of each voxel, in input order) over calls
+// of very different sizes, so that each call uses a different part of the
+// table and must not see the marks of earlier calls; with runs of points in
+// one voxel, which skip the lookup.
+TEST(VoxelDownsampler, MatchesBruteForceAcrossCallsOfDifferentSizes) {
+  VoxelDownsampler downsampler(50000);
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(50000);
+  for (const std::size_t n : {40000U, 30U, 25000U, 1U, 40000U}) {
+    auto points = random_points(n, 20.0F, static_cast<unsigned>(n));
+    for (std::size_t i = 1; i < points.size(); i += 3) points[i] = points[i - 1] + Eigen::Vector3f::Constant(0.01F);
+    std::map<std::tuple<int, int, int>, bool> seen;
+    std::vector<Eigen::Vector3f> expected;
+    for (const auto& p : points) {
+      const VoxelKey k = voxel_key(p, 1.0F / 0.3F);
+      if (seen.try_emplace({k.x, k.y, k.z}, true).second) expected.push_back(p);
+    }
+    ASSERT_EQ(downsampler.downsample(points, 0.3F, out), expected.size()) << n;
+    EXPECT_TRUE(std::equal(out.begin(), out.end(), expected.begin())) << n;
+  }
 }
 
 }  // namespace

@@ -65,6 +65,11 @@ class VoxelHashMap {
   // max_plane_error_m of the plane.
   MapPlane nearest_plane(const Eigen::Vector3f& query, int neighbors, float max_plane_error_m = 0.1F) const;
 
+  // A hint, no effect on results: starts loading the slots of the 27 voxels
+  // around `query` into cache. The search is bound by cache misses on the
+  // table (measured on 64-beam scans), so callers issue this a few queries ahead.
+  void prefetch_around(const Eigen::Vector3f& query) const;
+
   void clear();
   bool empty() const { return voxel_count_ == 0; }
   std::size_t voxel_count() const { return voxel_count_; }
