@@ -6,6 +6,13 @@
 // invented, and a surveyor's point is one the sensor saw. Tiles record
 // whether they changed, so a publisher sends only what is new.
 //
+// A long session's map outgrows RAM, so tiles the sensor has left can be
+// evicted: evict() hands out a tile's confirmed points and forgets the tile
+// (its unconfirmed candidates, voxels hit fewer than min_hits times, are lost);
+// the caller stores them. When the sensor comes back, restore() takes the
+// points again as confirmed voxels, so the tile is continued, not duplicated.
+// TileEviction says which tiles are cold. No file I/O here: slam/ is pure.
+//
 // Coordinates: tile (i, j, k) covers [i·s, (i+1)·s) × … in the map frame, the
 // same convention as protocol::tile_of. Inside a tile the voxel grid starts at
 // the tile's corner, so no voxel straddles two tiles.
@@ -13,6 +20,7 @@
 #include <compare>
 #include <cstdint>
 #include <map>
+#include <string>
 #include <set>
 #include <span>
 #include <vector>
@@ -53,23 +61,51 @@ class TiledVoxelMap {
   // returns how many voxels this confirmed (entered the map). Non-finite points are skipped.
   std::size_t add(std::span<const Eigen::Vector3f> points, std::span<const float> intensities, double time_s);
 
-  // The tiles that gained points since the previous call, in coordinate order.
+  // The tiles that gained points since the previous call, in coordinate order
+  // (evicted tiles are not among them: evict() says whether one had changed).
   std::vector<TileCoord> take_changed();
 
-  // The map points of one tile, confirmed voxels only (empty when the tile does not exist).
+  // The map points of one resident tile, confirmed voxels only (empty when the
+  // tile does not exist or is evicted).
   std::span<const MapSample> tile(const TileCoord& coord) const;
-  std::vector<TileCoord> tile_coords() const;
-  std::size_t size() const { return size_; }               // map points (confirmed voxels)
-  std::size_t candidates() const { return candidates_; }   // voxels hit at least once
-  std::size_t tile_count() const { return tiles_.size(); }
+  std::vector<TileCoord> tile_coords() const;          // resident tiles, in coordinate order
+  std::vector<TileCoord> evicted_coords() const;       // evicted tiles, in coordinate order
+  std::size_t evicted_points(const TileCoord& coord) const;  // points an evicted tile held (0 if not evicted)
+  bool is_evicted(const TileCoord& coord) const { return evicted_.contains(coord); }
+  std::size_t size() const { return size_; }               // map points (confirmed voxels), evicted tiles included
+  std::size_t candidates() const { return candidates_; }   // voxels hit at least once, in resident tiles
+  std::size_t tile_count() const { return tiles_.size() + evicted_.size(); }
+  std::size_t resident_tile_count() const { return tiles_.size(); }
+  std::size_t resident_points() const { return size_ - evicted_size_; }
+  std::size_t lost_candidates() const { return lost_candidates_; }  // unconfirmed voxels dropped by evict()
+  std::size_t dropped_in_evicted() const { return dropped_in_evicted_; }  // add(): points in an evicted tile
+  // Bytes held by the resident tiles' vectors and indices (capacities, not sizes).
+  std::size_t memory_bytes() const;
+
+  // A resident tile leaves RAM: returns its confirmed points and whether it had
+  // changed since the last take_changed() (then the caller still owes it to
+  // whoever publishes tiles). Voxels below min_hits are lost. Points later
+  // added into an evicted tile are skipped and counted (dropped_in_evicted):
+  // restore() it first. Empty and false when `coord` is not resident.
+  struct Evicted {
+    std::vector<MapSample> points;
+    bool changed = false;
+  };
+  Evicted evict(const TileCoord& coord);
+  // An evicted tile comes back with the points evict() gave out (or a decoded
+  // copy of them): each is a confirmed voxel again, so new points in the same
+  // voxels are not duplicated. Points that fall into one voxel (a 1 mm
+  // quantisation can move a point across a voxel face) are all kept. Replaces
+  // nothing: a no-op when `coord` is resident.
+  void restore(const TileCoord& coord, std::span<const MapSample> points);
+  // The evicted tiles that any of `points` falls into, in coordinate order:
+  // what must be restored before add() takes them.
+  std::vector<TileCoord> evicted_hit_by(std::span<const Eigen::Vector3f> points) const;
   const TiledMapConfig& config() const { return config_; }
 
   TileCoord tile_of(const Eigen::Vector3f& p) const;
 
  private:
-  // The voxels a tile holds: an open-addressing hash set of 32-bit voxel
-  // indices (linear probing, Knuth's multiplicative hash, load ≤ 1/2), about
-  // 8 bytes per point against ~40 for std::unordered_set's nodes.
   // The voxels a tile has seen: an open-addressing hash map from the 32-bit
   // voxel index to the voxel's candidate (linear probing, Knuth's
   // multiplicative hash, load ≤ 1/2): 16 bytes per slot.
@@ -77,6 +113,7 @@ class TiledVoxelMap {
    public:
     // The candidate of `voxel`, or `next` (then stored) when it is new.
     std::uint32_t find_or_insert(std::uint32_t voxel, std::uint32_t next);
+    std::size_t memory_bytes() const { return slots_.capacity() * sizeof(Slot); }
    private:
     static constexpr std::uint32_t kEmpty = 0xFFFFFFFFU;  // > any index (≤ 1600³ - 1)
     struct Slot {
@@ -93,12 +130,45 @@ class TiledVoxelMap {
     std::vector<std::uint8_t> hits;     // per candidate, saturating
     std::vector<MapSample> points;      // confirmed: what the map holds
   };
+  Tile& new_tile(const TileCoord& coord);
+  std::uint32_t voxel_of(const Eigen::Vector3f& p, const Eigen::Vector3f& origin) const;
+  Eigen::Vector3f origin_of(const TileCoord& coord) const;
+
   TiledMapConfig config_;
   std::int32_t voxels_per_edge_;
   std::map<TileCoord, Tile> tiles_;
+  std::map<TileCoord, std::size_t> evicted_;  // evicted tile → its point count
   std::set<TileCoord> changed_;
   std::size_t size_ = 0;
+  std::size_t evicted_size_ = 0;
   std::size_t candidates_ = 0;
+  std::size_t lost_candidates_ = 0;
+  std::size_t dropped_in_evicted_ = 0;
 };
+
+// Which resident tiles the sensor has left. A tile is cold once its whole cube
+// has lain farther than `radius_m` from the sensor at `after_keyframes`
+// consecutive keyframes. With radius_m ≥ map.max_range_m (plus the distance a
+// deskewed point can move, a few cm) no point of a scan taken there can fall
+// into the tile; the keyframe count adds hysteresis, so a path along a tile
+// boundary does not evict and reload the same tile over and over.
+struct TileEvictionConfig {
+  float radius_m = 50.0F;
+  int after_keyframes = 20;  // ≤ 0: never evict
+};
+
+class TileEviction {
+ public:
+  explicit TileEviction(const TileEvictionConfig& config) : config_(config) {}
+  // Once per keyframe: the resident tiles that are cold now, in coordinate order.
+  std::vector<TileCoord> cold_tiles(const TiledVoxelMap& map, const Eigen::Vector3f& sensor);
+
+ private:
+  TileEvictionConfig config_;
+  std::map<TileCoord, int> far_for_;  // resident tile → consecutive keyframes beyond the radius
+};
+
+// Distance from `p` to the cube of tile `coord` (0 inside).
+float distance_to_tile(const TileCoord& coord, float tile_size_m, const Eigen::Vector3f& p);
 
 }  // namespace adit::slam
