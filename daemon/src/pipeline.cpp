@@ -89,6 +89,13 @@ slam::TiledMapConfig map_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m), static_cast<std::uint8_t>(m.min_hits)};
 }
 
+// No point of a scan lies farther than max_range_m from the body (map_scan
+// filters them), deskewing moves points by at most a sweep's motion, and the
+// sensor's offset from the body is small: the margin covers both.
+slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
+  return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes};
+}
+
 }  // namespace
 
 struct Pipeline::Impl {
@@ -99,6 +106,7 @@ struct Pipeline::Impl {
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
         extrinsic(isometry_of(c.lidar.extrinsics).cast<float>()),
         map(map_config_of(c.map)),
+        eviction(eviction_config_of(c.map)),
         keyframe_selector({c.map.keyframe_distance_m, c.map.keyframe_angle_deg}) {
     options.odometry.min_range_m = static_cast<float>(c.lidar.min_range_m);
     options.odometry.max_range_m = static_cast<float>(c.lidar.max_range_m);
@@ -418,6 +426,7 @@ struct Pipeline::Impl {
     if (have_pending && !stop.load()) map_scan(pending, map_velocity);  // the last sweep: the last motion known
     have_pending = false;
     flush_tiles();
+    stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);
     stats.dropped_map_scans.store(map_slots->dropped());
     mapping_beat.finished.store(true);
   }
@@ -439,17 +448,56 @@ struct Pipeline::Impl {
     }
     map_deskewed.resize(map_points.size());
     map_deskewer.deskew(map_points, map_times, velocity, map_deskewed);
-    if (keyframe_selector.take(slot.pose)) {
+    const bool keyframe = keyframe_selector.take(slot.pose);
+    if (keyframe) {
       keyframe_downsampler->downsample(map_deskewed, static_cast<float>(config.map.keyframe_voxel_m), keyframe_points);
       keyframe_list.push_back({slot.stamp_ns, slot.pose, keyframe_points});
+      keyframe_bytes += sizeof(slam::Keyframe) + keyframe_list.back().points.capacity() * sizeof(Eigen::Vector3f);
       stats.keyframes.store(keyframe_list.size(), std::memory_order_relaxed);
+      stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
     }
     const Eigen::Isometry3f pose = slot.pose.cast<float>();
     for (Eigen::Vector3f& p : map_deskewed) p = pose * p;
+    if (spill) restore_tiles(map.evicted_hit_by(map_deskewed));
     map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
+    if (spill && keyframe) evict_tiles(eviction.cold_tiles(map, slot.pose.translation().cast<float>()));
     stats.mapped_scans.fetch_add(1, std::memory_order_relaxed);
     stats.map_points.store(map.size(), std::memory_order_relaxed);
     stats.map_tiles.store(map.tile_count(), std::memory_order_relaxed);
+    stats.resident_tiles.store(map.resident_tile_count(), std::memory_order_relaxed);
+    stats.dropped_in_evicted.store(map.dropped_in_evicted(), std::memory_order_relaxed);
+    if (keyframe) stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+  }
+
+  // Mapping thread: the sensor has come back to tiles it had left; they are
+  // read back, so the scan continues them instead of starting copies. A tile
+  // that cannot be read stays evicted (its file intact) and add() skips the
+  // points that fall into it (counted).
+  void restore_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      if (const std::string problem = spill->read(coord, tile_buffer); !problem.empty()) {
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+        continue;
+      }
+      map.restore(coord, tile_buffer);
+      stats.restored_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+
+  // Mapping thread: tiles the sensor has left are written to the session's
+  // tiles/ folder and leave RAM. A tile whose last change was not published
+  // yet goes to the sink first. A tile that cannot be written stays in RAM.
+  void evict_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      if (const std::string problem = spill->write(coord, map.tile(coord)); !problem.empty()) {
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+        continue;
+      }
+      const slam::TiledVoxelMap::Evicted evicted = map.evict(coord);
+      if (evicted.changed && options.sinks.tile) options.sinks.tile(coord, evicted.points);
+      stats.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.lost_candidates.store(map.lost_candidates(), std::memory_order_relaxed);
   }
 
   void flush_tiles() {
@@ -515,6 +563,10 @@ struct Pipeline::Impl {
   std::optional<Handoff<MapSlot>> map_slots;
   // Mapping thread only:
   slam::TiledVoxelMap map;
+  slam::TileEviction eviction;
+  std::optional<TileSpill> spill;          // set by start() when the session has a tiles folder
+  std::vector<slam::MapSample> tile_buffer;  // a tile read back
+  std::uint64_t keyframe_bytes = 0;
   slam::KeyframeSelector keyframe_selector;
   std::vector<slam::Keyframe> keyframe_list;
   std::optional<slam::VoxelDownsampler> keyframe_downsampler;
@@ -567,6 +619,11 @@ void Pipeline::start(const SessionFiles& files) {
   Impl& i = *impl_;
   if (!i.threads.empty()) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.record_file);
+  if (!files.tiles_dir.empty() && i.config.map.evict_after_keyframes > 0) {
+    protocol::TileParams params;
+    params.tile_size_m = i.config.map.tile_size_m;
+    i.spill.emplace(files.tiles_dir, params);
+  }
   if (i.wheels) i.wheels->start(files.can_record_file);
   if (i.config.threads.lock_memory) {
     auto w = lock_memory();
@@ -633,6 +690,7 @@ std::vector<StageLoad> Pipeline::loads() const {
 }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->map; }
+const TileSpill* Pipeline::tile_spill() const { return impl_->spill ? &*impl_->spill : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const { return impl_->keyframe_list; }
 std::vector<std::string> Pipeline::warnings() const {
   const std::lock_guard lock(impl_->warnings_mutex);
