@@ -487,23 +487,40 @@ struct Pipeline::Impl {
   // Mapping thread: tiles the sensor has left are written to the session's
   // tiles/ folder and leave RAM. A tile whose last change was not published
   // yet goes to the sink first. A tile that cannot be written stays in RAM.
+  // A restored tile's file holds its stored part: it is rewritten with the new
+  // points appended, or left as it is when nothing is new.
   void evict_tiles(const std::vector<slam::TileCoord>& coords) {
     for (const slam::TileCoord& coord : coords) {
-      if (const std::string problem = spill->write(coord, map.tile(coord)); !problem.empty()) {
-        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
-        continue;
+      const bool restored = map.stored_points(coord) > 0;
+      if (!restored || !map.tile(coord).empty()) {
+        std::string problem = spill->whole_tile(map, coord, tile_buffer);
+        if (problem.empty()) problem = spill->write(coord, tile_buffer);
+        if (!problem.empty()) {
+          if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+          continue;
+        }
       }
-      const slam::TiledVoxelMap::Evicted evicted = map.evict(coord);
-      if (evicted.changed && options.sinks.tile) options.sinks.tile(coord, evicted.points);
+      if (map.evict(coord).changed && options.sinks.tile && spill->whole_tile(map, coord, tile_buffer).empty())
+        options.sinks.tile(coord, tile_buffer);
       stats.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
     }
     stats.lost_candidates.store(map.lost_candidates(), std::memory_order_relaxed);
   }
 
+  // A restored tile's whole content is its stored part (read back) and what
+  // is new: decoding it costs a few ms per changed tile and period.
   void flush_tiles() {
     const std::vector<slam::TileCoord> changed = map.take_changed();
     if (!options.sinks.tile) return;
-    for (const slam::TileCoord& coord : changed) options.sinks.tile(coord, map.tile(coord));
+    for (const slam::TileCoord& coord : changed) {
+      if (!spill || map.stored_points(coord) == 0) {
+        options.sinks.tile(coord, map.tile(coord));
+      } else if (const std::string problem = spill->whole_tile(map, coord, tile_buffer); problem.empty()) {
+        options.sinks.tile(coord, tile_buffer);
+      } else if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) {
+        log::error("mapping: {}", problem);
+      }
+    }
   }
 
   void output_loop() {

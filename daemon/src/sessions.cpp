@@ -186,9 +186,18 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     // session's map does not fit in RAM whole).
     const protocol::TileParams params = tile_params_of(config_.map);
     TileSpill resident_tiles(dir / "tiles", params);
-    for (const slam::TileCoord& c : map.tile_coords())
-      if (const std::string problem = resident_tiles.write(c, map.tile(c)); !problem.empty())
-        throw std::runtime_error(problem);
+    const TileSpill* spill = pipeline->tile_spill();  // what the mapping thread evicted (and restored)
+    std::vector<slam::MapSample> whole;
+    for (const slam::TileCoord& c : map.tile_coords()) {
+      std::string problem;
+      if (map.stored_points(c) == 0) {
+        problem = resident_tiles.write(c, map.tile(c));
+      } else if (!map.tile(c).empty()) {  // a restored tile with new points: its file gets them
+        problem = spill == nullptr ? "restored tile without a tile folder" : spill->whole_tile(map, c, whole);
+        if (problem.empty()) problem = resident_tiles.write(c, whole);
+      }
+      if (!problem.empty()) throw std::runtime_error(problem);
+    }
     files.push_back("tiles/");
     std::vector<slam::TileCoord> coords = map.tile_coords();
     const std::vector<slam::TileCoord> evicted = map.evicted_coords();
@@ -211,9 +220,11 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     std::vector<slam::MapSample> read_back;
     for (const slam::TileCoord& c : coords) {
       std::span<const slam::MapSample> samples = map.tile(c);
-      if (map.is_evicted(c)) {
-        const TileSpill* spill = pipeline->tile_spill();
-        const std::string problem = spill == nullptr ? "evicted tile without a tile folder" : spill->read(c, read_back);
+      if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
+        const bool rewritten = !map.is_evicted(c) && !map.tile(c).empty();
+        const std::string problem = rewritten         ? resident_tiles.read(c, read_back)
+                                    : spill == nullptr ? "evicted tile without a tile folder"
+                                                       : spill->read(c, read_back);
         if (!problem.empty()) throw std::runtime_error(problem);
         samples = read_back;
       }

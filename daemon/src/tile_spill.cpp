@@ -62,4 +62,15 @@ std::string TileSpill::read(const slam::TileCoord& coord, std::vector<slam::MapS
   return "";
 }
 
+std::string TileSpill::whole_tile(const slam::TiledVoxelMap& map, const slam::TileCoord& coord,
+                                  std::vector<slam::MapSample>& out) const {
+  out.clear();
+  if (map.is_evicted(coord) || map.stored_points(coord) > 0) {
+    if (std::string problem = read(coord, out); !problem.empty()) return problem;
+  }
+  const std::span<const slam::MapSample> held = map.tile(coord);
+  out.insert(out.end(), held.begin(), held.end());
+  return "";
+}
+
 }  // namespace adit::daemon

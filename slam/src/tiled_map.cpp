@@ -70,6 +70,10 @@ std::size_t TiledVoxelMap::add(std::span<const Eigen::Vector3f> points, std::spa
       continue;
     }
     const std::uint32_t voxel = voxel_of(p, origin);
+    if (!tile->stored.empty()) {  // a restored tile: its stored voxels are in the map already
+      const auto [block, bit] = block_of(voxel);
+      if (tile->stored.contains(block, bit)) continue;
+    }
     const auto next = static_cast<std::uint32_t>(tile->candidates.size());
     const std::uint32_t candidate = tile->voxels.find_or_insert(voxel, next);
     if (candidate == next) {
@@ -96,9 +100,10 @@ TiledVoxelMap::Evicted TiledVoxelMap::evict(const TileCoord& coord) {
   Evicted out{std::move(tile.points), changed_.erase(coord) > 0};
   candidates_ -= tile.candidates.size();
   lost_candidates_ += tile.candidates.size() - confirmed;
+  stored_size_ -= tile.stored_points;
+  evicted_[coord] = tile.stored_points + confirmed;
+  evicted_size_ += tile.stored_points + confirmed;
   tiles_.erase(it);
-  evicted_[coord] = confirmed;
-  evicted_size_ += confirmed;
   return out;
 }
 
@@ -111,18 +116,35 @@ void TiledVoxelMap::restore(const TileCoord& coord, std::span<const MapSample> p
   }
   Tile& tile = new_tile(coord);
   const Eigen::Vector3f origin = origin_of(coord);
-  const std::uint8_t confirmed = std::max<std::uint8_t>(config_.min_hits, 1);
-  tile.candidates.reserve(points.size());
-  tile.hits.reserve(points.size());
-  tile.points.assign(points.begin(), points.end());
   for (const MapSample& s : points) {
-    const auto next = static_cast<std::uint32_t>(tile.candidates.size());
-    tile.voxels.find_or_insert(voxel_of(s.position, origin), next);  // a second point in a voxel: kept, not indexed
-    tile.candidates.push_back(s);
-    tile.hits.push_back(confirmed);
+    const auto [block, bit] = block_of(voxel_of(s.position, origin));
+    tile.stored.insert(block, bit);
   }
-  candidates_ += points.size();
+  tile.stored_points = points.size();
+  stored_size_ += points.size();
   size_ += points.size();
+}
+
+std::pair<std::uint32_t, std::uint32_t> TiledVoxelMap::block_of(std::uint32_t voxel) const {
+  const auto n = static_cast<std::uint32_t>(voxels_per_edge_);
+  const std::uint32_t blocks_per_edge = (n + 7) / 8;
+  const std::uint32_t z = voxel % n;
+  const std::uint32_t y = (voxel / n) % n;
+  const std::uint32_t x = voxel / (n * n);
+  return {((x >> 3) * blocks_per_edge + (y >> 3)) * blocks_per_edge + (z >> 3),
+          ((x & 7U) << 6) | ((y & 7U) << 3) | (z & 7U)};
+}
+
+void TiledVoxelMap::VoxelBits::insert(std::uint32_t block, std::uint32_t bit) {
+  const auto next = static_cast<std::uint32_t>(bitmaps_.size());
+  const std::uint32_t at = blocks_.find_or_insert(block, next);
+  if (at == next) bitmaps_.push_back(Bitmap{});
+  bitmaps_[at][bit >> 6] |= std::uint64_t{1} << (bit & 63U);
+}
+
+bool TiledVoxelMap::VoxelBits::contains(std::uint32_t block, std::uint32_t bit) const {
+  const std::uint32_t at = blocks_.find(block);
+  return at != VoxelIndex::kEmpty && (bitmaps_[at][bit >> 6] >> (bit & 63U) & 1U) != 0;
 }
 
 std::vector<TileCoord> TiledVoxelMap::evicted_hit_by(std::span<const Eigen::Vector3f> points) const {
@@ -146,7 +168,7 @@ std::size_t TiledVoxelMap::memory_bytes() const {
   for (const auto& [coord, tile] : tiles_)
     bytes += sizeof(coord) + sizeof(tile) + 4 * sizeof(void*) +  // std::map node
              tile.voxels.memory_bytes() + tile.candidates.capacity() * sizeof(MapSample) + tile.hits.capacity() +
-             tile.points.capacity() * sizeof(MapSample);
+             tile.points.capacity() * sizeof(MapSample) + tile.stored.memory_bytes();
   return bytes;
 }
 
@@ -160,6 +182,15 @@ std::uint32_t TiledVoxelMap::VoxelIndex::find_or_insert(std::uint32_t voxel, std
       ++size_;
       return next;
     }
+  }
+}
+
+std::uint32_t TiledVoxelMap::VoxelIndex::find(std::uint32_t voxel) const {
+  if (slots_.empty()) return kEmpty;
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = (voxel * 2654435761U) & mask;; i = (i + 1) & mask) {
+    if (slots_[i].voxel == voxel) return slots_[i].candidate;
+    if (slots_[i].voxel == kEmpty) return kEmpty;
   }
 }
 
@@ -195,6 +226,11 @@ std::vector<TileCoord> TiledVoxelMap::evicted_coords() const {
   out.reserve(evicted_.size());
   for (const auto& [coord, points] : evicted_) out.push_back(coord);
   return out;
+}
+
+std::size_t TiledVoxelMap::stored_points(const TileCoord& coord) const {
+  const auto it = tiles_.find(coord);
+  return it == tiles_.end() ? 0 : it->second.stored_points;
 }
 
 std::size_t TiledVoxelMap::evicted_points(const TileCoord& coord) const {

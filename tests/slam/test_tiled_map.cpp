@@ -160,12 +160,16 @@ TEST(TiledVoxelMapEviction, ARestoredTileContinuesWithoutDuplicatingItsVoxels) {
   map.add(points, {}, 1.0);
   map.add(points, {}, 2.0);
   map.take_changed();
+  const std::size_t bytes_before = map.memory_bytes();
   const std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
 
   map.restore({0, 0, 0}, stored);
   EXPECT_FALSE(map.is_evicted({0, 0, 0}));
   EXPECT_EQ(map.size(), points.size());
-  EXPECT_EQ(map.tile({0, 0, 0}).size(), points.size());
+  EXPECT_TRUE(map.tile({0, 0, 0}).empty());  // the stored points stay the caller's
+  EXPECT_EQ(map.stored_points({0, 0, 0}), points.size());
+  EXPECT_EQ(map.resident_points(), 0U);
+  EXPECT_LT(map.memory_bytes(), bytes_before / 10);  // a bit per stored voxel, not a candidate and a point
   EXPECT_TRUE(map.take_changed().empty());  // restoring is not a change: the content is what was published
   // The same voxels, hit once or many times more: nothing new.
   EXPECT_EQ(map.add(points, {}, 3.0), 0U);
@@ -177,12 +181,37 @@ TEST(TiledVoxelMapEviction, ARestoredTileContinuesWithoutDuplicatingItsVoxels) {
   EXPECT_EQ(map.add(fresh, {}, 6.0), 1U);
   EXPECT_EQ(map.size(), points.size() + 1);
   EXPECT_EQ(map.take_changed(), (std::vector<TileCoord>{{0, 0, 0}}));
+  ASSERT_EQ(map.tile({0, 0, 0}).size(), 1U);  // only what is new since the restore
+  EXPECT_FLOAT_EQ(map.tile({0, 0, 0})[0].position.x(), 9.0F);
   // A resident tile is not replaced by restore().
   map.restore({0, 0, 0}, {});
-  EXPECT_EQ(map.tile({0, 0, 0}).size(), points.size() + 1);
+  EXPECT_EQ(map.stored_points({0, 0, 0}), points.size());
+  // Evicted again: out go the new points; the tile's count is the stored part plus them.
+  const TiledVoxelMap::Evicted again = map.evict({0, 0, 0});
+  EXPECT_EQ(again.points.size(), 1U);
+  EXPECT_EQ(map.evicted_points({0, 0, 0}), points.size() + 1);
+  EXPECT_EQ(map.size(), points.size() + 1);
 }
 
-TEST(TiledVoxelMapEviction, ARestoredCopyWithTwoPointsInOneVoxelKeepsBoth) {
+TEST(TiledVoxelMapEviction, StoredVoxelsAreRecognisedInEveryBlockOfABigTile) {
+  // 1 cm voxels in a 12 m tile: 1200 voxels per edge, 150 blocks per edge; points spread over all of it.
+  TiledVoxelMap map({12.0F, 0.01F, 1});
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j)
+      points.emplace_back(0.005F + 0.3F * static_cast<float>(i), 0.005F + 0.3F * static_cast<float>(j),
+                          11.995F - 0.29F * static_cast<float>((i * 7 + j) % 41));
+  ASSERT_EQ(map.add(points, {}, 0.0), points.size());
+  std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+  map.restore({0, 0, 0}, stored);
+  EXPECT_EQ(map.add(points, {}, 1.0), 0U);
+  // The voxels next to each stored one (1 cm away on every axis) are free.
+  std::vector<Eigen::Vector3f> neighbours;
+  for (const Eigen::Vector3f& p : points) neighbours.push_back(p + Eigen::Vector3f(0.01F, 0.01F, -0.01F));
+  EXPECT_EQ(map.add(neighbours, {}, 2.0), neighbours.size());
+}
+
+TEST(TiledVoxelMapEviction, ARestoredCopyWithTwoPointsInOneVoxelCountsBoth) {
   TiledVoxelMap map({20.0F, 0.05F, 1});
   map.add(std::vector<Eigen::Vector3f>{{1.01F, 1.01F, 1.01F}}, {}, 1.0);
   map.evict({0, 0, 0});
@@ -191,7 +220,7 @@ TEST(TiledVoxelMapEviction, ARestoredCopyWithTwoPointsInOneVoxelKeepsBoth) {
                                     {Eigen::Vector3f(1.02F, 1.02F, 1.02F), 2.0F, 1.0}};
   map.restore({0, 0, 0}, copy);
   EXPECT_EQ(map.size(), 2U);
-  EXPECT_EQ(map.tile({0, 0, 0}).size(), 2U);
+  EXPECT_EQ(map.stored_points({0, 0, 0}), 2U);
   EXPECT_EQ(map.add(std::vector<Eigen::Vector3f>{{1.03F, 1.03F, 1.03F}}, {}, 2.0), 0U);
 }
 

@@ -28,6 +28,11 @@ class TileSpill {
   std::string write(const slam::TileCoord& coord, std::span<const slam::MapSample> points);
   // Reads a tile written before into `out` (replaced); "" or why not.
   std::string read(const slam::TileCoord& coord, std::vector<slam::MapSample>& out) const;
+  // The whole content of a tile of `map` into `out`: its stored part (read
+  // back) and what the map holds (tile()), or the stored file alone when the
+  // tile is evicted; "" or why not.
+  std::string whole_tile(const slam::TiledVoxelMap& map, const slam::TileCoord& coord,
+                         std::vector<slam::MapSample>& out) const;
   std::filesystem::path file_of(const slam::TileCoord& coord) const;
   const std::filesystem::path& dir() const { return dir_; }
 

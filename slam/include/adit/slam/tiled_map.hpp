@@ -9,20 +9,27 @@
 // A long session's map outgrows RAM, so tiles the sensor has left can be
 // evicted: evict() hands out a tile's confirmed points and forgets the tile
 // (its unconfirmed candidates, voxels hit fewer than min_hits times, are lost);
-// the caller stores them. When the sensor comes back, restore() takes the
-// points again as confirmed voxels, so the tile is continued, not duplicated.
-// TileEviction says which tiles are cold. No file I/O here: slam/ is pure.
+// the caller stores them. When the sensor comes back, restore() marks the
+// stored points' voxels as taken, so the tile is continued, not duplicated,
+// but keeps neither the points nor a candidate per voxel: a bit per voxel in
+// 8×8×8 blocks (64 bytes per block a surface crosses, about a byte per surface
+// voxel against ~70 for a voxel hit in RAM), so a tile revisited again and
+// again costs RAM only for what is new since its last restore. Such a tile's
+// whole content is then the caller's stored part plus tile(). TileEviction
+// says which tiles are cold. No file I/O here: slam/ is pure.
 //
 // Coordinates: tile (i, j, k) covers [i·s, (i+1)·s) × … in the map frame, the
 // same convention as protocol::tile_of. Inside a tile the voxel grid starts at
 // the tile's corner, so no voxel straddles two tiles.
 
+#include <array>
 #include <compare>
 #include <cstdint>
 #include <map>
 #include <string>
 #include <set>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -65,9 +72,12 @@ class TiledVoxelMap {
   // (evicted tiles are not among them: evict() says whether one had changed).
   std::vector<TileCoord> take_changed();
 
-  // The map points of one resident tile, confirmed voxels only (empty when the
-  // tile does not exist or is evicted).
+  // The map points of one resident tile that the map holds itself: confirmed
+  // since the tile was made or restored (empty when it does not exist or is
+  // evicted). A restored tile's earlier points are the caller's (stored_points).
   std::span<const MapSample> tile(const TileCoord& coord) const;
+  // How many points of a resident tile the caller holds (given to restore()), 0 if none.
+  std::size_t stored_points(const TileCoord& coord) const;
   std::vector<TileCoord> tile_coords() const;          // resident tiles, in coordinate order
   std::vector<TileCoord> evicted_coords() const;       // evicted tiles, in coordinate order
   std::size_t evicted_points(const TileCoord& coord) const;  // points an evicted tile held (0 if not evicted)
@@ -76,7 +86,7 @@ class TiledVoxelMap {
   std::size_t candidates() const { return candidates_; }   // voxels hit at least once, in resident tiles
   std::size_t tile_count() const { return tiles_.size() + evicted_.size(); }
   std::size_t resident_tile_count() const { return tiles_.size(); }
-  std::size_t resident_points() const { return size_ - evicted_size_; }
+  std::size_t resident_points() const { return size_ - evicted_size_ - stored_size_; }  // points held in RAM
   std::size_t lost_candidates() const { return lost_candidates_; }  // unconfirmed voxels dropped by evict()
   std::size_t dropped_in_evicted() const { return dropped_in_evicted_; }  // add(): points in an evicted tile
   // Bytes held by the resident tiles' vectors and indices (capacities, not sizes).
@@ -92,11 +102,11 @@ class TiledVoxelMap {
     bool changed = false;
   };
   Evicted evict(const TileCoord& coord);
-  // An evicted tile comes back with the points evict() gave out (or a decoded
-  // copy of them): each is a confirmed voxel again, so new points in the same
-  // voxels are not duplicated. Points that fall into one voxel (a 1 mm
-  // quantisation can move a point across a voxel face) are all kept. Replaces
-  // nothing: a no-op when `coord` is resident.
+  // An evicted tile comes back: `points` are what the caller stored for it
+  // (evict()'s points, merged with any earlier stored part; or a decoded copy).
+  // Their voxels count as confirmed, so new points in them are not added
+  // again; the points themselves stay the caller's (stored_points()), and
+  // evict() later hands out only what is new. A no-op when `coord` is resident.
   void restore(const TileCoord& coord, std::span<const MapSample> points);
   // The evicted tiles that any of `points` falls into, in coordinate order:
   // what must be restored before add() takes them.
@@ -113,9 +123,11 @@ class TiledVoxelMap {
    public:
     // The candidate of `voxel`, or `next` (then stored) when it is new.
     std::uint32_t find_or_insert(std::uint32_t voxel, std::uint32_t next);
+    // The candidate of `voxel`, or kEmpty.
+    std::uint32_t find(std::uint32_t voxel) const;
     std::size_t memory_bytes() const { return slots_.capacity() * sizeof(Slot); }
-   private:
     static constexpr std::uint32_t kEmpty = 0xFFFFFFFFU;  // > any index (≤ 1600³ - 1)
+   private:
     struct Slot {
       std::uint32_t voxel = kEmpty;
       std::uint32_t candidate = 0;
@@ -124,12 +136,29 @@ class TiledVoxelMap {
     std::vector<Slot> slots_;
     std::size_t size_ = 0;
   };
+  // A set of voxels as one bit per voxel in 8×8×8 blocks: a block index
+  // (VoxelIndex: block → bitmap) and 512-bit bitmaps.
+  class VoxelBits {
+   public:
+    void insert(std::uint32_t block, std::uint32_t bit);
+    bool contains(std::uint32_t block, std::uint32_t bit) const;
+    bool empty() const { return bitmaps_.empty(); }
+    std::size_t memory_bytes() const { return blocks_.memory_bytes() + bitmaps_.capacity() * sizeof(Bitmap); }
+   private:
+    using Bitmap = std::array<std::uint64_t, 8>;
+    VoxelIndex blocks_;
+    std::vector<Bitmap> bitmaps_;
+  };
   struct Tile {
     VoxelIndex voxels;
     std::vector<MapSample> candidates;  // first point of each voxel hit so far
     std::vector<std::uint8_t> hits;     // per candidate, saturating
-    std::vector<MapSample> points;      // confirmed: what the map holds
+    std::vector<MapSample> points;      // confirmed since made or restored: what the map holds
+    VoxelBits stored;                   // voxels of the points the caller holds (restore())
+    std::size_t stored_points = 0;
   };
+  // (block, bit) of a voxel index for VoxelBits.
+  std::pair<std::uint32_t, std::uint32_t> block_of(std::uint32_t voxel) const;
   Tile& new_tile(const TileCoord& coord);
   std::uint32_t voxel_of(const Eigen::Vector3f& p, const Eigen::Vector3f& origin) const;
   Eigen::Vector3f origin_of(const TileCoord& coord) const;
@@ -141,6 +170,7 @@ class TiledVoxelMap {
   std::set<TileCoord> changed_;
   std::size_t size_ = 0;
   std::size_t evicted_size_ = 0;
+  std::size_t stored_size_ = 0;  // points of resident tiles that the caller holds
   std::size_t candidates_ = 0;
   std::size_t lost_candidates_ = 0;
   std::size_t dropped_in_evicted_ = 0;
