@@ -93,7 +93,8 @@ slam::TiledMapConfig map_config_of(const config::MapSection& m) {
 // filters them), deskewing moves points by at most a sweep's motion, and the
 // sensor's offset from the body is small: the margin covers both.
 slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
-  return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes};
+  return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
+          static_cast<std::size_t>(m.compact_tile_voxels)};
 }
 
 }  // namespace
@@ -460,13 +461,34 @@ struct Pipeline::Impl {
     for (Eigen::Vector3f& p : map_deskewed) p = pose * p;
     if (spill) restore_tiles(map.evicted_hit_by(map_deskewed));
     map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
-    if (spill && keyframe) evict_tiles(eviction.cold_tiles(map, slot.pose.translation().cast<float>()));
+    if (spill && keyframe) {
+      evict_tiles(eviction.cold_tiles(map, slot.pose.translation().cast<float>()));
+      compact_tiles(eviction.crowded_tiles(map));
+    }
     stats.mapped_scans.fetch_add(1, std::memory_order_relaxed);
     stats.map_points.store(map.size(), std::memory_order_relaxed);
     stats.map_tiles.store(map.tile_count(), std::memory_order_relaxed);
     stats.resident_tiles.store(map.resident_tile_count(), std::memory_order_relaxed);
     stats.dropped_in_evicted.store(map.dropped_in_evicted(), std::memory_order_relaxed);
     if (keyframe) stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+  }
+
+  // Mapping thread: a tile holding too many voxels in RAM is written out,
+  // evicted and restored at once: its points go to its file and only a bit
+  // per voxel stays (unconfirmed voxels are lost, as on eviction).
+  void compact_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      std::string problem = spill->whole_tile(map, coord, tile_buffer);
+      if (problem.empty()) problem = spill->write(coord, tile_buffer);
+      if (!problem.empty()) {
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+        continue;
+      }
+      if (map.evict(coord).changed && options.sinks.tile) options.sinks.tile(coord, tile_buffer);
+      map.restore(coord, tile_buffer);
+      stats.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.lost_candidates.store(map.lost_candidates(), std::memory_order_relaxed);
   }
 
   // Mapping thread: the sensor has come back to tiles it had left; they are

@@ -255,6 +255,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
                  {"evicted_tiles", s.evicted_tiles.load()}, {"restored_tiles", s.restored_tiles.load()},
+                 {"compacted_tiles", s.compacted_tiles.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
         {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},

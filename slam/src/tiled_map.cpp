@@ -228,6 +228,11 @@ std::vector<TileCoord> TiledVoxelMap::evicted_coords() const {
   return out;
 }
 
+std::size_t TiledVoxelMap::held_voxels(const TileCoord& coord) const {
+  const auto it = tiles_.find(coord);
+  return it == tiles_.end() ? 0 : it->second.candidates.size();
+}
+
 std::size_t TiledVoxelMap::stored_points(const TileCoord& coord) const {
   const auto it = tiles_.find(coord);
   return it == tiles_.end() ? 0 : it->second.stored_points;
@@ -261,6 +266,14 @@ std::vector<TileCoord> TileEviction::cold_tiles(const TiledVoxelMap& map, const 
   }
   far_for_ = std::move(far_for);  // near, evicted or gone tiles start again from zero
   return cold;
+}
+
+std::vector<TileCoord> TileEviction::crowded_tiles(const TiledVoxelMap& map) const {
+  std::vector<TileCoord> crowded;
+  if (config_.compact_voxels == 0) return crowded;
+  for (const TileCoord& coord : map.tile_coords())
+    if (map.held_voxels(coord) > config_.compact_voxels) crowded.push_back(coord);
+  return crowded;
 }
 
 }  // namespace adit::slam

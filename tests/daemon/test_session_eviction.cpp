@@ -51,9 +51,10 @@ struct SessionRun {
   std::map<std::int64_t, std::size_t> published;  // tile id → points in its newest live update
 };
 
-// Small tiles (5 m) and a short mapping range (5 m, margin 1 m) so that a
-// 20 m drive leaves tiles behind; evict_after_keyframes 0 keeps all in RAM.
-SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes) {
+// Small tiles (5 m) and a short mapping range (5 m, margin 1 m) so that the
+// drive leaves tiles behind (evict_after_keyframes 0: every tile stays in RAM);
+// compact_tile_voxels 0: never compacted.
+SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels) {
   const std::filesystem::path session = driving_session();
   std::ifstream sim_config(session / "session.yaml");
   std::string yaml((std::istreambuf_iterator<char>(sim_config)), std::istreambuf_iterator<char>());
@@ -69,8 +70,8 @@ SessionRun map_session(const std::filesystem::path& work, int evict_after_keyfra
   replace("  replay_speed: 1.0", "  replay_speed: 0");  // as fast as possible: a replay waits, nothing is dropped
   yaml += fmt::format(
       "map:\n  tile_size_m: 5\n  max_range_m: 5\n  evict_margin_m: 1\n  evict_after_keyframes: {}\n"
-      "session:\n  exports: [ply, las]\nthreads:\n  lock_memory: false\n",
-      evict_after_keyframes);
+      "  compact_tile_voxels: {}\nsession:\n  exports: [ply, las]\nthreads:\n  lock_memory: false\n",
+      evict_after_keyframes, compact_tile_voxels);
   std::filesystem::create_directories(work);
   const std::filesystem::path config_file = work / "aditd.yaml";
   std::ofstream(config_file) << yaml;
@@ -121,63 +122,96 @@ std::size_t unmatched(const std::vector<test::XyzI>& points, const std::vector<t
   return missing;
 }
 
-TEST(SessionEviction, TilesLeftBehindAreEvictedAndTheMapStillHoldsEveryPoint) {
-  const std::filesystem::path work = test::binary_dir() / fmt::format("session-eviction-{}", ::getpid());
-  std::filesystem::remove_all(work);
-  const SessionRun kept = map_session(work / "kept", 0);
-  const SessionRun evicting = map_session(work / "evicting", 3);
-
-  const nlohmann::json& map = evicting.summary["map"];
+// Every point of the session's map is in its exports, in its tiles/ (what a
+// download serves) and, per tile, in the newest update published live.
+void expect_every_point_everywhere(const SessionRun& run, const std::filesystem::path& config_file) {
+  const nlohmann::json& map = run.summary["map"];
   const std::size_t points = map["points"];
-  ASSERT_GT(points, 10'000U);
-  // The drive goes 6 m down the drift, turns and comes back: tiles are left and re-entered.
-  EXPECT_GT(map["evicted_tiles"].get<std::size_t>(), 3U) << map.dump();
-  EXPECT_GT(map["restored_tiles"].get<std::size_t>(), 0U) << map.dump();
   EXPECT_EQ(map["tile_file_errors"], 0);
   EXPECT_EQ(map["dropped_in_evicted"], 0);
-  EXPECT_EQ(kept.summary["map"]["evicted_tiles"], 0);
-  EXPECT_EQ(map["tiles"], kept.summary["map"]["tiles"]);  // re-entered tiles were continued, not duplicated
+  EXPECT_EQ(test::read_ply(run.folder / "map.ply").size(), points);
+  EXPECT_EQ(test::read_las_checked(run.folder / "map.las").size(), points);
 
-  // Exports: every point of the map.
-  const std::vector<test::XyzI> ply = test::read_ply(evicting.folder / "map.ply");
-  ASSERT_EQ(ply.size(), points);
-  EXPECT_EQ(test::read_las_checked(evicting.folder / "map.las").size(), points);
-  // Against the session that kept every tile in RAM: eviction costs only the
-  // voxels hit fewer than min_hits times before their tile left (lost
-  // candidates), and the 1 mm tile quantum (half of it per axis, plus float rounding).
-  const std::size_t lost = map["lost_candidates"];
-  const std::vector<test::XyzI> kept_ply = test::read_ply(kept.folder / "map.ply");
-  const std::size_t kept_missing = unmatched(kept_ply, ply, 0.0006);
-  const std::size_t new_points = unmatched(ply, kept_ply, 0.0006);
-  fmt::print("{} map points ({} with every tile in RAM); {} evictions, {} reloads, {} unconfirmed voxels lost; "
-             "{} points of the kept map missing, {} points not in it\n",
-             points, kept_ply.size(), map["evicted_tiles"].get<std::size_t>(),
-             map["restored_tiles"].get<std::size_t>(), lost, kept_missing, new_points);
-  EXPECT_LE(kept_missing, lost) << kept_missing << " points of the kept map are not in the evicting one";
-  EXPECT_LE(new_points, lost) << new_points << " points of the evicting map are not in the kept one";
-  EXPECT_LT(kept_missing, kept_ply.size() / 50);
-  EXPECT_LT(new_points, kept_ply.size() / 50);
-
-  // Downloads after the session serve tiles/*.adt: every tile, every point.
   TileStore stored({5.0, 0.001, 3});
-  config::Config config = config::load_config(work / "evicting" / "aditd.yaml");
-  Sessions reader(config, {});
-  ASSERT_EQ(reader.load_tiles(evicting.folder.filename().string(), stored), "");
+  Sessions reader(config::load_config(config_file), {});
+  ASSERT_EQ(reader.load_tiles(run.folder.filename().string(), stored), "");
   EXPECT_EQ(stored.total_points(), static_cast<std::int64_t>(points));
   EXPECT_EQ(stored.tiles().size(), map["tiles"].get<std::size_t>());
 
-  // Live publishing: each tile's newest update holds what its stored file
-  // holds (tiles whose voxels never reached min_hits are stored empty, never published).
+  // Tiles whose voxels never reached min_hits are stored empty and never published.
   std::size_t non_empty = 0;
   for (const auto& [id, tile] : stored.tiles()) {
     if (tile.n_points == 0) continue;
     ++non_empty;
-    const auto it = evicting.published.find(id);
-    ASSERT_NE(it, evicting.published.end()) << "tile " << id << " was never published";
+    const auto it = run.published.find(id);
+    ASSERT_NE(it, run.published.end()) << "tile " << id << " was never published";
     EXPECT_EQ(it->second, static_cast<std::size_t>(tile.n_points)) << "tile " << id;
   }
-  EXPECT_EQ(evicting.published.size(), non_empty);
-  std::filesystem::remove_all(work);
+  EXPECT_EQ(run.published.size(), non_empty);
+}
+
+struct Comparison {
+  std::size_t kept_missing = 0;  // points of the all-in-RAM map not in the other
+  std::size_t new_points = 0;    // points of the other map not in the all-in-RAM one
+};
+
+// Map points matched within the tile codec's quantum (1 mm: half of it per axis, plus float rounding).
+Comparison compare_maps(const SessionRun& kept, const SessionRun& other) {
+  const std::vector<test::XyzI> a = test::read_ply(kept.folder / "map.ply");
+  const std::vector<test::XyzI> b = test::read_ply(other.folder / "map.ply");
+  const Comparison c{unmatched(a, b, 0.0006), unmatched(b, a, 0.0006)};
+  const nlohmann::json& map = other.summary["map"];
+  fmt::print("{} map points ({} with every tile in RAM); {} evictions, {} reloads, {} compactions, {} unconfirmed "
+             "voxels lost; {} points of the all-in-RAM map missing, {} points not in it\n",
+             map["points"].get<std::size_t>(), a.size(), map["evicted_tiles"].get<std::size_t>(),
+             map["restored_tiles"].get<std::size_t>(), map["compacted_tiles"].get<std::size_t>(),
+             map["lost_candidates"].get<std::size_t>(), c.kept_missing, c.new_points);
+  return c;
+}
+
+class SessionEviction : public testing::Test {
+ protected:
+  void SetUp() override { std::filesystem::remove_all(work); }
+  void TearDown() override { std::filesystem::remove_all(work); }
+  const std::filesystem::path work = test::binary_dir() / fmt::format("session-eviction-{}", ::getpid());
+};
+
+TEST_F(SessionEviction, TilesLeftBehindAreEvictedAndReloadedAndTheMapStillHoldsEveryPoint) {
+  const SessionRun kept = map_session(work / "kept", 0, 0);
+  const SessionRun evicting = map_session(work / "evicting", 3, 0);
+  const nlohmann::json& map = evicting.summary["map"];
+  ASSERT_GT(map["points"].get<std::size_t>(), 10'000U);
+  // The drive goes 6 m down the drift, turns and comes back: tiles are left and re-entered.
+  EXPECT_GT(map["evicted_tiles"].get<std::size_t>(), 3U) << map.dump();
+  EXPECT_GT(map["restored_tiles"].get<std::size_t>(), 0U) << map.dump();
+  EXPECT_EQ(kept.summary["map"]["evicted_tiles"], 0);
+  EXPECT_EQ(map["tiles"], kept.summary["map"]["tiles"]);  // re-entered tiles were continued, not duplicated
+  expect_every_point_everywhere(evicting, work / "evicting" / "aditd.yaml");
+
+  // Against the session that kept every tile in RAM, eviction costs only the
+  // voxels hit fewer than min_hits times before their tile left (lost candidates).
+  const Comparison c = compare_maps(kept, evicting);
+  const std::size_t lost = map["lost_candidates"];
+  const std::size_t kept_points = kept.summary["map"]["points"];
+  EXPECT_LE(c.kept_missing, lost);
+  EXPECT_LE(c.new_points, lost);
+  EXPECT_LT(c.kept_missing, kept_points / 50);
+  EXPECT_LT(c.new_points, kept_points / 50);
+}
+
+TEST_F(SessionEviction, CrowdedTilesAreCompactedAndTheMapStillHoldsEveryPoint) {
+  const SessionRun kept = map_session(work / "kept", 0, 0);
+  // A tile is compacted each time it holds 3000 voxels in RAM: many times in 20 s.
+  const SessionRun compacting = map_session(work / "compacting", 3, 3000);
+  const nlohmann::json& map = compacting.summary["map"];
+  EXPECT_GT(map["compacted_tiles"].get<std::size_t>(), 5U) << map.dump();
+  EXPECT_EQ(kept.summary["map"]["compacted_tiles"], 0);
+  EXPECT_EQ(map["tiles"], kept.summary["map"]["tiles"]);
+  expect_every_point_everywhere(compacting, work / "compacting" / "aditd.yaml");
+  // Each compaction drops the tile's unconfirmed voxels: what differs is bounded by them.
+  const Comparison c = compare_maps(kept, compacting);
+  EXPECT_LE(c.kept_missing, map["lost_candidates"].get<std::size_t>());
+  EXPECT_LE(c.new_points, map["lost_candidates"].get<std::size_t>());
 }
 
 }  // namespace

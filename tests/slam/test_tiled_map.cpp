@@ -224,6 +224,20 @@ TEST(TiledVoxelMapEviction, ARestoredCopyWithTwoPointsInOneVoxelCountsBoth) {
   EXPECT_EQ(map.add(std::vector<Eigen::Vector3f>{{1.03F, 1.03F, 1.03F}}, {}, 2.0), 0U);
 }
 
+TEST(TileEviction, ATileHoldingMoreThanCompactVoxelsIsCrowded) {
+  TiledVoxelMap map({20.0F, 0.05F, 2});
+  map.add(block(1.0F), {}, 0.0);                                    // 400 voxels in tile (0, 0, 0), candidates only
+  map.add(std::vector<Eigen::Vector3f>{{21.0F, 1.0F, 1.0F}}, {}, 0.0);  // 1 in tile (1, 0, 0)
+  EXPECT_EQ(map.held_voxels({0, 0, 0}), 400U);
+  EXPECT_EQ(TileEviction({50.0F, 20, 399}).crowded_tiles(map), (std::vector<TileCoord>{{0, 0, 0}}));
+  EXPECT_TRUE(TileEviction({50.0F, 20, 400}).crowded_tiles(map).empty());
+  EXPECT_TRUE(TileEviction({50.0F, 20, 0}).crowded_tiles(map).empty());
+  // Compacted (evicted and restored at once), it holds nothing but the bits of its stored voxels.
+  std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+  map.restore({0, 0, 0}, stored);
+  EXPECT_EQ(map.held_voxels({0, 0, 0}), 0U);
+}
+
 TEST(TileEviction, DistanceToATileIsZeroInsideAndToTheNearestFaceOrCornerOutside) {
   EXPECT_FLOAT_EQ(distance_to_tile({0, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 0.0F);
   EXPECT_FLOAT_EQ(distance_to_tile({1, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 15.0F);
@@ -234,7 +248,7 @@ TEST(TileEviction, DistanceToATileIsZeroInsideAndToTheNearestFaceOrCornerOutside
 TEST(TileEviction, ATileIsColdOnlyAfterNConsecutiveKeyframesBeyondTheRadius) {
   TiledVoxelMap map({20.0F, 0.5F, 1});
   map.add(std::vector<Eigen::Vector3f>{{1.0F, 1.0F, 1.0F}, {101.0F, 1.0F, 1.0F}}, {}, 0.0);  // tiles (0,0,0), (5,0,0)
-  TileEviction eviction({30.0F, 3});
+  TileEviction eviction({30.0F, 3, 0});
   const Eigen::Vector3f far_from_origin(90.0F, 1.0F, 1.0F);  // 70 m from tile 0, inside tile 4's neighbourhood
   EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
   EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
@@ -246,7 +260,7 @@ TEST(TileEviction, ATileIsColdOnlyAfterNConsecutiveKeyframesBeyondTheRadius) {
   map.evict({0, 0, 0});
   EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());  // evicted tiles are not offered again
 
-  TileEviction never({30.0F, 0});
+  TileEviction never({30.0F, 0, 0});
   for (int i = 0; i < 5; ++i) EXPECT_TRUE(never.cold_tiles(map, {1000.0F, 0.0F, 0.0F}).empty());
 }
 

@@ -88,6 +88,7 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.resident_tiles = s.resident_tiles.load();
   f.evicted_tiles = s.evicted_tiles.load();
   f.restored_tiles = s.restored_tiles.load();
+  f.compacted_tiles = s.compacted_tiles.load();
   f.lost_candidates = s.lost_candidates.load();
   f.tile_file_errors = s.tile_file_errors.load();
   f.keyframes = s.keyframes.load();
@@ -135,7 +136,8 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
   if (f.mapping)
     j["map"] = {{"points", f.map_points},           {"tiles", f.map_tiles},
                 {"resident_tiles", f.resident_tiles}, {"evicted_tiles", f.evicted_tiles},
-                {"restored_tiles", f.restored_tiles}, {"lost_candidates", f.lost_candidates},
+                {"restored_tiles", f.restored_tiles}, {"compacted_tiles", f.compacted_tiles},
+                {"lost_candidates", f.lost_candidates},
                 {"tile_file_errors", f.tile_file_errors}, {"resident_mb", f.map_mb},
                 {"keyframes", f.keyframes},           {"keyframe_mb", f.keyframe_mb}};
   return j;
@@ -157,9 +159,10 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
                         g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb);
   if (f.mapping)
     text += fmt::format(
-        "\nmap: {} points in {} tiles, {} resident ({:.1f} MB); {} evictions, {} reloads, {} unconfirmed voxels "
-        "lost, {} tile file errors; {} keyframes ({:.1f} MB)",
-        f.map_points, f.map_tiles, f.resident_tiles, f.map_mb, f.evicted_tiles, f.restored_tiles, f.lost_candidates,
+        "\nmap: {} points in {} tiles, {} resident ({:.1f} MB); {} evictions, {} reloads, {} compactions, {} "
+        "unconfirmed voxels lost, {} tile file errors; {} keyframes ({:.1f} MB)",
+        f.map_points, f.map_tiles, f.resident_tiles, f.map_mb, f.evicted_tiles, f.restored_tiles, f.compacted_tiles,
+        f.lost_candidates,
         f.tile_file_errors, f.keyframes, f.keyframe_mb);
   return text + "\n";
 }

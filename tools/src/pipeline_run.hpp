@@ -64,6 +64,7 @@ struct PipelineFigures {
   std::uint64_t resident_tiles = 0;
   std::uint64_t evicted_tiles = 0;
   std::uint64_t restored_tiles = 0;
+  std::uint64_t compacted_tiles = 0;
   std::uint64_t lost_candidates = 0;
   std::uint64_t tile_file_errors = 0;
   std::uint64_t keyframes = 0;

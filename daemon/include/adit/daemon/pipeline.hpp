@@ -79,6 +79,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> resident_tiles{0};
   std::atomic<std::uint64_t> evicted_tiles{0};        // evictions (a tile evicted twice counts twice)
   std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
+  std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
   std::atomic<std::uint64_t> lost_candidates{0};      // voxels hit < min_hits times in evicted tiles
   std::atomic<std::uint64_t> tile_file_errors{0};     // a tile that could not be written (kept) or read (skipped)
   std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back

@@ -131,6 +131,9 @@ struct MapSection {
   // tiles/ folder and leave RAM; 0 keyframes = keep every tile in RAM.
   double evict_margin_m = 10.0;
   int evict_after_keyframes = 20;
+  // A tile holding more voxels than this in RAM (the sensor stays near it or
+  // keeps coming back) is written out and keeps one bit per voxel; 0 = never.
+  int compact_tile_voxels = 100'000;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.

@@ -82,6 +82,8 @@ class TiledVoxelMap {
   std::vector<TileCoord> evicted_coords() const;       // evicted tiles, in coordinate order
   std::size_t evicted_points(const TileCoord& coord) const;  // points an evicted tile held (0 if not evicted)
   bool is_evicted(const TileCoord& coord) const { return evicted_.contains(coord); }
+  // Voxels a resident tile holds as candidates (confirmed or not), 0 if none.
+  std::size_t held_voxels(const TileCoord& coord) const;
   std::size_t size() const { return size_; }               // map points (confirmed voxels), evicted tiles included
   std::size_t candidates() const { return candidates_; }   // voxels hit at least once, in resident tiles
   std::size_t tile_count() const { return tiles_.size() + evicted_.size(); }
@@ -182,9 +184,15 @@ class TiledVoxelMap {
 // deskewed point can move, a few cm) no point of a scan taken there can fall
 // into the tile; the keyframe count adds hysteresis, so a path along a tile
 // boundary does not evict and reload the same tile over and over.
+//
+// A tile the sensor never leaves (it works around it for an hour) or keeps
+// coming back to would still grow in RAM: a tile holding more than
+// `compact_voxels` voxels is crowded, and the caller evicts and restores it at
+// once, so its points go to the store and only a bit per voxel stays.
 struct TileEvictionConfig {
   float radius_m = 50.0F;
-  int after_keyframes = 20;  // ≤ 0: never evict
+  int after_keyframes = 20;        // ≤ 0: never evict
+  std::size_t compact_voxels = 0;  // 0: never compact
 };
 
 class TileEviction {
@@ -192,6 +200,8 @@ class TileEviction {
   explicit TileEviction(const TileEvictionConfig& config) : config_(config) {}
   // Once per keyframe: the resident tiles that are cold now, in coordinate order.
   std::vector<TileCoord> cold_tiles(const TiledVoxelMap& map, const Eigen::Vector3f& sensor);
+  // The resident tiles holding more than compact_voxels voxels, in coordinate order.
+  std::vector<TileCoord> crowded_tiles(const TiledVoxelMap& map) const;
 
  private:
   TileEvictionConfig config_;
