@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 
+#include <malloc.h>
 #include <pthread.h>
 #include <time.h>
 
@@ -24,6 +25,7 @@
 #include "adit/drivers/pcap_replay.hpp"
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/drivers/udp.hpp"
+#include "adit/protocol/map_export.hpp"
 #include "adit/slam/lie.hpp"
 
 namespace adit::daemon {
@@ -34,6 +36,7 @@ constexpr std::size_t kPacketSlots = 512;   // ~0.4 s of the busiest sensor (Ous
 constexpr std::size_t kScanSlots = 4;
 constexpr std::size_t kPoseSlots = 8;
 constexpr std::size_t kMapSlots = 4;
+constexpr std::size_t kKeyframeScansInRam = 100;  // the newest keyframes keep their scans in RAM (~5 MB)
 constexpr std::size_t kTimingCapacity = 1 << 20;  // scans kept for statistics (29 h at 10 Hz)
 
 struct Packet {
@@ -462,15 +465,48 @@ struct Pipeline::Impl {
     if (spill) restore_tiles(map.evicted_hit_by(map_deskewed));
     map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
     if (spill && keyframe) {
-      evict_tiles(eviction.cold_tiles(map, slot.pose.translation().cast<float>()));
-      compact_tiles(eviction.crowded_tiles(map));
+      const std::vector<slam::TileCoord> cold = eviction.cold_tiles(map, slot.pose.translation().cast<float>());
+      const std::vector<slam::TileCoord> crowded = eviction.crowded_tiles(map);
+      evict_tiles(cold);
+      compact_tiles(crowded);
+#ifdef __GLIBC__
+      // The freed tiles lie amid the mapping thread's arena, which glibc gives
+      // back to the kernel only from its top: return the free pages now.
+      if (!cold.empty() || !crowded.empty()) malloc_trim(0);
+#endif
     }
+    if (!keyframes_dir.empty() && keyframe) spill_keyframes();
     stats.mapped_scans.fetch_add(1, std::memory_order_relaxed);
     stats.map_points.store(map.size(), std::memory_order_relaxed);
     stats.map_tiles.store(map.tile_count(), std::memory_order_relaxed);
     stats.resident_tiles.store(map.resident_tile_count(), std::memory_order_relaxed);
     stats.dropped_in_evicted.store(map.dropped_in_evicted(), std::memory_order_relaxed);
     if (keyframe) stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+  }
+
+  // Mapping thread: the scans of all but the newest kKeyframeScansInRam
+  // keyframes go to the session folder; their poses stay. Loop closure looks
+  // for old keyframes, and reads their scans back then. A 30-minute drive
+  // keeps ~1800 keyframes of ~50 kB each; a radius rule would not bound them
+  // on a route that keeps coming back to the same drifts.
+  void spill_keyframes() {
+    for (; keyframes_in_ram_from + kKeyframeScansInRam < keyframe_list.size(); ++keyframes_in_ram_from) {
+      slam::Keyframe& k = keyframe_list[keyframes_in_ram_from];
+      std::vector<protocol::MapPoint> points;
+      points.reserve(k.points.size());
+      for (const Eigen::Vector3f& p : k.points) points.push_back({p.x(), p.y(), p.z(), 0.0F, 0.0});
+      try {
+        std::filesystem::create_directories(keyframes_dir);
+        protocol::write_map(keyframes_dir / fmt::format("{}.ply", k.stamp_ns), protocol::MapFormat::ply, points);
+      } catch (const std::exception& e) {  // kept in RAM then
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", e.what());
+        continue;
+      }
+      keyframe_bytes -= k.points.capacity() * sizeof(Eigen::Vector3f);
+      std::vector<Eigen::Vector3f>().swap(k.points);
+      stats.spilled_keyframes.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
   }
 
   // Mapping thread: a tile holding too many voxels in RAM is written out,
@@ -606,6 +642,8 @@ struct Pipeline::Impl {
   std::optional<TileSpill> spill;          // set by start() when the session has a tiles folder
   std::vector<slam::MapSample> tile_buffer;  // a tile read back
   std::uint64_t keyframe_bytes = 0;
+  std::filesystem::path keyframes_dir;  // set by start(); empty = keyframe scans stay in RAM
+  std::size_t keyframes_in_ram_from = 0;  // keyframes before this one had their scans written out
   slam::KeyframeSelector keyframe_selector;
   std::vector<slam::Keyframe> keyframe_list;
   std::optional<slam::VoxelDownsampler> keyframe_downsampler;
@@ -663,6 +701,7 @@ void Pipeline::start(const SessionFiles& files) {
     params.tile_size_m = i.config.map.tile_size_m;
     i.spill.emplace(files.tiles_dir, params);
   }
+  if (i.config.map.evict_after_keyframes > 0) i.keyframes_dir = files.keyframes_dir;
   if (i.wheels) i.wheels->start(files.can_record_file);
   if (i.config.threads.lock_memory) {
     auto w = lock_memory();

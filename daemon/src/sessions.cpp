@@ -116,7 +116,8 @@ std::string Sessions::start_locked() {
   std::unique_ptr<Pipeline> pipeline = std::move(standby_);
   SessionFiles files;
   files.trajectory_file = dir / "trajectory.tum";
-  files.tiles_dir = dir / "tiles";  // tiles the sensor has left go there during the session
+  files.tiles_dir = dir / "tiles";          // tiles the sensor has left go there during the session
+  files.keyframes_dir = dir / "keyframes";  // and the scans of keyframes it has left
   if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
   try {
@@ -239,6 +240,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     }
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
+    if (s.spilled_keyframes.load() > 0) files.push_back("keyframes/");
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
     if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {
@@ -256,6 +258,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
                  {"evicted_tiles", s.evicted_tiles.load()}, {"restored_tiles", s.restored_tiles.load()},
                  {"compacted_tiles", s.compacted_tiles.load()},
+                 {"spilled_keyframes", s.spilled_keyframes.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
         {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},

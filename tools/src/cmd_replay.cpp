@@ -24,7 +24,7 @@ struct ReplayOptions {
   double speed = 0.0;  // × real time; 0 = as fast as possible
   bool json = false;
   double memory_from = 0.1;
-  std::string tiles_dir;  // empty: a temporary folder, removed at the end
+  std::string session_dir;  // empty: a temporary folder, removed at the end
 };
 
 // A fresh folder under the system's temporary directory, removed when done.
@@ -32,7 +32,7 @@ class TemporaryFolder {
  public:
   TemporaryFolder() {
     std::string name = (std::filesystem::temp_directory_path() / "adit-replay-tiles-XXXXXX").string();
-    if (::mkdtemp(name.data()) == nullptr) throw InputError(name, "--tiles-dir", "cannot create a temporary folder");
+    if (::mkdtemp(name.data()) == nullptr) throw InputError(name, "--session-dir", "cannot create a temporary folder");
     path_ = name;
   }
   ~TemporaryFolder() {
@@ -62,13 +62,11 @@ int replay(const ReplayOptions& o) {
   options.replay_speed = o.realtime ? 1.0 : o.speed;
   daemon::Pipeline pipeline(config, options);
   std::optional<TemporaryFolder> temporary;
+  if (o.session_dir.empty()) temporary.emplace();
+  const std::filesystem::path dir = temporary ? temporary->path() : std::filesystem::absolute(o.session_dir);
   daemon::SessionFiles files;
-  if (o.tiles_dir.empty()) {
-    temporary.emplace();
-    files.tiles_dir = temporary->path();
-  } else {
-    files.tiles_dir = std::filesystem::absolute(o.tiles_dir);
-  }
+  files.tiles_dir = dir / "tiles";
+  files.keyframes_dir = dir / "keyframes";
   const PipelineFigures figures = run_pipeline(pipeline, {}, files);
   for (const std::string& warning : pipeline.warnings()) fmt::print(stderr, "adit replay: {}\n", warning);
   if (o.json) {
@@ -105,9 +103,10 @@ void register_replay_commands(CLI::App& app, int& status) {
                     ->check(CLI::Range(0.0, 1e6));
   realtime->excludes(speed);
   cmd->add_flag("--json", o->json, "Print the figures as JSON (for scripts)");
-  cmd->add_option("--tiles-dir", o->tiles_dir,
-                  "Where the mapping thread writes the tiles the sensor has left (tiles/<id>.adt, as a session; "
-                  "map.evict_after_keyframes: 0 keeps all in RAM). Default: a temporary folder removed at the end");
+  cmd->add_option("--session-dir", o->session_dir,
+                  "Where the mapping thread writes what the sensor has left, as a session does: tiles/<id>.adt and "
+                  "keyframes/<stamp>.ply (map.evict_after_keyframes: 0 keeps all in RAM). Default: a temporary "
+                  "folder removed at the end");
   cmd->add_option("--memory-from", o->memory_from,
                   "Resident growth is measured from this fraction of the poses (local map full) to the end")
       ->check(CLI::Range(0.0, 1.0))

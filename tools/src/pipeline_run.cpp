@@ -92,6 +92,7 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.lost_candidates = s.lost_candidates.load();
   f.tile_file_errors = s.tile_file_errors.load();
   f.keyframes = s.keyframes.load();
+  f.spilled_keyframes = s.spilled_keyframes.load();
   f.map_mb = 1e-6 * static_cast<double>(s.map_bytes.load());
   f.keyframe_mb = 1e-6 * static_cast<double>(s.keyframe_bytes.load());
   return f;
@@ -139,7 +140,8 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
                 {"restored_tiles", f.restored_tiles}, {"compacted_tiles", f.compacted_tiles},
                 {"lost_candidates", f.lost_candidates},
                 {"tile_file_errors", f.tile_file_errors}, {"resident_mb", f.map_mb},
-                {"keyframes", f.keyframes},           {"keyframe_mb", f.keyframe_mb}};
+                {"keyframes", f.keyframes},           {"spilled_keyframes", f.spilled_keyframes},
+                {"keyframe_mb", f.keyframe_mb}};
   return j;
 }
 
@@ -160,10 +162,10 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
   if (f.mapping)
     text += fmt::format(
         "\nmap: {} points in {} tiles, {} resident ({:.1f} MB); {} evictions, {} reloads, {} compactions, {} "
-        "unconfirmed voxels lost, {} tile file errors; {} keyframes ({:.1f} MB)",
+        "unconfirmed voxels lost, {} file errors; {} keyframes, {} scans in RAM ({:.1f} MB)",
         f.map_points, f.map_tiles, f.resident_tiles, f.map_mb, f.evicted_tiles, f.restored_tiles, f.compacted_tiles,
         f.lost_candidates,
-        f.tile_file_errors, f.keyframes, f.keyframe_mb);
+        f.tile_file_errors, f.keyframes, f.keyframes - f.spilled_keyframes, f.keyframe_mb);
   return text + "\n";
 }
 

@@ -68,6 +68,7 @@ struct PipelineFigures {
   std::uint64_t lost_candidates = 0;
   std::uint64_t tile_file_errors = 0;
   std::uint64_t keyframes = 0;
+  std::uint64_t spilled_keyframes = 0;
   double map_mb = 0.0;       // resident tiles' structures
   double keyframe_mb = 0.0;  // keyframes' downsampled scans
   double speed() const { return duration_s > 0.0 ? sensor_span_s / duration_s : 0.0; }  // × real time

@@ -81,7 +81,8 @@ struct PipelineStats {
   std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
   std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
   std::atomic<std::uint64_t> lost_candidates{0};      // voxels hit < min_hits times in evicted tiles
-  std::atomic<std::uint64_t> tile_file_errors{0};     // a tile that could not be written (kept) or read (skipped)
+  std::atomic<std::uint64_t> spilled_keyframes{0};    // keyframes whose scan went to keyframes_dir
+  std::atomic<std::uint64_t> tile_file_errors{0};     // a tile or keyframe that could not be written (kept) or read (skipped)
   std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
@@ -115,6 +116,9 @@ struct SessionFiles {
   // Where tiles the sensor has left are written (tiles/<id>.adt) so they can
   // leave RAM (map.evict_after_keyframes); empty = every tile stays in RAM.
   std::filesystem::path tiles_dir;
+  // Where the scans of keyframes the sensor has left are written
+  // (<stamp_ns>.ply, body frame) so that only their poses stay in RAM; empty = all stay.
+  std::filesystem::path keyframes_dir;
 };
 
 class Pipeline {
@@ -147,7 +151,8 @@ class Pipeline {
   std::vector<StageLoad> loads() const;         // while running
 
   // The session's map and keyframes: complete after join(), not to be read before.
-  // Evicted tiles are not in map() (see map().evicted_coords()) but in tile_spill().
+  // Evicted tiles are not in map() (see map().evicted_coords()) but in tile_spill();
+  // a keyframe whose points are empty had them written to SessionFiles::keyframes_dir.
   const slam::TiledVoxelMap& map() const;
   const TileSpill* tile_spill() const;  // null without SessionFiles::tiles_dir
   const std::vector<slam::Keyframe>& keyframes() const;
