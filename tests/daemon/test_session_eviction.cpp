@@ -54,7 +54,8 @@ struct SessionRun {
 // Small tiles (5 m) and a short mapping range (5 m, margin 1 m) so that the
 // drive leaves tiles behind (evict_after_keyframes 0: every tile stays in RAM);
 // compact_tile_voxels 0: never compacted.
-SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels) {
+SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels,
+                       double keyframe_distance_m = 1.0, double keyframe_angle_deg = 10.0) {
   const std::filesystem::path session = driving_session();
   std::ifstream sim_config(session / "session.yaml");
   std::string yaml((std::istreambuf_iterator<char>(sim_config)), std::istreambuf_iterator<char>());
@@ -70,8 +71,9 @@ SessionRun map_session(const std::filesystem::path& work, int evict_after_keyfra
   replace("  replay_speed: 1.0", "  replay_speed: 0");  // as fast as possible: a replay waits, nothing is dropped
   yaml += fmt::format(
       "map:\n  tile_size_m: 5\n  max_range_m: 5\n  evict_margin_m: 1\n  evict_after_keyframes: {}\n"
-      "  compact_tile_voxels: {}\nsession:\n  exports: [ply, las]\nthreads:\n  lock_memory: false\n",
-      evict_after_keyframes, compact_tile_voxels);
+      "  compact_tile_voxels: {}\n  keyframe_distance_m: {}\n  keyframe_angle_deg: {}\n"
+      "session:\n  exports: [ply, las]\nthreads:\n  lock_memory: false\n",
+      evict_after_keyframes, compact_tile_voxels, keyframe_distance_m, keyframe_angle_deg);
   std::filesystem::create_directories(work);
   const std::filesystem::path config_file = work / "aditd.yaml";
   std::ofstream(config_file) << yaml;
@@ -212,6 +214,28 @@ TEST_F(SessionEviction, CrowdedTilesAreCompactedAndTheMapStillHoldsEveryPoint) {
   const Comparison c = compare_maps(kept, compacting);
   EXPECT_LE(c.kept_missing, map["lost_candidates"].get<std::size_t>());
   EXPECT_LE(c.new_points, map["lost_candidates"].get<std::size_t>());
+}
+
+TEST_F(SessionEviction, TheScansOfAllButTheNewest100KeyframesGoToTheSessionFolder) {
+  // A keyframe every 10 cm or 1°: over 100 in the drive and its turn.
+  const SessionRun run = map_session(work / "keyframes", 3, 0, 0.1, 1.0);
+  const nlohmann::json& map = run.summary["map"];
+  const std::size_t keyframes = map["keyframes"];
+  ASSERT_GT(keyframes, 110U);  // at most one per scan: 200
+  EXPECT_EQ(map["spilled_keyframes"].get<std::size_t>(), keyframes - 100);
+  std::size_t files = 0;
+  std::size_t points = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(run.folder / "keyframes")) {
+    ++files;
+    points += test::read_ply(entry.path()).size();
+  }
+  EXPECT_EQ(files, keyframes - 100);
+  EXPECT_GT(points, 100 * files);  // downsampled scans, not empty files
+  // Every keyframe's pose is still written.
+  std::ifstream tum(run.folder / "keyframes.tum");
+  std::size_t lines = 0;
+  for (std::string line; std::getline(tum, line);) lines += (!line.empty() && line[0] != '#') ? 1 : 0;
+  EXPECT_EQ(lines, keyframes);
 }
 
 }  // namespace
