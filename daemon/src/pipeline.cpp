@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 
+#include <malloc.h>
 #include <pthread.h>
 #include <time.h>
 
@@ -24,6 +25,7 @@
 #include "adit/drivers/pcap_replay.hpp"
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/drivers/udp.hpp"
+#include "adit/protocol/map_export.hpp"
 #include "adit/slam/lie.hpp"
 
 namespace adit::daemon {
@@ -34,6 +36,7 @@ constexpr std::size_t kPacketSlots = 512;   // ~0.4 s of the busiest sensor (Ous
 constexpr std::size_t kScanSlots = 4;
 constexpr std::size_t kPoseSlots = 8;
 constexpr std::size_t kMapSlots = 4;
+constexpr std::size_t kKeyframeScansInRam = 100;  // the newest keyframes keep their scans in RAM (~5 MB)
 constexpr std::size_t kTimingCapacity = 1 << 20;  // scans kept for statistics (29 h at 10 Hz)
 
 struct Packet {
@@ -89,6 +92,14 @@ slam::TiledMapConfig map_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m), static_cast<std::uint8_t>(m.min_hits)};
 }
 
+// No point of a scan lies farther than max_range_m from the body (map_scan
+// filters them), deskewing moves points by at most a sweep's motion, and the
+// sensor's offset from the body is small: the margin covers both.
+slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
+  return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
+          static_cast<std::size_t>(m.compact_tile_voxels)};
+}
+
 }  // namespace
 
 struct Pipeline::Impl {
@@ -99,6 +110,7 @@ struct Pipeline::Impl {
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
         extrinsic(isometry_of(c.lidar.extrinsics).cast<float>()),
         map(map_config_of(c.map)),
+        eviction(eviction_config_of(c.map)),
         keyframe_selector({c.map.keyframe_distance_m, c.map.keyframe_angle_deg}) {
     options.odometry.min_range_m = static_cast<float>(c.lidar.min_range_m);
     options.odometry.max_range_m = static_cast<float>(c.lidar.max_range_m);
@@ -418,6 +430,7 @@ struct Pipeline::Impl {
     if (have_pending && !stop.load()) map_scan(pending, map_velocity);  // the last sweep: the last motion known
     have_pending = false;
     flush_tiles();
+    stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);
     stats.dropped_map_scans.store(map_slots->dropped());
     mapping_beat.finished.store(true);
   }
@@ -439,23 +452,133 @@ struct Pipeline::Impl {
     }
     map_deskewed.resize(map_points.size());
     map_deskewer.deskew(map_points, map_times, velocity, map_deskewed);
-    if (keyframe_selector.take(slot.pose)) {
+    const bool keyframe = keyframe_selector.take(slot.pose);
+    if (keyframe) {
       keyframe_downsampler->downsample(map_deskewed, static_cast<float>(config.map.keyframe_voxel_m), keyframe_points);
       keyframe_list.push_back({slot.stamp_ns, slot.pose, keyframe_points});
+      keyframe_bytes += sizeof(slam::Keyframe) + keyframe_list.back().points.capacity() * sizeof(Eigen::Vector3f);
       stats.keyframes.store(keyframe_list.size(), std::memory_order_relaxed);
+      stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
     }
     const Eigen::Isometry3f pose = slot.pose.cast<float>();
     for (Eigen::Vector3f& p : map_deskewed) p = pose * p;
+    if (spill) restore_tiles(map.evicted_hit_by(map_deskewed));
     map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
+    if (spill && keyframe) {
+      const std::vector<slam::TileCoord> cold = eviction.cold_tiles(map, slot.pose.translation().cast<float>());
+      const std::vector<slam::TileCoord> crowded = eviction.crowded_tiles(map);
+      evict_tiles(cold);
+      compact_tiles(crowded);
+#ifdef __GLIBC__
+      // The freed tiles lie amid the mapping thread's arena, which glibc gives
+      // back to the kernel only from its top: return the free pages now.
+      if (!cold.empty() || !crowded.empty()) malloc_trim(0);
+#endif
+    }
+    if (!keyframes_dir.empty() && keyframe) spill_keyframes();
     stats.mapped_scans.fetch_add(1, std::memory_order_relaxed);
     stats.map_points.store(map.size(), std::memory_order_relaxed);
     stats.map_tiles.store(map.tile_count(), std::memory_order_relaxed);
+    stats.resident_tiles.store(map.resident_tile_count(), std::memory_order_relaxed);
+    stats.dropped_in_evicted.store(map.dropped_in_evicted(), std::memory_order_relaxed);
+    if (keyframe) stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
   }
 
+  // Mapping thread: the scans of all but the newest kKeyframeScansInRam
+  // keyframes go to the session folder; their poses stay. Loop closure looks
+  // for old keyframes, and reads their scans back then. A 30-minute drive
+  // keeps ~1800 keyframes of ~50 kB each; a radius rule would not bound them
+  // on a route that keeps coming back to the same drifts.
+  void spill_keyframes() {
+    for (; keyframes_in_ram_from + kKeyframeScansInRam < keyframe_list.size(); ++keyframes_in_ram_from) {
+      slam::Keyframe& k = keyframe_list[keyframes_in_ram_from];
+      std::vector<protocol::MapPoint> points;
+      points.reserve(k.points.size());
+      for (const Eigen::Vector3f& p : k.points) points.push_back({p.x(), p.y(), p.z(), 0.0F, 0.0});
+      try {
+        std::filesystem::create_directories(keyframes_dir);
+        protocol::write_map(keyframes_dir / fmt::format("{}.ply", k.stamp_ns), protocol::MapFormat::ply, points);
+      } catch (const std::exception& e) {  // kept in RAM then
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", e.what());
+        continue;
+      }
+      keyframe_bytes -= k.points.capacity() * sizeof(Eigen::Vector3f);
+      std::vector<Eigen::Vector3f>().swap(k.points);
+      stats.spilled_keyframes.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
+  }
+
+  // Mapping thread: a tile holding too many voxels in RAM is written out,
+  // evicted and restored at once: its points go to its file and only a bit
+  // per voxel stays (unconfirmed voxels are lost, as on eviction).
+  void compact_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      std::string problem = spill->whole_tile(map, coord, tile_buffer);
+      if (problem.empty()) problem = spill->write(coord, tile_buffer);
+      if (!problem.empty()) {
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+        continue;
+      }
+      if (map.evict(coord).changed && options.sinks.tile) options.sinks.tile(coord, tile_buffer);
+      map.restore(coord, tile_buffer);
+      stats.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.lost_candidates.store(map.lost_candidates(), std::memory_order_relaxed);
+  }
+
+  // Mapping thread: the sensor has come back to tiles it had left; they are
+  // read back, so the scan continues them instead of starting copies. A tile
+  // that cannot be read stays evicted (its file intact) and add() skips the
+  // points that fall into it (counted).
+  void restore_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      if (const std::string problem = spill->read(coord, tile_buffer); !problem.empty()) {
+        if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+        continue;
+      }
+      map.restore(coord, tile_buffer);
+      stats.restored_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+
+  // Mapping thread: tiles the sensor has left are written to the session's
+  // tiles/ folder and leave RAM. A tile whose last change was not published
+  // yet goes to the sink first. A tile that cannot be written stays in RAM.
+  // A restored tile's file holds its stored part: it is rewritten with the new
+  // points appended, or left as it is when nothing is new.
+  void evict_tiles(const std::vector<slam::TileCoord>& coords) {
+    for (const slam::TileCoord& coord : coords) {
+      const bool restored = map.stored_points(coord) > 0;
+      if (!restored || !map.tile(coord).empty()) {
+        std::string problem = spill->whole_tile(map, coord, tile_buffer);
+        if (problem.empty()) problem = spill->write(coord, tile_buffer);
+        if (!problem.empty()) {
+          if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+          continue;
+        }
+      }
+      if (map.evict(coord).changed && options.sinks.tile && spill->whole_tile(map, coord, tile_buffer).empty())
+        options.sinks.tile(coord, tile_buffer);
+      stats.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
+    }
+    stats.lost_candidates.store(map.lost_candidates(), std::memory_order_relaxed);
+  }
+
+  // A restored tile's whole content is its stored part (read back) and what
+  // is new: decoding it costs a few ms per changed tile and period.
   void flush_tiles() {
     const std::vector<slam::TileCoord> changed = map.take_changed();
     if (!options.sinks.tile) return;
-    for (const slam::TileCoord& coord : changed) options.sinks.tile(coord, map.tile(coord));
+    for (const slam::TileCoord& coord : changed) {
+      if (!spill || map.stored_points(coord) == 0) {
+        options.sinks.tile(coord, map.tile(coord));
+      } else if (const std::string problem = spill->whole_tile(map, coord, tile_buffer); problem.empty()) {
+        options.sinks.tile(coord, tile_buffer);
+      } else if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) {
+        log::error("mapping: {}", problem);
+      }
+    }
   }
 
   void output_loop() {
@@ -515,6 +638,12 @@ struct Pipeline::Impl {
   std::optional<Handoff<MapSlot>> map_slots;
   // Mapping thread only:
   slam::TiledVoxelMap map;
+  slam::TileEviction eviction;
+  std::optional<TileSpill> spill;          // set by start() when the session has a tiles folder
+  std::vector<slam::MapSample> tile_buffer;  // a tile read back
+  std::uint64_t keyframe_bytes = 0;
+  std::filesystem::path keyframes_dir;  // set by start(); empty = keyframe scans stay in RAM
+  std::size_t keyframes_in_ram_from = 0;  // keyframes before this one had their scans written out
   slam::KeyframeSelector keyframe_selector;
   std::vector<slam::Keyframe> keyframe_list;
   std::optional<slam::VoxelDownsampler> keyframe_downsampler;
@@ -567,6 +696,10 @@ void Pipeline::start(const SessionFiles& files) {
   Impl& i = *impl_;
   if (!i.threads.empty()) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.record_file);
+  if (!files.tiles_dir.empty() && i.config.map.evict_after_keyframes > 0) {
+    i.spill.emplace(files.tiles_dir, stored_tile_params(i.config.map.tile_size_m));
+  }
+  if (i.config.map.evict_after_keyframes > 0) i.keyframes_dir = files.keyframes_dir;
   if (i.wheels) i.wheels->start(files.can_record_file);
   if (i.config.threads.lock_memory) {
     auto w = lock_memory();
@@ -633,6 +766,7 @@ std::vector<StageLoad> Pipeline::loads() const {
 }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->map; }
+const TileSpill* Pipeline::tile_spill() const { return impl_->spill ? &*impl_->spill : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const { return impl_->keyframe_list; }
 std::vector<std::string> Pipeline::warnings() const {
   const std::lock_guard lock(impl_->warnings_mutex);

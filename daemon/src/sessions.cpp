@@ -3,6 +3,8 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cctype>
 #include <charconv>
 #include <iterator>
@@ -18,6 +20,7 @@
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/protocol/utime.hpp"
+#include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/trajectory_io.hpp"
 
 namespace adit::daemon {
@@ -35,25 +38,6 @@ std::string utc_id() {
   return fmt::format("{:04}{:02}{:02}T{:02}{:02}{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour,
                      utc.tm_min, utc.tm_sec);
 }
-
-// For the stored tiles/<id>.adt: they never change again, so they take the
-// largest segments, which compress best (a 112 000-point tunnel tile: 176 kB
-// against 229 kB in the stream's 1024-point segments; bench_tile_stream).
-protocol::TileParams stored_tile_params(const config::MapSection& m) {
-  protocol::TileParams p;
-  p.tile_size_m = m.tile_size_m;
-  p.segment_points = protocol::kMaxSegmentPoints;
-  return p;
-}
-
-std::vector<protocol::MapPoint> map_points_of(std::span<const slam::MapSample> samples) {
-  std::vector<protocol::MapPoint> out;
-  out.reserve(samples.size());
-  for (const slam::MapSample& s : samples)
-    out.push_back({s.position.x(), s.position.y(), s.position.z(), s.intensity, s.time_s});
-  return out;
-}
-
 
 std::int64_t disk_free_bytes(const std::filesystem::path& dir) {
   struct statvfs s {};
@@ -126,6 +110,8 @@ std::string Sessions::start_locked() {
   std::unique_ptr<Pipeline> pipeline = std::move(standby_);
   SessionFiles files;
   files.trajectory_file = dir / "trajectory.tum";
+  files.tiles_dir = dir / "tiles";          // tiles the sensor has left go there during the session
+  files.keyframes_dir = dir / "keyframes";  // and the scans of keyframes it has left
   if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
   try {
@@ -190,25 +176,57 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
   const slam::TiledVoxelMap& map = pipeline->map();
   nlohmann::json files = nlohmann::json::array({"trajectory.tum", "config.yaml"});
   try {
-    // The map files, from the tiles.
-    std::vector<protocol::MapPoint> all;
-    all.reserve(map.size());
-    const protocol::TileParams params = stored_tile_params(config_.map);
-    std::filesystem::create_directories(dir / "tiles");
+    // The tiles still in RAM join those the mapping thread evicted to tiles/
+    // during the session; then the map files, streamed tile by tile (a long
+    // session's map does not fit in RAM whole).
+    const protocol::TileParams params = stored_tile_params(config_.map.tile_size_m);
+    TileSpill resident_tiles(dir / "tiles", params);
+    const TileSpill* spill = pipeline->tile_spill();  // what the mapping thread evicted (and restored)
+    std::vector<slam::MapSample> whole;
     for (const slam::TileCoord& c : map.tile_coords()) {
-      const std::vector<protocol::MapPoint> points = map_points_of(map.tile(c));
-      const protocol::TileKey key{c.x, c.y, c.z};
-      const std::vector<std::uint8_t> blob = protocol::encode_tile(key, points, params);
-      std::ofstream(dir / "tiles" / fmt::format("{}.adt", protocol::tile_id(key)), std::ios::binary)
-          .write(reinterpret_cast<const char*>(blob.data()), static_cast<std::streamsize>(blob.size()));
-      all.insert(all.end(), points.begin(), points.end());
+      std::string problem;
+      if (map.stored_points(c) == 0) {
+        problem = resident_tiles.write(c, map.tile(c));
+      } else if (!map.tile(c).empty()) {  // a restored tile with new points: its file gets them
+        problem = spill == nullptr ? "restored tile without a tile folder" : spill->whole_tile(map, c, whole);
+        if (problem.empty()) problem = resident_tiles.write(c, whole);
+      }
+      if (!problem.empty()) throw std::runtime_error(problem);
     }
     files.push_back("tiles/");
+    std::vector<slam::TileCoord> coords = map.tile_coords();
+    const std::vector<slam::TileCoord> evicted = map.evicted_coords();
+    coords.insert(coords.end(), evicted.begin(), evicted.end());
+    std::sort(coords.begin(), coords.end());
+    std::array<double, 3> corner{0, 0, 0};  // the lowest tile corner: at or below every point
+    for (std::size_t i = 0; i < coords.size(); ++i) {
+      const std::array<double, 3> c{coords[i].x * config_.map.tile_size_m, coords[i].y * config_.map.tile_size_m,
+                                    coords[i].z * config_.map.tile_size_m};
+      for (std::size_t a = 0; a < 3; ++a) corner[a] = i == 0 ? c[a] : std::min(corner[a], c[a]);
+    }
+    for (double& v : corner) v = std::floor(v);
+    std::vector<protocol::MapFileWriter> writers;
+    writers.reserve(config_.session.exports.size());
     for (const std::string& name : config_.session.exports) {
       const std::filesystem::path file = dir / ("map." + name);
-      protocol::write_map(file, *protocol::parse_map_format(name), all);
+      writers.emplace_back(file, *protocol::parse_map_format(name), map.size(), corner);
       files.push_back(file.filename().string());
     }
+    std::vector<slam::MapSample> read_back;
+    for (const slam::TileCoord& c : coords) {
+      std::span<const slam::MapSample> samples = map.tile(c);
+      if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
+        const bool rewritten = !map.is_evicted(c) && !map.tile(c).empty();
+        const std::string problem = rewritten         ? resident_tiles.read(c, read_back)
+                                    : spill == nullptr ? "evicted tile without a tile folder"
+                                                       : spill->read(c, read_back);
+        if (!problem.empty()) throw std::runtime_error(problem);
+        samples = read_back;
+      }
+      const std::vector<protocol::MapPoint> points = map_points_of(samples);
+      for (protocol::MapFileWriter& w : writers) w.write(points);
+    }
+    for (protocol::MapFileWriter& w : writers) w.finish();
     slam::Trajectory keyframes;
     for (const slam::Keyframe& k : pipeline->keyframes()) {
       keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
@@ -216,6 +234,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     }
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
+    if (s.spilled_keyframes.load() > 0) files.push_back("keyframes/");
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
     if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {
@@ -230,7 +249,12 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"wheels_missing", s.scans_without_wheels.load()}}},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
-                 {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()}}},
+                 {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
+                 {"evicted_tiles", s.evicted_tiles.load()}, {"restored_tiles", s.restored_tiles.load()},
+                 {"compacted_tiles", s.compacted_tiles.load()},
+                 {"spilled_keyframes", s.spilled_keyframes.load()},
+                 {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
+                 {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
         {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},
                     {"odometry_ms_p99", quantile(t.odometry_ms, 0.99)},
                     {"latency_ms_p99", quantile(t.latency_ms, 0.99)},

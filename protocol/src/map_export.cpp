@@ -20,6 +20,8 @@ namespace {
 // Appends little-endian values (the host is little-endian: x86-64, aarch64).
 class Bytes {
  public:
+  // Reserved up front: GCC 12 warns falsely (-Warray-bounds) about growing a vector from a few bytes.
+  explicit Bytes(std::size_t capacity) { data_.reserve(capacity); }
   template <typename T>
   void put(T value) {
     const auto* p = reinterpret_cast<const std::uint8_t*>(&value);
@@ -36,68 +38,37 @@ class Bytes {
   std::vector<std::uint8_t> data_;
 };
 
-void save(const std::filesystem::path& file, const Bytes& bytes) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (out) out.write(reinterpret_cast<const char*>(bytes.data().data()), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw InputError(file.string(), "", "cannot write the map file");
-}
-
-Bytes ply(std::span<const MapPoint> points) {
-  Bytes b;
-  b.append(fmt::format(
+std::string ply_header(std::uint64_t n) {
+  return fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment adit map\nelement vertex {}\n"
       "property float x\nproperty float y\nproperty float z\nproperty float intensity\nend_header\n",
-      points.size()));
-  for (const MapPoint& p : points) {
-    b.put(static_cast<float>(p.x));
-    b.put(static_cast<float>(p.y));
-    b.put(static_cast<float>(p.z));
-    b.put(p.intensity);
-  }
-  return b;
+      n);
 }
 
 // PCD v0.7 (pointclouds.org file format): ASCII header, binary records.
-Bytes pcd(std::span<const MapPoint> points) {
-  Bytes b;
-  b.append(fmt::format(
+std::string pcd_header(std::uint64_t n) {
+  return fmt::format(
       "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\n"
       "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH {0}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {0}\nDATA binary\n",
-      points.size()));
-  for (const MapPoint& p : points) {
-    b.put(static_cast<float>(p.x));
-    b.put(static_cast<float>(p.y));
-    b.put(static_cast<float>(p.z));
-    b.put(p.intensity);
-  }
-  return b;
+      n);
+}
+
+void put_float_xyzi(Bytes& b, const MapPoint& p) {
+  b.put(static_cast<float>(p.x));
+  b.put(static_cast<float>(p.y));
+  b.put(static_cast<float>(p.z));
+  b.put(p.intensity);
 }
 
 // LAS 1.4 R15 (ASPRS, 2019), Table 3 (public header block, 375 bytes) and
 // Table 13 (point data record format 6, 30 bytes). No VLRs, no EVLRs.
-Bytes las(std::span<const MapPoint> points) {
-  std::array<double, 3> lo{0, 0, 0};
-  std::array<double, 3> hi{0, 0, 0};
-  if (!points.empty()) {
-    lo = {points[0].x, points[0].y, points[0].z};
-    hi = lo;
-    for (const MapPoint& p : points) {
-      const std::array<double, 3> v{p.x, p.y, p.z};
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], v[a]);
-        hi[a] = std::max(hi[a], v[a]);
-      }
-    }
-  }
-  // Offsets at whole metres below the minimum keep the integers small and
-  // positive; 1 mm scale then spans 2 147 km, far beyond any survey.
-  std::array<double, 3> offset{};
-  for (int a = 0; a < 3; ++a) offset[a] = std::floor(lo[a]);
+Bytes las_header(std::uint64_t n, const std::array<double, 3>& offset, const std::array<double, 3>& lo,
+                 const std::array<double, 3>& hi) {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
 
-  Bytes b;
+  Bytes b(kLasHeaderSize);
   b.put_text("LASF", 4);
   b.put<std::uint16_t>(0);  // file source id
   // Global encoding: bit 0 = Adjusted Standard GPS Time, bit 4 = WKT (must be
@@ -129,27 +100,27 @@ Bytes las(std::span<const MapPoint> points) {
   b.put<std::uint64_t>(0);  // start of waveform data packet record
   b.put<std::uint64_t>(0);  // start of first EVLR
   b.put<std::uint32_t>(0);  // number of EVLRs
-  b.put<std::uint64_t>(points.size());
-  b.put<std::uint64_t>(points.size());  // every point is return 1 of 1
+  b.put<std::uint64_t>(n);
+  b.put<std::uint64_t>(n);  // every point is return 1 of 1
   for (int i = 1; i < 15; ++i) b.put<std::uint64_t>(0);
+  return b;
+}
 
+void put_las_point(Bytes& b, const MapPoint& p, const std::array<double, 3>& offset) {
   const auto scaled = [](double v, double off) {
     return static_cast<std::int32_t>(std::llround((v - off) / kLasScale));
   };
-  for (const MapPoint& p : points) {
-    b.put<std::int32_t>(scaled(p.x, offset[0]));
-    b.put<std::int32_t>(scaled(p.y, offset[1]));
-    b.put<std::int32_t>(scaled(p.z, offset[2]));
-    b.put<std::uint16_t>(static_cast<std::uint16_t>(std::clamp(p.intensity, 0.0f, 65535.0f)));
-    b.put<std::uint8_t>(0x11);  // return number 1 (bits 0-3), number of returns 1 (bits 4-7)
-    b.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
-    b.put<std::uint8_t>(1);     // classification: unclassified
-    b.put<std::uint8_t>(0);     // user data
-    b.put<std::int16_t>(0);     // scan angle
-    b.put<std::uint16_t>(0);    // point source id
-    b.put<double>(adjusted_standard_gps_time(p.time));
-  }
-  return b;
+  b.put<std::int32_t>(scaled(p.x, offset[0]));
+  b.put<std::int32_t>(scaled(p.y, offset[1]));
+  b.put<std::int32_t>(scaled(p.z, offset[2]));
+  b.put<std::uint16_t>(static_cast<std::uint16_t>(std::clamp(p.intensity, 0.0f, 65535.0f)));
+  b.put<std::uint8_t>(0x11);  // return number 1 (bits 0-3), number of returns 1 (bits 4-7)
+  b.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
+  b.put<std::uint8_t>(1);     // classification: unclassified
+  b.put<std::uint8_t>(0);     // user data
+  b.put<std::int16_t>(0);     // scan angle
+  b.put<std::uint16_t>(0);    // point source id
+  b.put<double>(adjusted_standard_gps_time(p.time));
 }
 
 }  // namespace
@@ -165,12 +136,65 @@ std::optional<MapFormat> parse_map_format(std::string_view name) {
   return std::nullopt;
 }
 
-void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points) {
-  switch (format) {
-    case MapFormat::ply: save(file, ply(points)); return;
-    case MapFormat::pcd: save(file, pcd(points)); return;
-    case MapFormat::las: save(file, las(points)); return;
+MapFileWriter::MapFileWriter(const std::filesystem::path& file, MapFormat format, std::uint64_t n_points,
+                             const std::array<double, 3>& las_offset)
+    : file_(file), format_(format), n_points_(n_points), offset_(las_offset), out_(file, std::ios::binary | std::ios::trunc) {
+  Bytes header(kLasHeaderSize);
+  switch (format_) {
+    case MapFormat::ply: header.append(ply_header(n_points)); break;
+    case MapFormat::pcd: header.append(pcd_header(n_points)); break;
+    case MapFormat::las: header = las_header(n_points, offset_, lo_, hi_); break;
   }
+  save(header.data());
+}
+
+void MapFileWriter::save(std::span<const std::uint8_t> bytes) {
+  if (out_) out_.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (!out_) throw InputError(file_.string(), "", "cannot write the map file");
+}
+
+void MapFileWriter::write(std::span<const MapPoint> points) {
+  if (points.empty()) return;
+  Bytes b(points.size() * kLasPointFormat6Length);
+  for (const MapPoint& p : points) {
+    if (format_ == MapFormat::las) {
+      put_las_point(b, p, offset_);
+      const std::array<double, 3> v{p.x, p.y, p.z};
+      for (std::size_t a = 0; a < 3; ++a) {
+        lo_[a] = written_ == 0 ? v[a] : std::min(lo_[a], v[a]);
+        hi_[a] = written_ == 0 ? v[a] : std::max(hi_[a], v[a]);
+      }
+    } else {
+      put_float_xyzi(b, p);
+    }
+    ++written_;
+  }
+  save(b.data());
+}
+
+void MapFileWriter::finish() {
+  if (written_ != n_points_)
+    throw InputError(file_.string(), "", fmt::format("{} points written, {} announced", written_, n_points_));
+  if (format_ == MapFormat::las) {  // the bounds are known now
+    out_.seekp(0);
+    save(las_header(n_points_, offset_, lo_, hi_).data());
+  }
+  out_.close();
+  if (!out_) throw InputError(file_.string(), "", "cannot write the map file");
+}
+
+void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points) {
+  // Offsets at whole metres below the minimum keep the integers small and
+  // positive; 1 mm scale then spans 2 147 km, far beyond any survey.
+  std::array<double, 3> offset{0, 0, 0};
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::array<double, 3> v{points[i].x, points[i].y, points[i].z};
+    for (std::size_t a = 0; a < 3; ++a) offset[a] = i == 0 ? v[a] : std::min(offset[a], v[a]);
+  }
+  for (double& o : offset) o = std::floor(o);
+  MapFileWriter writer(file, format, points.size(), offset);
+  writer.write(points);
+  writer.finish();
 }
 
 }  // namespace adit::protocol

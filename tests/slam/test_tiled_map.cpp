@@ -101,5 +101,168 @@ TEST(KeyframeSelector, TakesTheFirstPoseAndThenEveryMetreOrTenDegrees) {
   EXPECT_TRUE(selector.take(pose));
 }
 
+// A 10 × 10 × 4 block of distinct voxel centres (5 cm) inside tile (0, 0, 0).
+std::vector<Eigen::Vector3f> block(float x0) {
+  std::vector<Eigen::Vector3f> out;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 4; ++k) out.emplace_back(x0 + 0.025F + 0.05F * i, 0.025F + 0.05F * j, 0.025F + 0.05F * k);
+  return out;
+}
+
+TEST(TiledVoxelMapEviction, EvictHandsOutTheConfirmedPointsAndLosesOnlyUnconfirmedCandidates) {
+  TiledVoxelMap map({20.0F, 0.05F, 2});
+  const std::vector<Eigen::Vector3f> twice = block(1.0F);  // hit twice: confirmed
+  const std::vector<Eigen::Vector3f> once = block(5.0F);   // hit once: candidates
+  map.add(twice, {}, 1.0);
+  map.add(twice, {}, 2.0);
+  map.add(once, {}, 3.0);
+  map.add(std::vector<Eigen::Vector3f>{{30.0F, 1.0F, 1.0F}, {30.0F, 1.0F, 1.0F}}, {}, 3.0);  // tile (1, 0, 0)
+  ASSERT_EQ(map.size(), twice.size() + 1);
+  const std::size_t bytes_before = map.memory_bytes();
+
+  const TiledVoxelMap::Evicted evicted = map.evict({0, 0, 0});
+  EXPECT_EQ(evicted.points.size(), twice.size());
+  EXPECT_TRUE(evicted.changed);  // never taken by take_changed: the caller still owes it to the publisher
+  EXPECT_DOUBLE_EQ(evicted.points.front().time_s, 1.0);
+  EXPECT_EQ(map.lost_candidates(), once.size());
+  EXPECT_EQ(map.size(), twice.size() + 1);  // evicted points still belong to the map
+  EXPECT_EQ(map.resident_points(), 1U);
+  EXPECT_EQ(map.tile_count(), 2U);
+  EXPECT_EQ(map.resident_tile_count(), 1U);
+  EXPECT_TRUE(map.is_evicted({0, 0, 0}));
+  EXPECT_EQ(map.evicted_points({0, 0, 0}), twice.size());
+  EXPECT_EQ(map.evicted_coords(), (std::vector<TileCoord>{{0, 0, 0}}));
+  EXPECT_EQ(map.tile_coords(), (std::vector<TileCoord>{{1, 0, 0}}));
+  EXPECT_TRUE(map.tile({0, 0, 0}).empty());
+  EXPECT_LT(map.memory_bytes(), bytes_before / 4);
+  EXPECT_EQ(map.take_changed(), (std::vector<TileCoord>{{1, 0, 0}}));  // the evicted one is not reported twice
+  EXPECT_TRUE(map.evict({0, 0, 0}).points.empty());  // not resident any more
+  EXPECT_FALSE(map.evict({7, 7, 7}).changed);
+}
+
+TEST(TiledVoxelMapEviction, PointsInAnEvictedTileAreSkippedUntilItIsRestored) {
+  TiledVoxelMap map({20.0F, 0.05F, 1});
+  const std::vector<Eigen::Vector3f> points = block(1.0F);
+  map.add(points, {}, 1.0);
+  const std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+  EXPECT_EQ(map.evicted_hit_by(points), (std::vector<TileCoord>{{0, 0, 0}}));
+  EXPECT_TRUE(map.evicted_hit_by(std::vector<Eigen::Vector3f>{{25.0F, 0.0F, 0.0F}}).empty());
+  EXPECT_EQ(map.add(points, {}, 2.0), 0U);
+  EXPECT_EQ(map.dropped_in_evicted(), points.size());
+  EXPECT_EQ(map.tile_count(), 1U);  // no second copy of the tile was started
+  EXPECT_EQ(map.size(), points.size());
+}
+
+TEST(TiledVoxelMapEviction, ARestoredTileContinuesWithoutDuplicatingItsVoxels) {
+  TiledVoxelMap map({20.0F, 0.05F, 2});
+  const std::vector<Eigen::Vector3f> points = block(1.0F);
+  map.add(points, {}, 1.0);
+  map.add(points, {}, 2.0);
+  map.take_changed();
+  const std::size_t bytes_before = map.memory_bytes();
+  const std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+
+  map.restore({0, 0, 0}, stored);
+  EXPECT_FALSE(map.is_evicted({0, 0, 0}));
+  EXPECT_EQ(map.size(), points.size());
+  EXPECT_TRUE(map.tile({0, 0, 0}).empty());  // the stored points stay the caller's
+  EXPECT_EQ(map.stored_points({0, 0, 0}), points.size());
+  EXPECT_EQ(map.resident_points(), 0U);
+  EXPECT_LT(map.memory_bytes(), bytes_before / 10);  // a bit per stored voxel, not a candidate and a point
+  EXPECT_TRUE(map.take_changed().empty());  // restoring is not a change: the content is what was published
+  // The same voxels, hit once or many times more: nothing new.
+  EXPECT_EQ(map.add(points, {}, 3.0), 0U);
+  EXPECT_EQ(map.add(points, {}, 4.0), 0U);
+  EXPECT_EQ(map.size(), points.size());
+  // A new voxel still needs min_hits hits.
+  const std::vector<Eigen::Vector3f> fresh{{9.0F, 9.0F, 9.0F}};
+  EXPECT_EQ(map.add(fresh, {}, 5.0), 0U);
+  EXPECT_EQ(map.add(fresh, {}, 6.0), 1U);
+  EXPECT_EQ(map.size(), points.size() + 1);
+  EXPECT_EQ(map.take_changed(), (std::vector<TileCoord>{{0, 0, 0}}));
+  ASSERT_EQ(map.tile({0, 0, 0}).size(), 1U);  // only what is new since the restore
+  EXPECT_FLOAT_EQ(map.tile({0, 0, 0})[0].position.x(), 9.0F);
+  // A resident tile is not replaced by restore().
+  map.restore({0, 0, 0}, {});
+  EXPECT_EQ(map.stored_points({0, 0, 0}), points.size());
+  // Evicted again: out go the new points; the tile's count is the stored part plus them.
+  const TiledVoxelMap::Evicted again = map.evict({0, 0, 0});
+  EXPECT_EQ(again.points.size(), 1U);
+  EXPECT_EQ(map.evicted_points({0, 0, 0}), points.size() + 1);
+  EXPECT_EQ(map.size(), points.size() + 1);
+}
+
+TEST(TiledVoxelMapEviction, StoredVoxelsAreRecognisedInEveryBlockOfABigTile) {
+  // 1 cm voxels in a 12 m tile: 1200 voxels per edge, 150 blocks per edge; points spread over all of it.
+  TiledVoxelMap map({12.0F, 0.01F, 1});
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j)
+      points.emplace_back(0.005F + 0.3F * static_cast<float>(i), 0.005F + 0.3F * static_cast<float>(j),
+                          11.995F - 0.29F * static_cast<float>((i * 7 + j) % 41));
+  ASSERT_EQ(map.add(points, {}, 0.0), points.size());
+  std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+  map.restore({0, 0, 0}, stored);
+  EXPECT_EQ(map.add(points, {}, 1.0), 0U);
+  // The voxels next to each stored one (1 cm away on every axis) are free.
+  std::vector<Eigen::Vector3f> neighbours;
+  for (const Eigen::Vector3f& p : points) neighbours.push_back(p + Eigen::Vector3f(0.01F, 0.01F, -0.01F));
+  EXPECT_EQ(map.add(neighbours, {}, 2.0), neighbours.size());
+}
+
+TEST(TiledVoxelMapEviction, ARestoredCopyWithTwoPointsInOneVoxelCountsBoth) {
+  TiledVoxelMap map({20.0F, 0.05F, 1});
+  map.add(std::vector<Eigen::Vector3f>{{1.01F, 1.01F, 1.01F}}, {}, 1.0);
+  map.evict({0, 0, 0});
+  // A decoded copy can put two points into one voxel (1 mm quantisation at a face).
+  const std::vector<MapSample> copy{{Eigen::Vector3f(1.01F, 1.01F, 1.01F), 1.0F, 1.0},
+                                    {Eigen::Vector3f(1.02F, 1.02F, 1.02F), 2.0F, 1.0}};
+  map.restore({0, 0, 0}, copy);
+  EXPECT_EQ(map.size(), 2U);
+  EXPECT_EQ(map.stored_points({0, 0, 0}), 2U);
+  EXPECT_EQ(map.add(std::vector<Eigen::Vector3f>{{1.03F, 1.03F, 1.03F}}, {}, 2.0), 0U);
+}
+
+TEST(TileEviction, ATileHoldingMoreThanCompactVoxelsIsCrowded) {
+  TiledVoxelMap map({20.0F, 0.05F, 2});
+  map.add(block(1.0F), {}, 0.0);                                    // 400 voxels in tile (0, 0, 0), candidates only
+  map.add(std::vector<Eigen::Vector3f>{{21.0F, 1.0F, 1.0F}}, {}, 0.0);  // 1 in tile (1, 0, 0)
+  EXPECT_EQ(map.held_voxels({0, 0, 0}), 400U);
+  EXPECT_EQ(TileEviction({50.0F, 20, 399}).crowded_tiles(map), (std::vector<TileCoord>{{0, 0, 0}}));
+  EXPECT_TRUE(TileEviction({50.0F, 20, 400}).crowded_tiles(map).empty());
+  EXPECT_TRUE(TileEviction({50.0F, 20, 0}).crowded_tiles(map).empty());
+  // Compacted (evicted and restored at once), it holds nothing but the bits of its stored voxels.
+  std::vector<MapSample> stored = map.evict({0, 0, 0}).points;
+  map.restore({0, 0, 0}, stored);
+  EXPECT_EQ(map.held_voxels({0, 0, 0}), 0U);
+}
+
+TEST(TileEviction, DistanceToATileIsZeroInsideAndToTheNearestFaceOrCornerOutside) {
+  EXPECT_FLOAT_EQ(distance_to_tile({0, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 0.0F);
+  EXPECT_FLOAT_EQ(distance_to_tile({1, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 15.0F);
+  EXPECT_FLOAT_EQ(distance_to_tile({-1, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 5.0F);
+  EXPECT_NEAR(distance_to_tile({1, 1, 0}, 20.0F, {17.0F, 16.0F, 5.0F}), 5.0F, 1e-5F);  // (3, 4) to the corner
+}
+
+TEST(TileEviction, ATileIsColdOnlyAfterNConsecutiveKeyframesBeyondTheRadius) {
+  TiledVoxelMap map({20.0F, 0.5F, 1});
+  map.add(std::vector<Eigen::Vector3f>{{1.0F, 1.0F, 1.0F}, {101.0F, 1.0F, 1.0F}}, {}, 0.0);  // tiles (0,0,0), (5,0,0)
+  TileEviction eviction({30.0F, 3, 0});
+  const Eigen::Vector3f far_from_origin(90.0F, 1.0F, 1.0F);  // 70 m from tile 0, inside tile 4's neighbourhood
+  EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
+  EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
+  // Back near the origin once: the count starts again.
+  EXPECT_TRUE(eviction.cold_tiles(map, {10.0F, 1.0F, 1.0F}).empty());
+  EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
+  EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());
+  EXPECT_EQ(eviction.cold_tiles(map, far_from_origin), (std::vector<TileCoord>{{0, 0, 0}}));
+  map.evict({0, 0, 0});
+  EXPECT_TRUE(eviction.cold_tiles(map, far_from_origin).empty());  // evicted tiles are not offered again
+
+  TileEviction never({30.0F, 0, 0});
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(never.cold_tiles(map, {1000.0F, 0.0F, 0.0F}).empty());
+}
+
 }  // namespace
 }  // namespace adit::slam

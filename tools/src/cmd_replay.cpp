@@ -2,7 +2,10 @@
 // scans, as fast as possible or at a chosen pace; writes the trajectory and
 // prints the pipeline's figures (counters, odometry time, latency, memory).
 
+#include <stdlib.h>
+
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -21,6 +24,27 @@ struct ReplayOptions {
   double speed = 0.0;  // × real time; 0 = as fast as possible
   bool json = false;
   double memory_from = 0.1;
+  std::string session_dir;  // empty: a temporary folder, removed at the end
+};
+
+// A fresh folder under the system's temporary directory, removed when done.
+class TemporaryFolder {
+ public:
+  TemporaryFolder() {
+    std::string name = (std::filesystem::temp_directory_path() / "adit-replay-tiles-XXXXXX").string();
+    if (::mkdtemp(name.data()) == nullptr) throw InputError(name, "--session-dir", "cannot create a temporary folder");
+    path_ = name;
+  }
+  ~TemporaryFolder() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
 };
 
 const std::string& source_of(const config::Config& c) {
@@ -37,7 +61,13 @@ int replay(const ReplayOptions& o) {
   if (!o.out.empty()) options.trajectory_file = std::filesystem::absolute(o.out);
   options.replay_speed = o.realtime ? 1.0 : o.speed;
   daemon::Pipeline pipeline(config, options);
-  const PipelineFigures figures = run_pipeline(pipeline);
+  std::optional<TemporaryFolder> temporary;
+  if (o.session_dir.empty()) temporary.emplace();
+  const std::filesystem::path dir = temporary ? temporary->path() : std::filesystem::absolute(o.session_dir);
+  daemon::SessionFiles files;
+  files.tiles_dir = dir / "tiles";
+  files.keyframes_dir = dir / "keyframes";
+  const PipelineFigures figures = run_pipeline(pipeline, {}, files);
   for (const std::string& warning : pipeline.warnings()) fmt::print(stderr, "adit replay: {}\n", warning);
   if (o.json) {
     nlohmann::json j = figures_json(figures, o.memory_from);
@@ -73,6 +103,10 @@ void register_replay_commands(CLI::App& app, int& status) {
                     ->check(CLI::Range(0.0, 1e6));
   realtime->excludes(speed);
   cmd->add_flag("--json", o->json, "Print the figures as JSON (for scripts)");
+  cmd->add_option("--session-dir", o->session_dir,
+                  "Where the mapping thread writes what the sensor has left, as a session does: tiles/<id>.adt and "
+                  "keyframes/<stamp>.ply (map.evict_after_keyframes: 0 keeps all in RAM). Default: a temporary "
+                  "folder removed at the end");
   cmd->add_option("--memory-from", o->memory_from,
                   "Resident growth is measured from this fraction of the poses (local map full) to the end")
       ->check(CLI::Range(0.0, 1.0))

@@ -36,11 +36,11 @@ config::Config load_pipeline_config(const PipelineInputs& in) {
   return c;
 }
 
-PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks) {
+PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, const daemon::SessionFiles& files) {
   PipelineFigures f;
   f.memory.reserve(1 << 20);  // 29 h of scans at 10 Hz; reserved, so sampling does not move memory
   const daemon::PipelineStats& s = pipeline.stats();
-  pipeline.start();
+  pipeline.start(files);
   if (hooks.started) hooks.started();
   std::uint64_t sampled_poses = 0;
   while (!pipeline.drained()) {
@@ -82,6 +82,19 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks) 
   f.sensor_span_s = t.sensor_span_s;
   f.duration_s = t.duration_s;
   f.peak_resident_mb = peak_resident_mb();
+  f.mapping = s.mapped_scans.load() > 0;
+  f.map_points = s.map_points.load();
+  f.map_tiles = s.map_tiles.load();
+  f.resident_tiles = s.resident_tiles.load();
+  f.evicted_tiles = s.evicted_tiles.load();
+  f.restored_tiles = s.restored_tiles.load();
+  f.compacted_tiles = s.compacted_tiles.load();
+  f.lost_candidates = s.lost_candidates.load();
+  f.tile_file_errors = s.tile_file_errors.load();
+  f.keyframes = s.keyframes.load();
+  f.spilled_keyframes = s.spilled_keyframes.load();
+  f.map_mb = 1e-6 * static_cast<double>(s.map_bytes.load());
+  f.keyframe_mb = 1e-6 * static_cast<double>(s.keyframe_bytes.load());
   return f;
 }
 
@@ -121,6 +134,14 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
   if (const auto g = memory_growth(f.memory, from_fraction))
     j["resident_growth"] = {{"from_pose", g->from_pose}, {"from_mb", g->from_mb}, {"end_mb", g->end_mb},
                             {"max_mb", g->max_mb},       {"percent", g->percent()}, {"samples", f.memory.size()}};
+  if (f.mapping)
+    j["map"] = {{"points", f.map_points},           {"tiles", f.map_tiles},
+                {"resident_tiles", f.resident_tiles}, {"evicted_tiles", f.evicted_tiles},
+                {"restored_tiles", f.restored_tiles}, {"compacted_tiles", f.compacted_tiles},
+                {"lost_candidates", f.lost_candidates},
+                {"tile_file_errors", f.tile_file_errors}, {"resident_mb", f.map_mb},
+                {"keyframes", f.keyframes},           {"spilled_keyframes", f.spilled_keyframes},
+                {"keyframe_mb", f.keyframe_mb}};
   return j;
 }
 
@@ -138,6 +159,13 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
   if (const auto g = memory_growth(f.memory, from_fraction))
     text += fmt::format("; resident {:.1f} MB at pose {} -> {:.1f} MB at the end ({:+.2f} %, max {:.1f} MB)",
                         g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb);
+  if (f.mapping)
+    text += fmt::format(
+        "\nmap: {} points in {} tiles, {} resident ({:.1f} MB); {} evictions, {} reloads, {} compactions, {} "
+        "unconfirmed voxels lost, {} file errors; {} keyframes, {} scans in RAM ({:.1f} MB)",
+        f.map_points, f.map_tiles, f.resident_tiles, f.map_mb, f.evicted_tiles, f.restored_tiles, f.compacted_tiles,
+        f.lost_candidates,
+        f.tile_file_errors, f.keyframes, f.keyframes - f.spilled_keyframes, f.keyframe_mb);
   return text + "\n";
 }
 

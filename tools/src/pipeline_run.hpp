@@ -57,6 +57,20 @@ struct PipelineFigures {
   double duration_s = 0.0;     // wall time
   double peak_resident_mb = 0.0;
   std::vector<MemorySample> memory;
+  // Mapping: what it holds in RAM at the end and what it evicted to disk.
+  bool mapping = false;
+  std::uint64_t map_points = 0;
+  std::uint64_t map_tiles = 0;
+  std::uint64_t resident_tiles = 0;
+  std::uint64_t evicted_tiles = 0;
+  std::uint64_t restored_tiles = 0;
+  std::uint64_t compacted_tiles = 0;
+  std::uint64_t lost_candidates = 0;
+  std::uint64_t tile_file_errors = 0;
+  std::uint64_t keyframes = 0;
+  std::uint64_t spilled_keyframes = 0;
+  double map_mb = 0.0;       // resident tiles' structures
+  double keyframe_mb = 0.0;  // keyframes' downsampled scans
   double speed() const { return duration_s > 0.0 ? sensor_span_s / duration_s : 0.0; }  // × real time
 };
 
@@ -68,7 +82,9 @@ struct RunHooks {
 // Starts the pipeline and waits until it has drained or `stop_when()` returns
 // true (then stops it), sampling the resident size whenever a pose is counted;
 // joins and gathers the figures.
-PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks = {});
+// `files` as for a session (tiles_dir: where evicted tiles go).
+PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks = {},
+                             const daemon::SessionFiles& files = {});
 
 // Resident growth, from the first sample at or after `from_fraction` of the
 // poses (when the local map has filled) to the last sample.

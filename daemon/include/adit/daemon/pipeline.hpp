@@ -27,6 +27,7 @@
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/heartbeat.hpp"
+#include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/keyframes.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/tiled_map.hpp"
@@ -72,6 +73,17 @@ struct PipelineStats {
   std::atomic<std::uint64_t> map_points{0};
   std::atomic<std::uint64_t> map_tiles{0};
   std::atomic<std::uint64_t> keyframes{0};
+  // What the mapping thread holds and sends away (eviction: tiles the sensor has left go to disk).
+  std::atomic<std::uint64_t> map_bytes{0};            // resident tiles' vectors and indices
+  std::atomic<std::uint64_t> keyframe_bytes{0};       // keyframes' downsampled scans
+  std::atomic<std::uint64_t> resident_tiles{0};
+  std::atomic<std::uint64_t> evicted_tiles{0};        // evictions (a tile evicted twice counts twice)
+  std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
+  std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
+  std::atomic<std::uint64_t> lost_candidates{0};      // voxels hit < min_hits times in evicted tiles
+  std::atomic<std::uint64_t> spilled_keyframes{0};    // keyframes whose scan went to keyframes_dir
+  std::atomic<std::uint64_t> tile_file_errors{0};     // a tile or keyframe that could not be written (kept) or read (skipped)
+  std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
 };
@@ -101,6 +113,12 @@ struct SessionFiles {
   std::filesystem::path trajectory_file;  // TUM; empty = none (or PipelineOptions')
   std::filesystem::path record_file;      // raw packets as pcap; empty = none
   std::filesystem::path can_record_file;  // the CAN bus as candump -L; empty = none
+  // Where tiles the sensor has left are written (tiles/<id>.adt) so they can
+  // leave RAM (map.evict_after_keyframes); empty = every tile stays in RAM.
+  std::filesystem::path tiles_dir;
+  // Where the scans of keyframes the sensor has left are written
+  // (<stamp_ns>.ply, body frame) so that only their poses stay in RAM; empty = all stay.
+  std::filesystem::path keyframes_dir;
 };
 
 class Pipeline {
@@ -133,7 +151,10 @@ class Pipeline {
   std::vector<StageLoad> loads() const;         // while running
 
   // The session's map and keyframes: complete after join(), not to be read before.
+  // Evicted tiles are not in map() (see map().evicted_coords()) but in tile_spill();
+  // a keyframe whose points are empty had them written to SessionFiles::keyframes_dir.
   const slam::TiledVoxelMap& map() const;
+  const TileSpill* tile_spill() const;  // null without SessionFiles::tiles_dir
   const std::vector<slam::Keyframe>& keyframes() const;
 
  private:

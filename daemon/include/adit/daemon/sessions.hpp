@@ -9,8 +9,9 @@
 // petting the watchdog, writes the session's files:
 //   trajectory.tum   body poses in the map frame (TUM), written live
 //   map.ply|pcd|las  the map (session.exports), from the same tiles the tablet gets
-//   tiles/<id>.adt   each tile's encoded blob (protocol/tile_codec.hpp), for downloads later
-//   keyframes.tum    keyframe poses (their scans stay in memory for loop closure)
+//   tiles/<id>.adt   each tile's encoded blob (protocol/tile_codec.hpp), for downloads later;
+//                    written during the session for tiles the sensor has left (eviction)
+//   keyframes.tum    keyframe poses; keyframes/<stamp_ns>.ply the scans of older keyframes
 //   summary.json     counts, timings, files; config.yaml the effective configuration
 //   lidar.pcap       raw packets, when session.record_lidar is true
 

@@ -126,6 +126,14 @@ struct MapSection {
   double keyframe_distance_m = 1.0;
   double keyframe_angle_deg = 10.0;
   double keyframe_voxel_m = 0.2;         // a keyframe's scan is downsampled to this
+  // Tiles the sensor has left (farther than max_range_m + evict_margin_m for
+  // evict_after_keyframes keyframes in a row) are written to the session's
+  // tiles/ folder and leave RAM; 0 keyframes = keep every tile in RAM.
+  double evict_margin_m = 10.0;
+  int evict_after_keyframes = 20;
+  // A tile holding more voxels than this in RAM (the sensor stays near it or
+  // keeps coming back) is written out and keeps one bit per voxel; 0 = never.
+  int compact_tile_voxels = 100'000;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.

@@ -173,6 +173,9 @@ void describe(V& v, MapSection& s) {
   v.optional("keyframe_distance_m", s.keyframe_distance_m, Range<double>{0.1, 100.0});
   v.optional("keyframe_angle_deg", s.keyframe_angle_deg, Range<double>{1.0, 180.0});
   v.optional("keyframe_voxel_m", s.keyframe_voxel_m, Range<double>{0.05, 2.0});
+  v.optional("evict_margin_m", s.evict_margin_m, Range<double>{0.0, 1000.0});
+  v.optional("evict_after_keyframes", s.evict_after_keyframes, Range<int>{0, 1000000});
+  v.optional("compact_tile_voxels", s.compact_tile_voxels, Range<int>{0, 100000000});
 }
 
 template <typename V>

@@ -3,7 +3,10 @@
 // (PCL) and LAS 1.4 point data record format 6 (every survey package), all
 // written by hand: Debian has no LAS library.
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -17,6 +20,32 @@ std::optional<MapFormat> parse_map_format(std::string_view name);
 
 // Throws adit::InputError naming the file when it cannot be written.
 void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points);
+
+// Writes a map file a batch of points at a time, so that a large map never has
+// to be in memory whole (a session's stop-time export goes tile by tile). The
+// point count must be known up front: every format's header gives it. LAS
+// stores points as integers from `las_offset` (whole metres at or below the
+// map's minimum keep them small and positive); its bounds are written by
+// finish(). Throws adit::InputError naming the file when it cannot be written.
+class MapFileWriter {
+ public:
+  MapFileWriter(const std::filesystem::path& file, MapFormat format, std::uint64_t n_points,
+                const std::array<double, 3>& las_offset = {0, 0, 0});
+  void write(std::span<const MapPoint> points);
+  // Throws when the count written differs from the one announced.
+  void finish();
+
+ private:
+  void save(std::span<const std::uint8_t> bytes);
+  std::filesystem::path file_;
+  MapFormat format_;
+  std::uint64_t n_points_;
+  std::uint64_t written_ = 0;
+  std::array<double, 3> offset_;
+  std::array<double, 3> lo_{0, 0, 0};
+  std::array<double, 3> hi_{0, 0, 0};
+  std::ofstream out_;
+};
 
 // LAS 1.4 R15 constants the writer uses (and the tests check against).
 inline constexpr std::size_t kLasHeaderSize = 375;

@@ -1,0 +1,83 @@
+#include "adit/daemon/tile_spill.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+
+#include <fmt/format.h>
+
+namespace adit::daemon {
+
+protocol::TileParams stored_tile_params(double tile_size_m) {
+  protocol::TileParams p;
+  p.tile_size_m = tile_size_m;
+  p.segment_points = protocol::kMaxSegmentPoints;
+  return p;
+}
+
+std::vector<protocol::MapPoint> map_points_of(std::span<const slam::MapSample> samples) {
+  std::vector<protocol::MapPoint> out;
+  out.reserve(samples.size());
+  for (const slam::MapSample& s : samples)
+    out.push_back({s.position.x(), s.position.y(), s.position.z(), s.intensity, s.time_s});
+  return out;
+}
+
+std::filesystem::path TileSpill::file_of(const slam::TileCoord& coord) const {
+  return dir_ / fmt::format("{}.adt", protocol::tile_id({coord.x, coord.y, coord.z}));
+}
+
+std::string TileSpill::write(const slam::TileCoord& coord, std::span<const slam::MapSample> points) {
+  const std::vector<protocol::MapPoint> map_points = map_points_of(points);
+  const std::vector<std::uint8_t> blob = protocol::encode_tile({coord.x, coord.y, coord.z}, map_points, params_);
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) return fmt::format("{}: cannot create the folder: {}", dir_.string(), ec.message());
+  const std::filesystem::path file = file_of(coord);
+  std::filesystem::path part = file;
+  part += ".part";
+  {
+    std::ofstream out(part, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(blob.data()), static_cast<std::streamsize>(blob.size()));
+    out.close();
+    if (!out) return fmt::format("{}: cannot write the tile", part.string());
+  }
+  std::filesystem::rename(part, file, ec);
+  if (ec) return fmt::format("{}: cannot rename the tile into place: {}", file.string(), ec.message());
+  double newest = 0.0;
+  for (const slam::MapSample& s : points) newest = std::max(newest, s.time_s);
+  newest_time_s_[coord] = newest;
+  return "";
+}
+
+std::string TileSpill::read(const slam::TileCoord& coord, std::vector<slam::MapSample>& out) const {
+  out.clear();
+  const std::filesystem::path file = file_of(coord);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return fmt::format("{}: cannot open the tile", file.string());
+  const std::vector<std::uint8_t> blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<protocol::MapPoint> points;
+  if (std::string problem = protocol::decode_tile(blob, {coord.x, coord.y, coord.z}, points); !problem.empty())
+    return fmt::format("{}: {}", file.string(), problem);
+  const auto time = newest_time_s_.find(coord);
+  const double time_s = time == newest_time_s_.end() ? 0.0 : time->second;
+  out.reserve(points.size());
+  for (const protocol::MapPoint& p : points)
+    out.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
+                   p.intensity, time_s});
+  return "";
+}
+
+std::string TileSpill::whole_tile(const slam::TiledVoxelMap& map, const slam::TileCoord& coord,
+                                  std::vector<slam::MapSample>& out) const {
+  out.clear();
+  if (map.is_evicted(coord) || map.stored_points(coord) > 0) {
+    if (std::string problem = read(coord, out); !problem.empty()) return problem;
+  }
+  const std::span<const slam::MapSample> held = map.tile(coord);
+  out.insert(out.end(), held.begin(), held.end());
+  return "";
+}
+
+}  // namespace adit::daemon
