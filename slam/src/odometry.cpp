@@ -161,7 +161,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     constant_sweep.information = sweep_information.asDiagonal();
     const RegistrationResult alternative =
         register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, constant_sweep);
-    if (alternative.correspondences > result.registration.correspondences) {
+    if (static_cast<double>(alternative.correspondences) >
+        (1.0 + config_.wheel_rejection_margin) * static_cast<double>(result.registration.correspondences)) {
       result.registration = alternative;
       result.wheel_rejected = true;
     }

@@ -47,6 +47,11 @@ struct OdometryConfig {
   // constant velocity too: a spinning wheel can keep the scan overlapping.
   double max_wheel_disagreement_rad = 0.026;
   double max_wheel_disagreement_m = 0.15;
+  // Constant velocity replaces the wheels only when it explains this share
+  // more of the scan: where the scan cannot tell (a degenerate direction
+  // keeps each registration's own prior) a tie must not hand the pose to a
+  // velocity that may still carry a spun wheel's false turn.
+  double wheel_rejection_margin = 0.05;
   // Estimate the body velocity over each sweep with the pose (continuous-time
   // registration, see SweepMotion) instead of deskewing with the prediction's.
   // The prior on it, per sweep: the prediction's velocity with these σ.
