@@ -4,7 +4,8 @@
 
 namespace adit::slam {
 
-void Deskewer::deskew(std::span<const Eigen::Vector3f> points, std::span<const float> times_s,
+template <int Bins>
+void TabulatedDeskewer<Bins>::deskew(std::span<const Eigen::Vector3f> points, std::span<const float> times_s,
                       const Vector6d& velocity, std::span<Eigen::Vector3f> out) {
   float duration = 0.0F;
   for (const float t : times_s) duration = std::max(duration, t);
@@ -25,5 +26,8 @@ void Deskewer::deskew(std::span<const Eigen::Vector3f> points, std::span<const f
     out[k] = rotations_[b] * points[k] + translations_[b];
   }
 }
+
+template class TabulatedDeskewer<1024>;
+template class TabulatedDeskewer<128>;
 
 }  // namespace adit::slam

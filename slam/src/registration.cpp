@@ -1,11 +1,12 @@
 #include "adit/slam/registration.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
+
+#include "adit/slam/deskew.hpp"
 
 namespace adit::slam {
 namespace {
@@ -78,27 +79,6 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
     ne.g = ne.g12.head<6>();
   }
   return ne;
-}
-
-// Deskews `points` (measured at `times_s` after the scan start) to the start
-// with constant body velocity ξ, T(t) = exp(t·ξ), tabulated at kSweepBins
-// instants (nearest taken): 128 bins over 0.1 s at 40°/s step by 0.03°.
-void deskew_sweep(std::span<const Eigen::Vector3f> points, std::span<const float> times_s, const Vector6d& velocity,
-                  float duration_s, std::span<Eigen::Vector3f> out) {
-  constexpr int kSweepBins = 128;
-  std::array<Eigen::Matrix3f, kSweepBins> rotations;
-  std::array<Eigen::Vector3f, kSweepBins> translations;
-  const float bin_width = duration_s / static_cast<float>(kSweepBins - 1);
-  for (int i = 0; i < kSweepBins; ++i) {
-    const Eigen::Isometry3d T = exp_se3(velocity * static_cast<double>(static_cast<float>(i) * bin_width));
-    rotations[static_cast<std::size_t>(i)] = T.linear().cast<float>();
-    translations[static_cast<std::size_t>(i)] = T.translation().cast<float>();
-  }
-  const float inverse_bin = bin_width > 0.0F ? 1.0F / bin_width : 0.0F;
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const auto b = static_cast<std::size_t>(std::clamp(static_cast<int>(times_s[k] * inverse_bin + 0.5F), 0, kSweepBins - 1));
-    out[k] = rotations[b] * points[k] + translations[b];
-  }
 }
 
 struct Degeneracy {
@@ -179,9 +159,10 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
   const bool estimate = timed && sweep.estimate && duration > 0.0F;
   Vector6d velocity = sweep.velocity;
   std::span<const Eigen::Vector3f> points = measured;
+  TabulatedDeskewer<128> deskewer;  // on the stack: 6 kB, no allocation
   if (timed) {
     points = sweep.deskewed.first(measured.size());
-    deskew_sweep(measured, sweep.times_s, velocity, duration, sweep.deskewed);
+    deskewer.deskew(measured, sweep.times_s, velocity, sweep.deskewed);
   }
   result.sweep_velocity = velocity;
   result.pose = prior.mean;
@@ -244,7 +225,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
     result.pose = result.pose * exp_se3(delta);
     if (estimate) {
       velocity += delta_velocity;
-      deskew_sweep(measured, sweep.times_s, velocity, duration, sweep.deskewed);
+      deskewer.deskew(measured, sweep.times_s, velocity, sweep.deskewed);
     }
     result.iterations = iteration;
     const bool last_level = kappa <= config.min_kernel_scale_m;
