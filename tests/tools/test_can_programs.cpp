@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "run_program.hpp"
@@ -14,7 +16,10 @@ namespace {
 
 std::string adit() { return (binary_dir() / "bin" / "adit").string(); }
 
-std::filesystem::path temp(const std::string& name) { return std::filesystem::temp_directory_path() / name; }
+// Per process: ctest -j runs this file's tests side by side.
+std::filesystem::path temp(const std::string& name) {
+  return std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "-" + name);
+}
 
 TEST(CanPrograms, DecodeWritesCsvAndCountsMalformedLines) {
   ADIT_REQUIRE_SHARED_DATA(dir, "can/toyota-rav4-2017");
