@@ -1,5 +1,6 @@
 #include "adit/slam/odometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace adit::slam {
@@ -54,6 +55,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   const double dt = started_ ? 1e-9 * static_cast<double>(scan.stamp_ns - last_stamp_ns_) : 0.0;
   if (dt > config_.max_scan_gap_s) {  // the sensor stopped: old motion means nothing
     velocity_.setZero();
+    start_to_mid_.setIdentity();
+    mid_offset_s_ = 0.0;
     reacquire_ = true;
   }
 
@@ -71,8 +74,10 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     filtered_times_.push_back(timed ? scan.times_s[i] : 0.0F);
   }
 
-  // Prediction: wheel odometry when given, else constant velocity.
-  const Eigen::Isometry3d delta = wheel ? wheel->delta : exp_se3(velocity_ * dt);
+  // Prediction: wheel odometry when given, else constant velocity, carried
+  // on from the middle of the last sweep (see the end of this function).
+  const Eigen::Isometry3d constant_velocity_delta = start_to_mid_ * exp_se3(velocity_ * (dt - mid_offset_s_));
+  const Eigen::Isometry3d delta = wheel ? wheel->delta : constant_velocity_delta;
   const Eigen::Isometry3d predicted = pose_ * delta;
   const Vector6d scan_velocity = wheel && dt > 0.0 ? Vector6d(log_se3(wheel->delta) / dt) : velocity_;
 
@@ -92,6 +97,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     deskew_frame(scan_velocity);
     reacquire_ = true;
     pose_ = predicted;
+    start_to_mid_.setIdentity();
+    mid_offset_s_ = 0.0;
     last_stamp_ns_ = scan.stamp_ns;
     started_ = true;
     result.pose = pose_;
@@ -113,7 +120,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   }
 
   PosePrior constant_velocity;
-  constant_velocity.mean = pose_ * exp_se3(velocity_ * dt);
+  constant_velocity.mean = pose_ * constant_velocity_delta;
   Vector6d information;
   information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
   information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
@@ -171,7 +178,23 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   const Eigen::Isometry3d corrected = result.registration.pose;
 
   threshold_.update(predicted.inverse() * corrected, pose_.inverse() * corrected);
-  if (dt > 0.0) velocity_ = log_se3(pose_.inverse() * corrected) / dt;
+  // A scan pins its mid-sweep pose down far better than how the sweep's
+  // motion splits between its start pose and its velocity ξ (a start pose off
+  // by +e with ξ off the other way fits almost as well). Differencing start
+  // poses, T_{k-1}⁻¹·T_k, let such an error come back amplified in the next
+  // prediction: a drone hovering while it turned at 60°/s rolled ±1° in
+  // alternate scans, growing. So the velocity is the motion between sweep
+  // middles, M_k = T_k·exp(ξ_k·τ_k/2), and the prediction continues it from
+  // M_k (trajectory continuity between scans as in CT-ICP, Dellenbach et al.
+  // 2022, §III-B, with the better-observed pose as the anchor).
+  float duration = 0.0F;
+  for (const float t : source_times_) duration = std::max(duration, t);
+  const double half = 0.5 * static_cast<double>(duration);
+  const Eigen::Isometry3d start_to_mid = exp_se3(result.registration.sweep_velocity * half);
+  const double mid_to_mid = dt - mid_offset_s_ + half;
+  if (mid_to_mid > 0.0) velocity_ = log_se3((pose_ * start_to_mid_).inverse() * corrected * start_to_mid) / mid_to_mid;
+  start_to_mid_ = start_to_mid;
+  mid_offset_s_ = half;
   pose_ = corrected;
   last_stamp_ns_ = scan.stamp_ns;
 

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -52,6 +53,70 @@ TEST(Odometry, TracksASmoothPathThroughAHall) {
   EXPECT_LT((r.pose.translation() - expected.translation()).norm(), 0.02) << r.pose.translation().transpose();
   EXPECT_LT(Eigen::AngleAxisd(r.pose.linear().transpose() * expected.linear()).angle(), 0.2 * M_PI / 180);
   EXPECT_EQ(r.status, OdometryStatus::ok);
+}
+
+// A spinning sensor sees each azimuth at one instant of its sweep: here a
+// sweep of 0.1 s turns once, and a point's time follows its azimuth.
+std::vector<Eigen::Vector3f> spin_observe(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& start,
+                                          const Vector6d& velocity, std::size_t n, unsigned seed,
+                                          std::vector<float>& times) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, world.size() - 1);
+  const Eigen::Isometry3d inverse = start.inverse();
+  std::vector<Eigen::Vector3f> scan;
+  times.clear();
+  while (scan.size() < n) {
+    const Eigen::Vector3d w = world[pick(rng)].cast<double>();
+    const Eigen::Vector3d p0 = inverse * w;
+    if (p0.norm() > 30.0 || p0.norm() < 0.5) continue;
+    const double t = 0.1 * (std::atan2(p0.y(), p0.x()) + M_PI) / (2.0 * M_PI);
+    scan.push_back(((start * exp_se3(velocity * t)).inverse() * w).cast<float>());
+    times.push_back(static_cast<float>(t));
+  }
+  return scan;
+}
+
+TEST(Odometry, ASensorTurningFastInPlaceGetsEachScansMotionRight) {
+  // Hovering while it turns at 60°/s, with a slow roll: each scan's start
+  // pose and its sweep's velocity are told apart only by when each azimuth
+  // was seen. Predicting from differenced start poses fed such a split back
+  // amplified (a simulated drone rolled ±1-4° in alternate scans, growing);
+  // the prediction from the sweep middles keeps each scan's motion right.
+  const auto hall = test::room(400000, 31, 12.0F, 8.0F, 3.0F);
+  OdometryConfig config;
+  config.max_range_m = 30.0F;
+  Odometry odometry(config);
+  const auto truth_at = [](double t) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    // The turn rate ramps up to 60°/s over 1.5 s.
+    const double yaw = M_PI / 3.0 * (t < 1.5 ? t * t / 3.0 : t - 0.75);
+    T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                  Eigen::AngleAxisd(0.05 * std::sin(2.0 * t), Eigen::Vector3d::UnitX()))
+                     .toRotationMatrix();
+    T.translation() << 1.0, 0.5, 0.0;
+    return T;
+  };
+  std::vector<float> times;
+  // The error of each scan's motion from the previous one (from the third
+  // scan on: the first two start the velocity from rest).
+  std::vector<double> step_errors_deg;
+  Eigen::Isometry3d previous_estimate = Eigen::Isometry3d::Identity();
+  for (int k = 0; k < 60; ++k) {
+    const double t = 0.1 * k;
+    const Eigen::Isometry3d start = truth_at(t);
+    const Vector6d velocity = log_se3(start.inverse() * truth_at(t + 0.1)) / 0.1;
+    const auto scan = spin_observe(hall, start, velocity, 20000, 300 + static_cast<unsigned>(k), times);
+    const OdometryResult r = odometry.process({static_cast<std::int64_t>(t * 1e9), scan, times});
+    ASSERT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
+    const Eigen::Isometry3d true_step = truth_at(t - 0.1).inverse() * start;
+    const Eigen::Isometry3d step = previous_estimate.inverse() * r.pose;
+    const double step_deg = Eigen::AngleAxisd(step.linear().transpose() * true_step.linear()).angle() * 180.0 / M_PI;
+    if (k >= 3) step_errors_deg.push_back(step_deg);
+    previous_estimate = r.pose;
+  }
+  // Measured: median 0.009° per scan; predicted from differenced start poses, 0.036°.
+  std::nth_element(step_errors_deg.begin(), step_errors_deg.begin() + step_errors_deg.size() / 2, step_errors_deg.end());
+  EXPECT_LT(step_errors_deg[step_errors_deg.size() / 2], 0.02);
 }
 
 TEST(Odometry, BadScansAreHeldWithAReasonAndTheOdometryRecovers) {

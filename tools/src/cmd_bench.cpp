@@ -43,6 +43,7 @@ struct BenchOptions {
   double point_sigma_m = slam::RegistrationConfig{}.point_sigma_m;
   int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
   bool fixed_sweep_velocity = false;  // deskew with the prediction's velocity only
+  double sweep_velocity_sigma_radps = slam::OdometryConfig{}.sweep_velocity_sigma_radps;
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -107,6 +108,7 @@ int bench_odometry(const BenchOptions& o) {
   config.registration.point_sigma_m = o.point_sigma_m;
   config.registration.plane_neighbors = o.plane_neighbors;
   config.estimate_sweep_velocity = !o.fixed_sweep_velocity;
+  config.sweep_velocity_sigma_radps = o.sweep_velocity_sigma_radps;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
@@ -217,6 +219,8 @@ void register_bench_commands(CLI::App& app, int& status) {
       ->check(CLI::Range(3, 16));
   odometry->add_flag("--fixed-sweep-velocity", o->fixed_sweep_velocity,
                      "Deskew with the prediction's velocity instead of estimating each sweep's (before continuous-time registration)");
+  odometry->add_option("--sweep-velocity-sigma", o->sweep_velocity_sigma_radps,
+                       "σ of the sweep's angular velocity around the constant-velocity prediction, rad/s (without wheels)");
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");

@@ -131,7 +131,9 @@ class Odometry {
   std::vector<Eigen::Vector3f> registered_;
   std::vector<MapPlane> planes_;             // registration's per-point planes
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
-  Vector6d velocity_ = Vector6d::Zero();     // body twist per second
+  Vector6d velocity_ = Vector6d::Zero();     // body twist per second, between the last two sweep middles
+  Eigen::Isometry3d start_to_mid_ = Eigen::Isometry3d::Identity();  // pose_ to the middle of its sweep
+  double mid_offset_s_ = 0.0;                // time from pose_ to the middle of its sweep
   std::int64_t last_stamp_ns_ = 0;
   bool started_ = false;
   bool reacquire_ = false;  // the next registration uses the initial threshold
