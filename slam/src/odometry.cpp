@@ -34,7 +34,7 @@ std::string_view to_string(OdometryStatus status) {
 
 Odometry::Odometry(const OdometryConfig& config)
     : config_(config),
-      map_(config.map_voxel_m, config.map_capacity_voxels),
+      map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
       downsampler_(config.max_scan_points),
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
   for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);

@@ -10,9 +10,10 @@
 
 namespace adit::slam {
 
-VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels)
+VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m)
     : voxel_size_(voxel_size_m),
       inverse_voxel_size_(1.0F / voxel_size_m),
+      min_point_spacing_(std::max(min_point_spacing_m, 0.0F)),
       mask_(std::bit_ceil(std::max<std::size_t>(capacity_voxels, 16)) - 1),
       max_voxels_((mask_ + 1) * 3 / 4),
       slots_(mask_ + 1),
@@ -44,9 +45,16 @@ std::size_t VoxelHashMap::find_or_insert(const VoxelKey& key) {
 }
 
 void VoxelHashMap::add(std::span<const Eigen::Vector3f> points) {
+  const float spacing_sq = min_point_spacing_ * min_point_spacing_;
   for (const Eigen::Vector3f& p : points) {
     const std::size_t i = find_or_insert(key_of(p));
     if (i == kNone || slots_[i].count >= kMaxPointsPerVoxel) {
+      ++dropped_points_;
+      continue;
+    }
+    const auto stored = std::span(voxels_[i].points).first(static_cast<std::size_t>(slots_[i].count));
+    if (spacing_sq > 0.0F &&
+        std::any_of(stored.begin(), stored.end(), [&](const Eigen::Vector3f& q) { return (q - p).squaredNorm() < spacing_sq; })) {
       ++dropped_points_;
       continue;
     }

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
 #include <tuple>
@@ -48,6 +49,41 @@ TEST(VoxelHashMap, KeepsAtMostTheVoxelCapacityAndCountsTheRest) {
   EXPECT_EQ(map.voxel_count(), 1U);
   EXPECT_EQ(map.point_count(), static_cast<std::size_t>(VoxelHashMap::kMaxPointsPerVoxel));
   EXPECT_EQ(map.dropped_points(), 5U);
+}
+
+// A VLP-16 ring crosses a 0.5 m voxel as a row of points, and the next scans'
+// rings cross it close to the same row. First come (no spacing), the first
+// rows fill the voxel and a later ring at another height is refused: the map
+// keeps the sampling of the scans that first saw the surface. With a minimum
+// spacing a row takes a few points and the later ring enters too.
+TEST(VoxelHashMap, AMinimumSpacingLetsALaterRingIntoAVoxelTheFirstRowsWouldFill) {
+  std::vector<Eigen::Vector3f> first_rows;  // three scans' rings, 1 cm apart in height, 2 cm along
+  for (int row = 0; row < 3; ++row)
+    for (int i = 0; i < 24; ++i) first_rows.emplace_back(0.01F + 0.02F * static_cast<float>(i), 0.25F, 0.1F + 0.01F * static_cast<float>(row));
+  std::vector<Eigen::Vector3f> later_ring;
+  for (int i = 0; i < 24; ++i) later_ring.emplace_back(0.01F + 0.02F * static_cast<float>(i), 0.25F, 0.4F);
+
+  VoxelHashMap first_come(0.5F, 64);
+  EXPECT_FLOAT_EQ(first_come.min_point_spacing(), 0.0F);
+  first_come.add(first_rows);
+  first_come.add(later_ring);
+  EXPECT_EQ(first_come.point_count(), static_cast<std::size_t>(VoxelHashMap::kMaxPointsPerVoxel));
+  first_come.for_each_point([](const Eigen::Vector3f& p) { EXPECT_LT(p.z(), 0.15F); });  // nothing of the later ring
+
+  const float spacing = 0.5F / std::sqrt(static_cast<float>(VoxelHashMap::kMaxPointsPerVoxel));  // KISS-ICP's
+  VoxelHashMap spaced(0.5F, 64, spacing);
+  spaced.add(first_rows);
+  const std::size_t after_rows = spaced.point_count();
+  EXPECT_GE(after_rows, 4U);   // the row, every ~0.12 m of its 0.48 m
+  EXPECT_LE(after_rows, 5U);   // the two rows 1-2 cm above it add nothing
+  spaced.add(later_ring);
+  EXPECT_EQ(spaced.point_count(), 2 * after_rows);  // the later ring enters, as evenly
+  EXPECT_EQ(spaced.voxel_count(), 1U);
+  EXPECT_EQ(spaced.dropped_points(), first_rows.size() + later_ring.size() - spaced.point_count());
+  std::vector<Eigen::Vector3f> kept;
+  spaced.for_each_point([&](const Eigen::Vector3f& p) { kept.push_back(p); });
+  for (std::size_t a = 0; a < kept.size(); ++a)
+    for (std::size_t b = a + 1; b < kept.size(); ++b) EXPECT_GE((kept[a] - kept[b]).norm(), spacing);
 }
 
 TEST(VoxelHashMap, RefusesNewVoxelsBeyondThreeQuartersOfTheTable) {

@@ -39,6 +39,7 @@ struct BenchOptions {
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
   float max_range_m = 100.0F;
   float map_voxel_m = 0.5F;
+  float map_point_spacing_m = slam::OdometryConfig{}.map_point_spacing_m;
   double degeneracy_threshold = slam::RegistrationConfig{}.degeneracy_threshold;
   double point_sigma_m = slam::RegistrationConfig{}.point_sigma_m;
   int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
@@ -104,6 +105,7 @@ int bench_odometry(const BenchOptions& o) {
   config.max_range_m = o.max_range_m;
   config.map_voxel_m = o.map_voxel_m;
   config.registration_voxel_m = 1.5F * o.map_voxel_m;
+  config.map_point_spacing_m = o.map_point_spacing_m;
   config.registration.degeneracy_threshold = o.degeneracy_threshold;
   config.registration.point_sigma_m = o.point_sigma_m;
   config.registration.plane_neighbors = o.plane_neighbors;
@@ -211,6 +213,9 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
   odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
   odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");
+  odometry->add_option("--map-point-spacing", o->map_point_spacing_m,
+                       "Minimum distance between two points of one map voxel, m (0 = none, KISS-ICP: voxel / sqrt(20))")
+      ->check(CLI::NonNegativeNumber);
   odometry->add_option("--degeneracy-threshold", o->degeneracy_threshold,
                        "Normalised Hessian eigenvalue below which a direction counts as unconstrained");
   odometry->add_option("--point-sigma", o->point_sigma_m,

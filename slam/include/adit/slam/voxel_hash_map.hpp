@@ -44,10 +44,15 @@ class VoxelHashMap {
 
   // capacity_voxels is rounded up to a power of two; the table is kept at
   // most 3/4 full (beyond that new voxels are refused and counted).
-  VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels);
+  // min_point_spacing_m > 0: a point closer than this to one already in its
+  // voxel is refused (KISS-ICP ≥ 1.0 uses voxel_size / sqrt(max points)).
+  // Without it a voxel keeps its first kMaxPointsPerVoxel points: the rings of
+  // the few scans that first saw it, repeated, and nothing of later scans.
+  VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m = 0.0F);
 
   // Adds points (map frame). A point lands in its voxel unless the voxel is
-  // full, or the table is; refused points are counted in dropped_points().
+  // full, or the table is, or (with a minimum spacing) a point of the voxel
+  // lies closer than it; refused points are counted in dropped_points().
   void add(std::span<const Eigen::Vector3f> points);
 
   // Removes every voxel whose first point is farther than max_distance_m from origin.
@@ -76,6 +81,7 @@ class VoxelHashMap {
   std::size_t point_count() const;
   std::uint64_t dropped_points() const { return dropped_points_; }
   float voxel_size() const { return voxel_size_; }
+  float min_point_spacing() const { return min_point_spacing_; }
   std::size_t capacity() const { return slots_.size(); }
 
   template <typename F>
@@ -111,6 +117,7 @@ class VoxelHashMap {
 
   float voxel_size_;
   float inverse_voxel_size_;
+  float min_point_spacing_;
   std::size_t mask_;
   std::size_t max_voxels_;
   std::size_t voxel_count_ = 0;
