@@ -137,7 +137,13 @@ struct LcmEndpoint::Impl final : TileSink {
       drain_poses();
       drain_status();
       TileUpdate t;
-      while (take_from(tiles, t)) publisher.update(t.key, t.points, t.utime);
+      while (take_from(tiles, t)) {
+        publisher.update(t.key, t.points, t.utime);
+        // take_from gives the slot what `t` held: it must be nothing, or each
+        // of the queue's slots would keep a whole tile's points (up to ~19 MB)
+        // until the producer comes round to it again.
+        std::vector<protocol::MapPoint>().swap(t.points);
+      }
       publisher.tick(Clock::now());
       const TilePublisherCounts& c = publisher.counts();
       counters.chunks_published = c.chunks_published;
