@@ -150,6 +150,7 @@ struct LcmEndpoint::Impl final : TileSink {
       counters.chunks_dropped_by_hook = c.chunks_dropped_by_hook;
       counters.chunk_bytes_published = c.chunk_bytes_published;
       counters.index_published = c.index_published;
+      counters.segment_read_errors = c.segment_read_errors;
     }
   }
 
@@ -239,7 +240,7 @@ struct LcmEndpoint::Impl final : TileSink {
     if (event == protocol::SessionEvent::start) {
       std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
       session_id = std::move(started);
-      publisher.reset(session_id);
+      publisher.reset(session_id, hooks.session_folder ? hooks.session_folder(session_id) : std::filesystem::path{});
       pose_seq = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
