@@ -11,6 +11,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
 #include "adit/daemon/payload_panel.hpp"
 #include "adit/daemon/sessions.hpp"
@@ -60,6 +61,7 @@ drivers::gpio::PayloadState panel_state(protocol::SessionState state, bool fault
 int run(const config::Config& config, const std::filesystem::path& config_file, const RunOptions& options) {
   log::info("configuration {}: payload '{}', lidar {} from {}", config_file.string(), config.payload.id,
             config.lidar.model, source_name(config.lidar.source));
+  if (!keep_large_blocks_mmapped()) log::warn("malloc: cannot fix the mmap threshold; a long session's RSS may creep");
 
   // SIGINT/SIGTERM are taken synchronously by this thread (sigtimedwait); the
   // workers inherit the blocked mask, so no handler runs on a hot path.

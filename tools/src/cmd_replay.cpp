@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "commands.hpp"
 #include "pipeline_run.hpp"
@@ -58,6 +59,7 @@ int replay(const ReplayOptions& o) {
   if (config.lidar.source == config::LidarSource::scan_dir && (o.realtime || o.speed > 0.0))
     throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
                      "a scan directory is replayed as fast as possible (the pipeline does not pace it)");
+  daemon::keep_large_blocks_mmapped();  // as aditd does, so the memory figures are aditd's
   daemon::PipelineOptions options;
   // Absolute: the pipeline creates the file's folder, and a bare name has none.
   if (!o.out.empty()) options.trajectory_file = std::filesystem::absolute(o.out);
