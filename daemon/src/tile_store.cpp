@@ -43,18 +43,77 @@ FileHandle::~FileHandle() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-TileStore::TileStore(protocol::TileParams params, const std::filesystem::path& spool_dir) : params_(params) {
-  // mkstemp then unlink: the file has no name, so nothing is left behind
-  // when the daemon stops or crashes, and its blocks are freed with the store.
-  std::string name = (spool_dir / ".tile-stream-XXXXXX").string();
+// mkstemp then unlink: the file has no name, so nothing is left behind when
+// the daemon stops or crashes, and its blocks are freed with the store.
+FileHandle TileStore::open_spool(const std::filesystem::path& dir, std::string& problem) {
+  std::string name = (dir / ".tile-stream-XXXXXX").string();
   const int fd = ::mkostemp(name.data(), O_CLOEXEC);
   if (fd < 0) {
-    spool_problem_ = fmt::format("{}: cannot create the tile stream's segment file: {}", name, errno_text());
-    return;
+    problem = fmt::format("{}: cannot create the tile stream's segment file: {}", name, errno_text());
+    return {};
   }
-  spool_ = FileHandle(fd);
   ::unlink(name.c_str());
   files_[0] = name;
+  return FileHandle(fd);
+}
+
+TileStore::TileStore(protocol::TileParams params, const std::filesystem::path& spool_dir,
+                     std::uint64_t spool_slack_bytes)
+    : params_(params), spool_dir_(spool_dir), spool_slack_bytes_(spool_slack_bytes) {
+  spool_ = open_spool(spool_dir, spool_problem_);
+}
+
+bool TileStore::write_all(int fd, std::span<const std::uint8_t> bytes, std::uint64_t offset) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::pwrite(fd, bytes.data() + done, bytes.size() - done, static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+// Frames replaced since they were appended stay in the file as garbage (a
+// tile read back from tiles/ comes reordered, so its full segments change);
+// once garbage exceeds the live frames and the slack, the live ones are
+// copied to a new file, so the file stays below twice the live frames plus
+// the slack. On any failure the old file stays in use.
+void TileStore::compact_spool() {
+  if (!spool_ || spool_bytes_ <= 2 * spool_live_bytes_ + spool_slack_bytes_) return;
+  std::string problem;
+  const std::filesystem::path old_name = files_[0];
+  FileHandle fresh = open_spool(spool_dir_, problem);
+  if (!fresh) {
+    files_[0] = old_name;
+    if (spool_write_errors_++ == 0) first_write_problem_ = problem;
+    spool_slack_bytes_ = spool_bytes_;  // do not retry at every update
+    return;
+  }
+  const std::filesystem::path new_name = files_[0];
+  files_[0] = old_name;  // read_frame reads the old file meanwhile
+  std::uint64_t at = 0;
+  std::vector<std::uint8_t> frame;
+  std::vector<std::pair<FrameLocation*, std::uint64_t>> moved;
+  for (auto& [id, tile] : tiles_) {
+    for (std::size_t s = 0; s < tile.where.size(); ++s) {
+      if (tile.where[s].file != 0) continue;
+      if (!read_frame(tile, s, frame).empty() || !write_all(fresh.get(), frame, at)) {
+        if (spool_write_errors_++ == 0)
+          first_write_problem_ = fmt::format("{}: cannot compact the tile stream's segment file", new_name.string());
+        spool_slack_bytes_ = spool_bytes_;
+        return;
+      }
+      moved.emplace_back(&tile.where[s], at);
+      at += frame.size();
+    }
+  }
+  for (auto& [where, offset] : moved) where->offset = offset;
+  spool_ = std::move(fresh);
+  files_[0] = new_name;
+  spool_bytes_ = at;
+  spool_live_bytes_ = at;
+  ++spool_compactions_;
 }
 
 void TileStore::spill_frames(EncodedTile& tile, std::size_t first) {
@@ -64,22 +123,14 @@ void TileStore::spill_frames(EncodedTile& tile, std::size_t first) {
     // The last, partial segment changes at almost every update: it stays.
     if (segment.n_points < tile.params.segment_points || segment.frame.empty()) continue;
     const std::size_t size = segment.frame.size();
-    std::size_t done = 0;
-    while (done < size) {
-      const ssize_t n = ::pwrite(spool_.get(), segment.frame.data() + done, size - done,
-                                 static_cast<off_t>(spool_bytes_ + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      done += static_cast<std::size_t>(n);
-    }
-    if (done < size) {  // disk full or failing: this frame stays in RAM
+    if (!write_all(spool_.get(), segment.frame, spool_bytes_)) {  // disk full or failing: this frame stays in RAM
       if (spool_write_errors_++ == 0)
-        first_write_problem_ = fmt::format("{}: cannot append a tile segment: {}", files_[0].string(),
-                                           done == 0 && errno != 0 ? errno_text() : "short write");
+        first_write_problem_ = fmt::format("{}: cannot append a tile segment: {}", files_[0].string(), errno_text());
       continue;
     }
     tile.where[s] = {0, static_cast<std::uint32_t>(size), spool_bytes_};
     spool_bytes_ += size;
+    spool_live_bytes_ += size;
     std::vector<std::uint8_t>().swap(segment.frame);
   }
 }
@@ -93,13 +144,14 @@ bool TileStore::update(protocol::TileKey key, std::span<const protocol::MapPoint
   // those whose frames are in a file need not be read back.
   const std::uint64_t before = ram_frame_bytes(tile);
   const std::size_t first = protocol::update_segments(key, points, params_, tile.version + 1, tile.segments);
+  if (first == tile.segments.size() && tile.where.size() == tile.segments.size()) return false;
+  // From `first` on, the old frames are replaced (or gone): garbage in the spool.
+  for (std::size_t s = first; s < tile.where.size(); ++s)
+    if (tile.where[s].file == 0) spool_live_bytes_ -= tile.where[s].bytes;
   tile.where.resize(tile.segments.size());
-  if (first == tile.segments.size()) {
-    frame_bytes_in_ram_ = frame_bytes_in_ram_ - before + ram_frame_bytes(tile);
-    return false;
-  }
   for (std::size_t s = first; s < tile.where.size(); ++s) tile.where[s] = {};  // the new frames are in RAM
   spill_frames(tile, first);
+  compact_spool();
   frame_bytes_in_ram_ = frame_bytes_in_ram_ - before + ram_frame_bytes(tile);
   total_points_ += static_cast<std::int64_t>(points.size()) - tile.n_points;
   tile.version += 1;
@@ -122,6 +174,8 @@ std::string TileStore::insert_blob(std::int64_t id, std::span<const std::uint8_t
   for (const protocol::TileSegment& s : segments) n_points += s.n_points;
   EncodedTile& tile = tiles_[id];
   frame_bytes_in_ram_ -= ram_frame_bytes(tile);
+  for (const FrameLocation& where : tile.where)
+    if (where.file == 0) spool_live_bytes_ -= where.bytes;
   total_points_ += n_points - tile.n_points;
   tile.id = id;
   tile.version = 1;

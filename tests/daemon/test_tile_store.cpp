@@ -85,6 +85,15 @@ void expect_only_partial_segments_in_ram(const TileStore& store) {
   EXPECT_EQ(store.frame_bytes_in_ram(), partial);
 }
 
+// The spool's live frames: those of segments whose frame is in file 0.
+std::uint64_t spooled_frame_bytes(const TileStore& store) {
+  std::uint64_t bytes = 0;
+  for (const auto& [id, tile] : store.tiles())
+    for (const FrameLocation& where : tile.where)
+      if (where.file == 0) bytes += where.bytes;
+  return bytes;
+}
+
 TEST(TileStore, SegmentsInTheSpoolFileServeTheSameBytesAsSegmentsInRam) {
   TemporaryFolder folder;
   TileStore in_ram({});
@@ -113,10 +122,32 @@ TEST(TileStore, SegmentsInTheSpoolFileServeTheSameBytesAsSegmentsInRam) {
   EXPECT_GT(in_ram.frame_bytes_in_ram(), 4 * spooled.frame_bytes_in_ram()) << "13 segments, two partial";
   EXPECT_EQ(spooled.spool_write_errors(), 0u);
   EXPECT_GE(spooled.spool_bytes(), in_ram.frame_bytes_in_ram() - spooled.frame_bytes_in_ram());
+  EXPECT_EQ(spooled.spool_live_bytes(), spooled_frame_bytes(spooled));
 
   // Moved, it still reads its file.
   TileStore moved = std::move(spooled);
   expect_same_tiles(in_ram, moved);
+}
+
+TEST(TileStore, TheSpoolFileIsRewrittenWithItsLiveFramesOnceGarbageOutgrowsThem) {
+  TemporaryFolder folder;
+  TileStore in_ram({});
+  TileStore spooled({}, folder.path(), 0);  // no slack: compact as soon as garbage exceeds the live frames
+  std::vector<protocol::MapPoint> a = random_points(8000, 3);
+  for (int step = 0; step < 6; ++step) {
+    std::reverse(a.begin(), a.begin() + 6000);  // reordered: every full segment changes
+    const auto more = random_points(500, 40 + step);
+    a.insert(a.end(), more.begin(), more.end());
+    ASSERT_TRUE(in_ram.update({0, 0, 0}, a, step));
+    ASSERT_TRUE(spooled.update({0, 0, 0}, a, step));
+    expect_same_tiles(in_ram, spooled);
+    expect_only_partial_segments_in_ram(spooled);
+    EXPECT_EQ(spooled.spool_live_bytes(), spooled_frame_bytes(spooled));
+    EXPECT_LE(spooled.spool_bytes(), 2 * spooled.spool_live_bytes());
+  }
+  EXPECT_GE(spooled.spool_compactions(), 2u);
+  EXPECT_EQ(spooled.spool_write_errors(), 0u);
+  EXPECT_TRUE(std::filesystem::is_empty(folder.path())) << "the rewritten file has no name either";
 }
 
 TEST(TileStore, WithoutItsSpoolFolderFramesStayInRamAndTheReasonNamesTheFolder) {

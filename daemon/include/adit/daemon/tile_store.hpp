@@ -83,8 +83,11 @@ class TileStore {
   // Every frame in RAM.
   explicit TileStore(protocol::TileParams params) : params_(params) {}
   // Full segments' frames in an unnamed file in `spool_dir`. When it cannot
-  // be made, frames stay in RAM and spool_problem() says why.
-  TileStore(protocol::TileParams params, const std::filesystem::path& spool_dir);
+  // be made, frames stay in RAM and spool_problem() says why. The file is
+  // rewritten with only its live frames when it exceeds twice them plus
+  // `spool_slack_bytes`.
+  TileStore(protocol::TileParams params, const std::filesystem::path& spool_dir,
+            std::uint64_t spool_slack_bytes = std::uint64_t{32} << 20);
 
   // The new whole content of tile `key` (append order): only the segments
   // that changed are re-encoded. The version goes up by one when anything
@@ -108,8 +111,11 @@ class TileStore {
 
   // Frame bytes held in RAM (what grows with the session without a spool).
   std::uint64_t frame_bytes_in_ram() const { return frame_bytes_in_ram_; }
-  // Bytes appended to the spool so far (live frames and those replaced since).
+  // The spool file's size (live frames and those replaced since), its live
+  // frames, and how many times it was rewritten with only those.
   std::uint64_t spool_bytes() const { return spool_bytes_; }
+  std::uint64_t spool_live_bytes() const { return spool_live_bytes_; }
+  std::uint64_t spool_compactions() const { return spool_compactions_; }
   bool spooling() const { return static_cast<bool>(spool_); }
   // Why there is no spool although a folder was given ("" otherwise).
   const std::string& spool_problem() const { return spool_problem_; }
@@ -122,6 +128,9 @@ class TileStore {
   // (Full: tile.params.segment_points.)
   void spill_frames(EncodedTile& tile, std::size_t first);
   std::string insert_blob(std::int64_t id, std::span<const std::uint8_t> blob, std::int64_t utime, bool spill);
+  FileHandle open_spool(const std::filesystem::path& dir, std::string& problem);
+  static bool write_all(int fd, std::span<const std::uint8_t> bytes, std::uint64_t offset);
+  void compact_spool();
 
   protocol::TileParams params_;
   std::map<std::int64_t, EncodedTile> tiles_;
@@ -130,7 +139,11 @@ class TileStore {
   // files_[0] is the spool ("" when none); others are stored tiles' files.
   std::vector<std::filesystem::path> files_{std::filesystem::path{}};
   FileHandle spool_;
+  std::filesystem::path spool_dir_;
+  std::uint64_t spool_slack_bytes_ = 0;
   std::uint64_t spool_bytes_ = 0;
+  std::uint64_t spool_live_bytes_ = 0;
+  std::uint64_t spool_compactions_ = 0;
   std::string spool_problem_;
   std::uint64_t spool_write_errors_ = 0;
   std::string first_write_problem_;
