@@ -137,13 +137,20 @@ struct LcmEndpoint::Impl final : TileSink {
       drain_poses();
       drain_status();
       TileUpdate t;
-      while (take_from(tiles, t)) publisher.update(t.key, t.points, t.utime);
+      while (take_from(tiles, t)) {
+        publisher.update(t.key, t.points, t.utime);
+        // take_from gives the slot what `t` held: it must be nothing, or each
+        // of the queue's slots would keep a whole tile's points (up to ~19 MB)
+        // until the producer comes round to it again.
+        std::vector<protocol::MapPoint>().swap(t.points);
+      }
       publisher.tick(Clock::now());
       const TilePublisherCounts& c = publisher.counts();
       counters.chunks_published = c.chunks_published;
       counters.chunks_dropped_by_hook = c.chunks_dropped_by_hook;
       counters.chunk_bytes_published = c.chunk_bytes_published;
       counters.index_published = c.index_published;
+      counters.segment_read_errors = c.segment_read_errors;
     }
   }
 
@@ -233,7 +240,7 @@ struct LcmEndpoint::Impl final : TileSink {
     if (event == protocol::SessionEvent::start) {
       std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
       session_id = std::move(started);
-      publisher.reset(session_id);
+      publisher.reset(session_id, hooks.session_folder ? hooks.session_folder(session_id) : std::filesystem::path{});
       pose_seq = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {

@@ -509,10 +509,17 @@ struct Pipeline::Impl {
     stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
   }
 
+  // The whole tiles these functions read back or write (compact, evict,
+  // restore, flush) live in a buffer local to each call, freed on return: a
+  // buffer kept as a member held the capacity of the largest tile of the
+  // session (24 B a point), resident between uses, and grew with the map
+  // (+28 MB in steps over the 30-minute simulated drive).
+  //
   // Mapping thread: a tile holding too many voxels in RAM is written out,
   // evicted and restored at once: its points go to its file and only a bit
   // per voxel stays (unconfirmed voxels are lost, as on eviction).
   void compact_tiles(const std::vector<slam::TileCoord>& coords) {
+    std::vector<slam::MapSample> tile_buffer;  // whole tiles, freed on return (see compact_tiles)
     for (const slam::TileCoord& coord : coords) {
       std::string problem = spill->whole_tile(map, coord, tile_buffer);
       if (problem.empty()) problem = spill->write(coord, tile_buffer);
@@ -532,6 +539,7 @@ struct Pipeline::Impl {
   // that cannot be read stays evicted (its file intact) and add() skips the
   // points that fall into it (counted).
   void restore_tiles(const std::vector<slam::TileCoord>& coords) {
+    std::vector<slam::MapSample> tile_buffer;  // whole tiles, freed on return (see compact_tiles)
     for (const slam::TileCoord& coord : coords) {
       if (const std::string problem = spill->read(coord, tile_buffer); !problem.empty()) {
         if (stats.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
@@ -548,6 +556,7 @@ struct Pipeline::Impl {
   // A restored tile's file holds its stored part: it is rewritten with the new
   // points appended, or left as it is when nothing is new.
   void evict_tiles(const std::vector<slam::TileCoord>& coords) {
+    std::vector<slam::MapSample> tile_buffer;  // whole tiles, freed on return (see compact_tiles)
     for (const slam::TileCoord& coord : coords) {
       const bool restored = map.stored_points(coord) > 0;
       if (!restored || !map.tile(coord).empty()) {
@@ -570,6 +579,7 @@ struct Pipeline::Impl {
   void flush_tiles() {
     const std::vector<slam::TileCoord> changed = map.take_changed();
     if (!options.sinks.tile) return;
+    std::vector<slam::MapSample> tile_buffer;  // whole tiles, freed on return (see compact_tiles)
     for (const slam::TileCoord& coord : changed) {
       if (!spill || map.stored_points(coord) == 0) {
         options.sinks.tile(coord, map.tile(coord));
@@ -640,7 +650,6 @@ struct Pipeline::Impl {
   slam::TiledVoxelMap map;
   slam::TileEviction eviction;
   std::optional<TileSpill> spill;          // set by start() when the session has a tiles folder
-  std::vector<slam::MapSample> tile_buffer;  // a tile read back
   std::uint64_t keyframe_bytes = 0;
   std::filesystem::path keyframes_dir;  // set by start(); empty = keyframe scans stay in RAM
   std::size_t keyframes_in_ram_from = 0;  // keyframes before this one had their scans written out

@@ -11,6 +11,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
 #include "adit/daemon/payload_panel.hpp"
 #include "adit/daemon/sessions.hpp"
@@ -60,6 +61,7 @@ drivers::gpio::PayloadState panel_state(protocol::SessionState state, bool fault
 int run(const config::Config& config, const std::filesystem::path& config_file, const RunOptions& options) {
   log::info("configuration {}: payload '{}', lidar {} from {}", config_file.string(), config.payload.id,
             config.lidar.model, source_name(config.lidar.source));
+  if (!keep_large_blocks_mmapped()) log::warn("malloc: cannot fix the mmap threshold; a long session's RSS may creep");
 
   // SIGINT/SIGTERM are taken synchronously by this thread (sigtimedwait); the
   // workers inherit the blocked mask, so no handler runs on a hot path.
@@ -114,6 +116,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     return files;
   };
   hooks.load_tiles = [&sessions](const std::string& id, TileStore& into) { return sessions.load_tiles(id, into); };
+  hooks.session_folder = [&sessions](const std::string& id) { return sessions.folder(id); };
   auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));
   endpoint_ptr.store(endpoint.get());
   log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);

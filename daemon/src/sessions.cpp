@@ -313,12 +313,11 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
     std::int64_t tile_id = 0;
     const std::string stem = entry.path().stem().string();
     const auto [end, err] = std::from_chars(stem.data(), stem.data() + stem.size(), tile_id);
-    std::ifstream in(entry.path(), std::ios::binary);
-    std::vector<std::uint8_t> blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Only the tile's segment table stays in RAM; its frames are read from the file when sent.
     const std::string problem = err != std::errc{} || end != stem.data() + stem.size()
-                                    ? "not named <tile id>.adt"
-                                    : into.insert_encoded(tile_id, blob, protocol::now_utime());
-    if (!problem.empty() && bad++ == 0) first_problem = entry.path().string() + ": " + problem;
+                                    ? entry.path().string() + ": not named <tile id>.adt"
+                                    : into.insert_file(tile_id, entry.path(), protocol::now_utime());
+    if (!problem.empty() && bad++ == 0) first_problem = problem;
   }
   if (bad > 0)
     log::warn("session {}: {} stored tile files are unreadable and were skipped (first: {})", id, bad, first_problem);

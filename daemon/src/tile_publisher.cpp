@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "adit/common/log.hpp"
+
 namespace adit::daemon {
 namespace {
 
@@ -26,9 +28,16 @@ TilePublisher::TilePublisher(TilePublisherOptions options, TileSink& sink)
       budget_bytes_(kBurstBytes),
       drop_rng_(options_.drop_seed) {}
 
-void TilePublisher::reset(std::string session_id) {
+void TilePublisher::reset(std::string session_id, const std::filesystem::path& spool_dir) {
   session_id_ = std::move(session_id);
-  store_ = TileStore(options_.tiles);
+  store_ = TileStore(options_.tiles);  // the last session's spool goes first
+  if (!spool_dir.empty()) {
+    store_ = TileStore(options_.tiles, spool_dir);
+    if (!store_.spool_problem().empty())
+      log::error("tile stream: {} (segments stay in RAM this session)", store_.spool_problem());
+  }
+  reported_write_errors_ = 0;
+  session_read_errors_ = 0;
   dirty_.clear();
   broadcast_version_.clear();
   outgoing_.clear();
@@ -37,6 +46,9 @@ void TilePublisher::reset(std::string session_id) {
 
 void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime) {
   if (store_.update(key, points, utime)) dirty_.insert(protocol::tile_id(key));
+  if (store_.spool_write_errors() > 0 && reported_write_errors_ == 0)
+    log::error("tile stream: {} (such segments stay in RAM)", store_.first_write_problem());
+  reported_write_errors_ = store_.spool_write_errors();
 }
 
 void TilePublisher::answer(const tile_request_t& request) {
@@ -174,13 +186,20 @@ void TilePublisher::send_chunks(Clock::time_point now) {
     // The tile may have changed since this was queued: its current segment
     // goes out, with what a holder of `base` lacks at the current version.
     if (base >= tile->version) base = 0;
-    const protocol::TileSegment& segment = tile->segments[static_cast<std::size_t>(ref.segment)];
-    budget_bytes_ -= static_cast<double>(segment.frame.size());
+    budget_bytes_ -= static_cast<double>(tile->frame_bytes(static_cast<std::size_t>(ref.segment)));
     if (options_.drop_fraction > 0 && unit_(drop_rng_) < options_.drop_fraction) {
       ++counts_.chunks_dropped_by_hook;
       continue;
     }
     tile_segment_t m;
+    // A segment that cannot be read is not sent: the client asks again, and
+    // the error (naming the file) is counted and logged once per session.
+    if (const std::string problem = store_.read_frame(*tile, static_cast<std::size_t>(ref.segment), m.data);
+        !problem.empty()) {
+      ++counts_.segment_read_errors;
+      if (session_read_errors_++ == 0) log::error("tile stream: {}", problem);
+      continue;
+    }
     m.utime = tile->utime;
     m.schema = 2;
     m.payload_id = options_.payload_id;
@@ -194,7 +213,6 @@ void TilePublisher::send_chunks(Clock::time_point now) {
     m.n_points = tile->n_points;
     m.tile_size_m = static_cast<float>(tile->params.tile_size_m);
     m.quantum_m = static_cast<float>(tile->params.quantum_m);
-    m.data = segment.frame;
     m.size = static_cast<std::int32_t>(m.data.size());
     sink_.send(m);
     ++counts_.chunks_published;

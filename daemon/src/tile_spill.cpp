@@ -52,30 +52,62 @@ std::string TileSpill::write(const slam::TileCoord& coord, std::span<const slam:
 }
 
 std::string TileSpill::read(const slam::TileCoord& coord, std::vector<slam::MapSample>& out) const {
+  return read_into(coord, out, 0);
+}
+
+// A tile of ~1 M points is 24 MB as samples: it is decoded one segment at a
+// time (≤ 4096 points), with `out` reserved once for the whole tile plus
+// `extra`, rather than through a whole-tile vector of protocol::MapPoint
+// (40 B a point) and a vector that grows by doubling.
+std::string TileSpill::read_into(const slam::TileCoord& coord, std::vector<slam::MapSample>& out,
+                                 std::size_t extra) const {
   out.clear();
   const std::filesystem::path file = file_of(coord);
-  std::ifstream in(file, std::ios::binary);
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) return fmt::format("{}: cannot open the tile", file.string());
-  const std::vector<std::uint8_t> blob((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::vector<protocol::MapPoint> points;
-  if (std::string problem = protocol::decode_tile(blob, {coord.x, coord.y, coord.z}, points); !problem.empty())
+  const std::streamoff size = in.tellg();
+  in.seekg(0);
+  std::vector<std::uint8_t> blob(size > 0 ? static_cast<std::size_t>(size) : 0);
+  in.read(reinterpret_cast<char*>(blob.data()), static_cast<std::streamsize>(blob.size()));
+  if (size < 0 || !in) return fmt::format("{}: cannot read the tile", file.string());
+  const protocol::TileKey key{coord.x, coord.y, coord.z};
+  protocol::TileParams params = params_;
+  std::vector<protocol::TileSegment> segments;
+  if (std::string problem = protocol::unpack_tile(blob, key, params, segments); !problem.empty())
     return fmt::format("{}: {}", file.string(), problem);
+  std::vector<std::uint8_t>().swap(blob);  // the segments hold copies of its frames
+  std::size_t n = 0;
+  for (const protocol::TileSegment& segment : segments) n += segment.n_points;
   const auto time = newest_time_s_.find(coord);
   const double time_s = time == newest_time_s_.end() ? 0.0 : time->second;
-  out.reserve(points.size());
-  for (const protocol::MapPoint& p : points)
-    out.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
-                   p.intensity, time_s});
+  out.reserve(n + extra);
+  std::vector<protocol::MapPoint> points;
+  points.reserve(protocol::kMaxSegmentPoints);
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    points.clear();
+    if (std::string problem = protocol::decode_segment(segments[s].frame, key, params.tile_size_m, params.quantum_m, points);
+        !problem.empty()) {
+      out.clear();
+      return fmt::format("{}: tile's segment {}: {}", file.string(), s, problem);
+    }
+    std::vector<std::uint8_t>().swap(segments[s].frame);
+    for (const protocol::MapPoint& p : points)
+      out.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
+                     p.intensity, time_s});
+  }
   return "";
 }
 
 std::string TileSpill::whole_tile(const slam::TiledVoxelMap& map, const slam::TileCoord& coord,
                                   std::vector<slam::MapSample>& out) const {
   out.clear();
-  if (map.is_evicted(coord) || map.stored_points(coord) > 0) {
-    if (std::string problem = read(coord, out); !problem.empty()) return problem;
-  }
   const std::span<const slam::MapSample> held = map.tile(coord);
+  if (map.is_evicted(coord) || map.stored_points(coord) > 0) {
+    // Room for what the map holds too: inserting it would double the capacity.
+    if (std::string problem = read_into(coord, out, held.size()); !problem.empty()) return problem;
+  } else {
+    out.reserve(held.size());
+  }
   out.insert(out.end(), held.begin(), held.end());
   return "";
 }

@@ -36,6 +36,21 @@ TEST(MemoryGrowth, SkipsPosesThatWereNotSampled) {
   EXPECT_NEAR(g->percent(), 100.0 / 21.0, 1e-9);
 }
 
+TEST(MemoryGrowth, GivesMallocsBytesInUseFromTheFirstHeapSampleOnAndTheMapsSize) {
+  // The heap is walked every few samples only (heap_mb < 0 elsewhere).
+  const std::vector<MemorySample> samples{
+      {0, 10.0, 5.0, 1.0}, {10, 20.0, -1.0, 2.0}, {12, 21.0, 8.0, 3.0}, {20, 22.0, -1.0, 4.0}, {30, 23.0, 9.0, 6.0}};
+  const auto g = memory_growth(samples, 0.3);
+  ASSERT_TRUE(g);
+  EXPECT_EQ(g->from_pose, 10U);
+  EXPECT_DOUBLE_EQ(g->heap_from_mb, 8.0) << "the first heap sample from pose 10 on";
+  EXPECT_DOUBLE_EQ(g->heap_end_mb, 9.0);
+  EXPECT_DOUBLE_EQ(g->map_from_mb, 2.0);
+  EXPECT_DOUBLE_EQ(g->map_end_mb, 6.0);
+  const std::string text = figures_text(PipelineFigures{.memory = samples}, 0.3);
+  EXPECT_NE(text.find("malloc in use 8.0 -> 9.0 MB, map tiles 2.0 -> 6.0 MB"), std::string::npos) << text;
+}
+
 TEST(PipelineConfig, CommandLineOverridesTheFile) {
   const test::TempFile file(
       "payload:\n  id: t\nlidar:\n  model: VLP-16\n  source: udp\n  calibration: cal.yaml\n", ".yaml");

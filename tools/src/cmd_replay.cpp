@@ -5,11 +5,13 @@
 #include <stdlib.h>
 
 #include <filesystem>
+#include <fstream>
 #include <optional>
 
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "commands.hpp"
 #include "pipeline_run.hpp"
@@ -25,6 +27,7 @@ struct ReplayOptions {
   bool json = false;
   double memory_from = 0.1;
   std::string session_dir;  // empty: a temporary folder, removed at the end
+  std::string memory_csv;   // empty: none
 };
 
 // A fresh folder under the system's temporary directory, removed when done.
@@ -56,6 +59,7 @@ int replay(const ReplayOptions& o) {
   if (config.lidar.source == config::LidarSource::scan_dir && (o.realtime || o.speed > 0.0))
     throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
                      "a scan directory is replayed as fast as possible (the pipeline does not pace it)");
+  daemon::keep_large_blocks_mmapped();  // as aditd does, so the memory figures are aditd's
   daemon::PipelineOptions options;
   // Absolute: the pipeline creates the file's folder, and a bare name has none.
   if (!o.out.empty()) options.trajectory_file = std::filesystem::absolute(o.out);
@@ -69,6 +73,15 @@ int replay(const ReplayOptions& o) {
   files.keyframes_dir = dir / "keyframes";
   const PipelineFigures figures = run_pipeline(pipeline, {}, files);
   for (const std::string& warning : pipeline.warnings()) fmt::print(stderr, "adit replay: {}\n", warning);
+  if (!o.memory_csv.empty()) {
+    std::ofstream csv(o.memory_csv);
+    csv << "poses,resident_mb,heap_in_use_mb,map_mb\n";
+    for (const MemorySample& m : figures.memory)
+      csv << fmt::format("{},{:.2f},{},{:.2f}\n", m.poses, m.resident_mb, m.heap_mb < 0 ? "" : fmt::format("{:.2f}", m.heap_mb),
+                         m.map_mb);
+    csv.close();
+    if (!csv) throw InputError(o.memory_csv, "--memory-csv", "cannot write the memory samples");
+  }
   if (o.json) {
     nlohmann::json j = figures_json(figures, o.memory_from);
     j["trajectory"] = o.out;
@@ -111,6 +124,9 @@ void register_replay_commands(CLI::App& app, int& status) {
                   "Resident growth is measured from this fraction of the poses (local map full) to the end")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_option("--memory-csv", o->memory_csv,
+                  "Write the memory samples here: poses, resident MB, malloc's bytes in use (every 50th sample), "
+                  "the tiled map's MB");
   cmd->callback([o, &status] { status = replay(*o); });
 }
 

@@ -50,13 +50,16 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
     }
     const std::uint64_t poses = s.poses.load(std::memory_order_relaxed);
     if (poses != sampled_poses && f.memory.size() < f.memory.capacity()) {
-      f.memory.push_back({poses, resident_mb()});
+      // The heap walk locks the arenas the pipeline allocates from: every
+      // 50th sample only (about every 5 s of data).
+      f.memory.push_back({poses, resident_mb(), f.memory.size() % 50 == 0 ? heap_in_use_mb() : -1.0,
+                          1e-6 * static_cast<double>(s.map_bytes.load(std::memory_order_relaxed))});
       sampled_poses = poses;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   pipeline.join();
-  f.memory.push_back({s.poses.load(), resident_mb()});
+  f.memory.push_back({s.poses.load(), resident_mb(), heap_in_use_mb(), 1e-6 * static_cast<double>(s.map_bytes.load())});
 
   f.datagrams = s.datagrams.load();
   f.scans = s.scans.load();
@@ -106,6 +109,11 @@ std::optional<MemoryGrowth> memory_growth(const std::vector<MemorySample>& sampl
   g.from_pose = first->poses;
   g.from_mb = first->resident_mb;
   g.end_mb = samples.back().resident_mb;
+  const auto heap = std::find_if(first, samples.end(), [](const MemorySample& m) { return m.heap_mb >= 0.0; });
+  if (heap != samples.end()) g.heap_from_mb = heap->heap_mb;
+  g.heap_end_mb = samples.back().heap_mb;
+  g.map_from_mb = first->map_mb;
+  g.map_end_mb = samples.back().map_mb;
   g.max_mb = std::max_element(first, samples.end(), [](const MemorySample& a, const MemorySample& b) {
                return a.resident_mb < b.resident_mb;
              })->resident_mb;
@@ -133,7 +141,9 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
   };
   if (const auto g = memory_growth(f.memory, from_fraction))
     j["resident_growth"] = {{"from_pose", g->from_pose}, {"from_mb", g->from_mb}, {"end_mb", g->end_mb},
-                            {"max_mb", g->max_mb},       {"percent", g->percent()}, {"samples", f.memory.size()}};
+                            {"max_mb", g->max_mb},       {"percent", g->percent()}, {"samples", f.memory.size()},
+                            {"heap_in_use_from_mb", g->heap_from_mb}, {"heap_in_use_end_mb", g->heap_end_mb},
+                            {"map_from_mb", g->map_from_mb}, {"map_end_mb", g->map_end_mb}};
   if (f.mapping)
     j["map"] = {{"points", f.map_points},           {"tiles", f.map_tiles},
                 {"resident_tiles", f.resident_tiles}, {"evicted_tiles", f.evicted_tiles},
@@ -159,6 +169,9 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
   if (const auto g = memory_growth(f.memory, from_fraction))
     text += fmt::format("; resident {:.1f} MB at pose {} -> {:.1f} MB at the end ({:+.2f} %, max {:.1f} MB)",
                         g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb);
+  if (const auto g = memory_growth(f.memory, from_fraction); g && g->heap_from_mb >= 0.0 && g->heap_end_mb >= 0.0)
+    text += fmt::format("; malloc in use {:.1f} -> {:.1f} MB, map tiles {:.1f} -> {:.1f} MB", g->heap_from_mb,
+                        g->heap_end_mb, g->map_from_mb, g->map_end_mb);
   if (f.mapping)
     text += fmt::format(
         "\nmap: {} points in {} tiles, {} resident ({:.1f} MB); {} evictions, {} reloads, {} compactions, {} "

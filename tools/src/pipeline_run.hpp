@@ -34,6 +34,8 @@ config::Config load_pipeline_config(const PipelineInputs& inputs);
 struct MemorySample {
   std::uint64_t poses = 0;  // poses handed on when sampled
   double resident_mb = 0.0;
+  double heap_mb = -1.0;  // malloc's bytes in use; < 0: not sampled at this pose
+  double map_mb = 0.0;    // the mapping thread's tiles in RAM (as of its last keyframe)
 };
 
 struct PipelineFigures {
@@ -93,6 +95,12 @@ struct MemoryGrowth {
   double from_mb = 0.0;
   double end_mb = 0.0;
   double max_mb = 0.0;  // the largest sample from from_pose on
+  // malloc's bytes in use at the first heap sample from from_pose on and at
+  // the end (< 0: not known): resident growth beyond theirs is the allocator's.
+  double heap_from_mb = -1.0;
+  double heap_end_mb = -1.0;
+  double map_from_mb = 0.0;  // the tiled map's own figure, at from_pose and at the end
+  double map_end_mb = 0.0;
   double percent() const { return from_mb > 0.0 ? 100.0 * (end_mb - from_mb) / from_mb : 0.0; }
 };
 std::optional<MemoryGrowth> memory_growth(const std::vector<MemorySample>& samples, double from_fraction);

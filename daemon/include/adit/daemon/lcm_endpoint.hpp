@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -71,6 +72,9 @@ struct SessionHooks {
   // A download of a stored session (not the one in memory): fills `into`
   // from its folder; returns "" or why not. Called only while IDLE.
   std::function<std::string(const std::string& session, TileStore& into)> load_tiles;
+  // The folder of a session just started: the tile stream keeps its segments
+  // in a file there rather than in RAM. Empty (or unset): in RAM.
+  std::function<std::filesystem::path(const std::string& session)> session_folder;
 };
 
 struct EndpointOptions {
@@ -96,6 +100,7 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> chunks_dropped_by_hook{0};
   std::atomic<std::uint64_t> chunk_bytes_published{0};
   std::atomic<std::uint64_t> index_published{0};
+  std::atomic<std::uint64_t> segment_read_errors{0};  // tile segments whose file could not be read
   std::atomic<std::uint64_t> commands_executed{0};
   std::atomic<std::uint64_t> commands_rejected{0};
   std::atomic<std::uint64_t> commands_replayed{0};

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <random>
@@ -49,6 +50,7 @@ struct TilePublisherCounts {
   std::uint64_t chunks_dropped_by_hook = 0;
   std::uint64_t chunk_bytes_published = 0;  // encoded tile_segment_t bytes
   std::uint64_t index_published = 0;
+  std::uint64_t segment_read_errors = 0;  // segments not sent: their file could not be read
 };
 
 class TilePublisher {
@@ -57,8 +59,10 @@ class TilePublisher {
 
   TilePublisher(TilePublisherOptions options, TileSink& sink);
 
-  // A new session: forgets every tile and everything queued.
-  void reset(std::string session_id);
+  // A new session: forgets every tile and everything queued. With a
+  // `spool_dir` (the session's folder), full segments' frames are kept in a
+  // file there instead of RAM (TileStore).
+  void reset(std::string session_id, const std::filesystem::path& spool_dir = {});
   // The whole new content of tile `key`, append order (its version goes up
   // by one when it changed).
   void update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
@@ -101,6 +105,8 @@ class TilePublisher {
   std::mt19937 drop_rng_;
   std::uniform_real_distribution<double> unit_{0.0, 1.0};
   TilePublisherCounts counts_;
+  std::uint64_t reported_write_errors_ = 0;  // spool write errors already logged this session
+  std::uint64_t session_read_errors_ = 0;    // this session's, the first is logged
 };
 
 }  // namespace adit::daemon

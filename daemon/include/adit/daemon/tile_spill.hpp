@@ -43,6 +43,9 @@ class TileSpill {
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
+  // read() leaving room for `extra` more points in `out`.
+  std::string read_into(const slam::TileCoord& coord, std::vector<slam::MapSample>& out, std::size_t extra) const;
+
   std::filesystem::path dir_;
   protocol::TileParams params_;
   std::map<slam::TileCoord, double> newest_time_s_;
