@@ -212,13 +212,14 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
       (folder / "trajectory.tum").string()));
   ASSERT_EQ(eval.status, 0) << eval.output;
   const nlohmann::json accuracy = nlohmann::json::parse(eval.output.substr(eval.output.find('{')));
-  // The target is 95 % within 5 cm; it is NOT met today: this run
-  // measured 89.9 % (88.5-88.9 % over the whole 12 s drive, docs/ARCHITECTURE.md).
+  // The target: 95 % within 5 cm. This window (the first ~6 s of the
+  // drive) measured 95.54-95.57 % in three runs since the odometry's map keeps
+  // 0.08 m between a voxel's points (92.9 % before, main at dcc82d0);
+  // the whole 12 s drive gives 93.3 % and the 60 s demo's drive 85.2 %, so the
+  // target is met here, not in general (docs/ARCHITECTURE.md, docs/ODOMETRY.md).
   // Mapping itself reaches 98.4 % with the true poses; what is left is the
-  // odometry's roll/pitch lag (0.25-0.30° rms, docs/ODOMETRY.md) at range.
-  // This floor catches a regression (without the wheel prior the figure was
-  // 23 %); raise it as the odometry improves.
-  EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.85) << accuracy.dump();
+  // odometry's roll/pitch lag and, on longer drives, its position drift.
+  EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.95) << accuracy.dump();
   RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
 
   EXPECT_EQ(aditd.stop(), 0);

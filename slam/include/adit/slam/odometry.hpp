@@ -35,10 +35,11 @@ struct OdometryConfig {
   // few scans that first saw it, and point-to-plane then prefers those scans'
   // attitude). KISS-ICP ≥ 1.0 refuses points closer than voxel / sqrt(20)
   // (0.112 m here). Measured (docs/ODOMETRY.md, "The robot's roll and pitch
-  // lag the truth"): 0.08 m lowers the robot's pitch lag on the simulated mine
-  // by a third to a half and lifts its map by 3-6 points, with the featureless
-  // drift unchanged; 0.112 m did as well on short drives but let a wheel spin
-  // through on a 120 s drive and cost the drift's map 16 points.
+  // lag the truth"): 0.08 m lowers the robot's pitch lag on the 12 s and 60 s
+  // mine drives (0.29° → 0.24°, 0.24° → 0.13°; not on 120 s) and lifts the
+  // mine maps by 3-6 points, with the featureless drift unchanged; 0.112 m did
+  // better on the 12 s drive but let a wheel spin through on a 120 s drive
+  // and cost the drift's map 16 points.
   float map_point_spacing_m = 0.08F;
   std::size_t max_scan_points = 400'000; // beyond this a scan is cut (counted)
   std::size_t min_registration_points = 100;
