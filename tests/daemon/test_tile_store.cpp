@@ -3,7 +3,6 @@
 // partial segment (or nothing for a stored session's files), and reports I/O
 // failures naming the file instead of crashing.
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <chrono>
 #include <filesystem>
@@ -12,28 +11,10 @@
 
 #include "adit/daemon/tile_publisher.hpp"
 #include "adit/daemon/tile_store.hpp"
+#include "temp_file.hpp"
 
 namespace adit::daemon {
 namespace {
-
-class TemporaryFolder {
- public:
-  TemporaryFolder() {
-    std::string name = (std::filesystem::temp_directory_path() / "adit-tile-store-XXXXXX").string();
-    if (::mkdtemp(name.data()) == nullptr) throw std::runtime_error("cannot create " + name);
-    path_ = name;
-  }
-  ~TemporaryFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TemporaryFolder(const TemporaryFolder&) = delete;
-  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
 
 std::vector<protocol::MapPoint> random_points(std::size_t n, unsigned seed, double x0 = 0.0) {
   std::mt19937 rng(seed);
@@ -95,7 +76,7 @@ std::uint64_t spooled_frame_bytes(const TileStore& store) {
 }
 
 TEST(TileStore, SegmentsInTheSpoolFileServeTheSameBytesAsSegmentsInRam) {
-  TemporaryFolder folder;
+  test::TempFolder folder;
   TileStore in_ram({});
   TileStore spooled({}, folder.path());
   ASSERT_TRUE(spooled.spooling()) << spooled.spool_problem();
@@ -130,7 +111,7 @@ TEST(TileStore, SegmentsInTheSpoolFileServeTheSameBytesAsSegmentsInRam) {
 }
 
 TEST(TileStore, TheSpoolFileIsRewrittenWithItsLiveFramesOnceGarbageOutgrowsThem) {
-  TemporaryFolder folder;
+  test::TempFolder folder;
   TileStore in_ram({});
   TileStore spooled({}, folder.path(), 0);  // no slack: compact as soon as garbage exceeds the live frames
   std::vector<protocol::MapPoint> a = random_points(8000, 3);
@@ -164,7 +145,7 @@ TEST(TileStore, WithoutItsSpoolFolderFramesStayInRamAndTheReasonNamesTheFolder) 
 }
 
 TEST(TileStore, AStoredSessionsFilesAreIndexedNotHeldAndAChangedFileIsReportedNotFatal) {
-  TemporaryFolder folder;
+  test::TempFolder folder;
   const protocol::TileParams stored{20.0, 0.001, 3, protocol::kMaxSegmentPoints};  // as tiles/<id>.adt
   const std::int64_t id2 = protocol::tile_id({0, 0, 0});
   const std::int64_t id1 = protocol::tile_id({2, 0, 0});
@@ -218,7 +199,7 @@ struct Sink : TileSink {
 
 TEST(TileStore, APublisherWithASpoolSendsWhatOneInRamSendsAndCountsUnreadableSegments) {
   using namespace std::chrono_literals;
-  TemporaryFolder folder;
+  test::TempFolder folder;
   Sink sink_ram;
   Sink sink_spool;
   TilePublisher in_ram({"rig1", {}, 1.0, 4.0e6, 0.0, 1, {}}, sink_ram);
