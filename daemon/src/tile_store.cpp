@@ -17,11 +17,6 @@ namespace {
 
 std::string errno_text() { return std::error_code(errno, std::generic_category()).message(); }
 
-std::uint32_t read_u32_le(std::span<const std::uint8_t> bytes, std::size_t at) {
-  return static_cast<std::uint32_t>(bytes[at]) | static_cast<std::uint32_t>(bytes[at + 1]) << 8 |
-         static_cast<std::uint32_t>(bytes[at + 2]) << 16 | static_cast<std::uint32_t>(bytes[at + 3]) << 24;
-}
-
 std::uint64_t ram_frame_bytes(const EncodedTile& tile) {
   std::uint64_t bytes = 0;
   for (std::size_t s = 0; s < tile.segments.size(); ++s)
@@ -208,7 +203,8 @@ std::string TileStore::insert_file(std::int64_t id, const std::filesystem::path&
   std::uint64_t at = protocol::kTileHeaderBytesFormat2 + 4 * tile.segments.size();
   frame_bytes_in_ram_ -= ram_frame_bytes(tile);
   for (std::size_t s = 0; s < tile.segments.size(); ++s) {
-    const std::uint32_t size = read_u32_le(blob, protocol::kTileHeaderBytesFormat2 + 4 * s);
+    // unpack_tile copied each frame verbatim, in file order.
+    const auto size = static_cast<std::uint32_t>(tile.segments[s].frame.size());
     tile.where[s] = {index, size, at};
     at += size;
     std::vector<std::uint8_t>().swap(tile.segments[s].frame);
