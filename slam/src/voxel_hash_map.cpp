@@ -67,22 +67,47 @@ void VoxelHashMap::visit_around(const Eigen::Vector3f& query, Bound&& bound, F&&
   const VoxelKey center = key_of(query);
   // The query's offset inside its voxel, per axis: the squared distance to a
   // neighbour voxel's box is the sum of the gaps on the axes where it differs.
-  // Neighbours whose box is already farther than the bound are skipped, the
-  // own voxel first, so most queries look at one or a few voxels.
+  // Neighbours whose box is already farther than the bound are skipped.
   const Eigen::Vector3f low = query - Eigen::Vector3f(static_cast<float>(center.x), static_cast<float>(center.y),
                                                       static_cast<float>(center.z)) * voxel_size_;
   const Eigen::Vector3f high = Eigen::Vector3f::Constant(voxel_size_) - low;
-  const auto gap2 = [&](int d, int axis) { return d < 0 ? low[axis] * low[axis] : d > 0 ? high[axis] * high[axis] : 0.0F; };
-  const auto visit = [&](int dx, int dy, int dz) {
-    if (gap2(dx, 0) + gap2(dy, 1) + gap2(dz, 2) >= bound()) return;
-    const std::size_t s = find({center.x + dx, center.y + dy, center.z + dz});
-    if (s != kNone) f(voxels_[s].points, slots_[s].count);
+  // Per axis, the side the query is nearer to (gap below half a voxel) and
+  // the far side (gap above). Visiting the own voxel, then neighbours with
+  // no far-side step, then one, two and three, fills a k-nearest search from
+  // its closest voxels first, so its bound shrinks early and more of the far
+  // voxels are skipped (the set found is the same in any order).
+  std::array<int, 3> near_side{};
+  std::array<std::array<float, 3>, 3> gap{};  // [axis][step: 0 same, 1 near side, 2 far side]
+  for (int a = 0; a < 3; ++a) {
+    const bool below = low[a] < high[a];
+    near_side[static_cast<std::size_t>(a)] = below ? -1 : 1;
+    const float near_gap = below ? low[a] : high[a];
+    const float far_gap = below ? high[a] : low[a];
+    gap[static_cast<std::size_t>(a)] = {0.0F, near_gap * near_gap, far_gap * far_gap};
+  }
+  // The 27 (x, y, z) steps sorted by (far steps, near steps).
+  static constexpr std::array<std::array<std::uint8_t, 3>, 27> kOrder = [] {
+    std::array<std::array<std::uint8_t, 3>, 27> order{};
+    std::size_t n = 0;
+    for (int far = 0; far <= 3; ++far)
+      for (int near = 0; near + far <= 3; ++near)
+        for (std::uint8_t x = 0; x < 3; ++x)
+          for (std::uint8_t y = 0; y < 3; ++y)
+            for (std::uint8_t z = 0; z < 3; ++z) {
+              const int fars = (x == 2) + (y == 2) + (z == 2);
+              const int nears = (x == 1) + (y == 1) + (z == 1);
+              if (fars == far && nears == near) order[n++] = {x, y, z};
+            }
+    return order;
+  }();
+  const auto step = [&](int axis, std::uint8_t s) {
+    return s == 0 ? 0 : s == 1 ? near_side[static_cast<std::size_t>(axis)] : -near_side[static_cast<std::size_t>(axis)];
   };
-  visit(0, 0, 0);
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz)
-        if (dx != 0 || dy != 0 || dz != 0) visit(dx, dy, dz);
+  for (const auto& o : kOrder) {
+    if (gap[0][o[0]] + gap[1][o[1]] + gap[2][o[2]] >= bound()) continue;
+    const std::size_t s = find({center.x + step(0, o[0]), center.y + step(1, o[1]), center.z + step(2, o[2])});
+    if (s != kNone) f(voxels_[s].points, slots_[s].count);
+  }
 }
 
 MapNeighbor VoxelHashMap::nearest(const Eigen::Vector3f& query, float max_distance_m) const {
@@ -107,7 +132,8 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
   // k nearest within one voxel edge, kept sorted by distance (k is small).
   const int k = std::clamp(neighbors, 3, kMaxPlaneNeighbors);
   std::array<float, kMaxPlaneNeighbors> d2;
-  std::array<Eigen::Vector3f, kMaxPlaneNeighbors> near;
+  // Pointers into the map, not copies: the insertion sort moves one word per shift.
+  std::array<const Eigen::Vector3f*, kMaxPlaneNeighbors> near{};
   d2.fill(voxel_size_ * voxel_size_);
   int found = 0;
   visit_around(query, [&] { return d2[static_cast<std::size_t>(k - 1)]; }, [&](const auto& points, int count) {
@@ -121,7 +147,7 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
         near[static_cast<std::size_t>(j)] = near[static_cast<std::size_t>(j - 1)];
       }
       d2[static_cast<std::size_t>(j)] = d;
-      near[static_cast<std::size_t>(j)] = p;
+      near[static_cast<std::size_t>(j)] = &p;
       found = std::min(found + 1, k);
     }
   });
@@ -130,12 +156,13 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
   // The plane: the covariance's eigenvector of the smallest eigenvalue
   // (relative to the first neighbour, in double, for precision far from the origin).
   const auto used = std::span(near).first(static_cast<std::size_t>(k));
+  const Eigen::Vector3f origin = *near[0];
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : used) mean += (p - near[0]).cast<double>();
+  for (const auto* p : used) mean += (*p - origin).cast<double>();
   mean /= k;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const auto& p : used) {
-    const Eigen::Vector3d d = (p - near[0]).cast<double>() - mean;
+  for (const auto* p : used) {
+    const Eigen::Vector3d d = (*p - origin).cast<double>() - mean;
     covariance.noalias() += d * d.transpose();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -146,9 +173,9 @@ MapPlane VoxelHashMap::nearest_plane(const Eigen::Vector3f& query, int neighbors
   constexpr double kFlatness = 0.1;  // λ0 / λ1
   if (!(lambda(0) < kFlatness * lambda(1))) return plane;
   const Eigen::Vector3d normal = solver.eigenvectors().col(0);
-  for (const auto& p : used)
-    if (std::abs(normal.dot((p - near[0]).cast<double>() - mean)) > max_plane_error_m) return plane;
-  plane.point = near[0] + mean.cast<float>();
+  for (const auto* p : used)
+    if (std::abs(normal.dot((*p - origin).cast<double>() - mean)) > max_plane_error_m) return plane;
+  plane.point = origin + mean.cast<float>();
   plane.normal = normal.cast<float>();
   plane.found = true;
   return plane;

@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <random>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -124,6 +128,60 @@ TEST(VoxelHashMap, NearestPlaneFitsTheNeighboursAndRefusesLinesAndClutter) {
 
   // Fewer neighbours within a voxel edge than asked for: none.
   EXPECT_FALSE(map.nearest_plane({3.0F, 3.0F, 3.0F}, 5).found);
+}
+
+// The plane search visits the 27 voxels nearest-first and skips those
+// beyond its bound: it must still use exactly the k map points nearest the
+// query within one voxel edge. A gently tilted, rough floor at random
+// offsets, against brute force (the plane's point is those points' mean).
+TEST(VoxelHashMap, NearestPlaneUsesExactlyTheKNearestPointsWithinAVoxelEdge) {
+  constexpr float kVoxel = 0.5F;
+  constexpr int kNeighbors = 10;
+  VoxelHashMap map(kVoxel, 4096);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-2.0F, 2.0F);
+  std::uniform_real_distribution<float> noise(-0.01F, 0.01F);
+  std::vector<Eigen::Vector3f> points;
+  // Sparse enough (about 40 per m²) that the tenth neighbour lies 0.3 m away
+  // and often in a neighbouring voxel, on the far side as well.
+  for (int i = 0; i < 600; ++i) {
+    const float x = u(rng);
+    const float y = u(rng);
+    points.emplace_back(x, y, 0.1F * x - 0.05F * y + noise(rng));
+  }
+  map.add(points);
+  int checked = 0;
+  for (int q = 0; q < 300; ++q) {
+    const float x = 0.8F * u(rng);
+    const float y = 0.8F * u(rng);
+    const Eigen::Vector3f query(x, y, 0.1F * x - 0.05F * y + 5.0F * noise(rng));
+    std::vector<std::pair<float, Eigen::Vector3f>> near;
+    map.for_each_point([&](const Eigen::Vector3f& p) {
+      const float d = (p - query).squaredNorm();
+      if (d < kVoxel * kVoxel) near.emplace_back(d, p);
+    });
+    std::sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const MapPlane plane = map.nearest_plane(query, kNeighbors);
+    ASSERT_EQ(plane.found, near.size() >= kNeighbors) << "query " << q;
+    if (!plane.found) continue;
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (int i = 0; i < kNeighbors; ++i) mean += near[static_cast<std::size_t>(i)].second / kNeighbors;
+    EXPECT_LT((plane.point - mean).norm(), 1e-5F) << "query " << q;
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(VoxelKey, FloorToIntMatchesStdFloor) {
+  for (const float x : {-2.0F, -1.5F, -1.0F, -0.9999999F, -1e-30F, -0.0F, 0.0F, 1e-30F, 0.5F, 0.9999999F, 1.0F,
+                        123456.7F, -123456.7F, 8388607.5F, -8388607.5F, 1e9F, -1e9F})
+    EXPECT_EQ(floor_to_int(x), static_cast<std::int32_t>(std::floor(x))) << x;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1000.0F, 1000.0F);
+  for (int i = 0; i < 100000; ++i) {
+    const float x = u(rng);
+    ASSERT_EQ(floor_to_int(x), static_cast<std::int32_t>(std::floor(x))) << x;
+  }
 }
 
 // remove_far under heavy hash collisions (a small, nearly full table): every
