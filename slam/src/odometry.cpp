@@ -207,7 +207,10 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   deskew_frame(result.registration.sweep_velocity);
   transform_into(deskewed_, pose_, registered_);
   map_.add(registered_);
-  map_.remove_far(pose_.translation().cast<float>(), config_.max_range_m);
+  if ((pose_.translation() - removed_far_at_).norm() >= config_.map_removal_step_m) {
+    map_.remove_far(pose_.translation().cast<float>(), config_.max_range_m);
+    removed_far_at_ = pose_.translation();
+  }
 
   result.pose = pose_;
   result.covariance = result.registration.covariance;

@@ -55,6 +55,31 @@ TEST(Odometry, TracksASmoothPathThroughAHall) {
   EXPECT_EQ(r.status, OdometryStatus::ok);
 }
 
+// The local map is pruned only after each map_removal_step_m of travel, so
+// between prunings it may hold voxels up to that much beyond the range, and
+// never more (a voxel goes by its first point; the others lie within its
+// diagonal). The sensor travels 11.8 m, so the end wall the first scans saw
+// 5 m behind them would be beyond that reach if the map were not pruned.
+TEST(Odometry, TheLocalMapReachesNoFartherThanTheRangePlusTheRemovalStep) {
+  const auto room = test::room(200000, 23, 12.0F, 5.0F, 2.5F);
+  OdometryConfig config;
+  config.max_range_m = 10.0F;
+  config.map_removal_step_m = 1.0F;
+  Odometry odometry(config);
+  const float reach = config.max_range_m + config.map_removal_step_m + std::sqrt(3.0F) * config.map_voxel_m;
+  for (int k = 0; k < 60; ++k) {
+    const Eigen::Isometry3d truth = planar_pose(-7.0 + 0.2 * k, 0.0, 0.0);
+    const auto scan = observe(room, truth, 20000, 300 + static_cast<unsigned>(k), config.max_range_m);
+    const OdometryResult r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, scan, {}});
+    ASSERT_TRUE(r.valid) << "scan " << k;
+    ASSERT_NEAR(r.pose.translation().x(), 0.2 * k, 0.05) << "scan " << k;  // it tracks
+    const Eigen::Vector3f sensor = r.pose.translation().cast<float>();
+    float farthest = 0.0F;
+    odometry.local_map().for_each_point([&](const Eigen::Vector3f& p) { farthest = std::max(farthest, (p - sensor).norm()); });
+    EXPECT_LE(farthest, reach) << "scan " << k;
+  }
+}
+
 // A spinning sensor sees each azimuth at one instant of its sweep: here a
 // sweep of 0.1 s turns once, and a point's time follows its azimuth.
 std::vector<Eigen::Vector3f> spin_observe(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& start,
