@@ -37,8 +37,8 @@ Odometry::Odometry(const OdometryConfig& config)
       map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
       downsampler_(config.max_scan_points),
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
-  for (auto* buffer : {&filtered_, &deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
-  for (auto* buffer : {&filtered_times_, &frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
+  for (auto* buffer : {&deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
+  for (auto* buffer : {&frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
   source_deskewed_.resize(config.max_scan_points);
   planes_.resize(config.max_scan_points);
 }
@@ -60,20 +60,6 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     reacquire_ = true;
   }
 
-  // Keep finite points within range.
-  filtered_.clear();
-  filtered_times_.clear();
-  const float min2 = config_.min_range_m * config_.min_range_m;
-  const float max2 = config_.max_range_m * config_.max_range_m;
-  const bool timed = scan.times_s.size() == scan.points.size();
-  for (std::size_t i = 0; i < scan.points.size() && filtered_.size() < config_.max_scan_points; ++i) {
-    const Eigen::Vector3f& p = scan.points[i];
-    const float r2 = p.squaredNorm();
-    if (!std::isfinite(r2) || r2 < min2 || r2 > max2) continue;
-    filtered_.push_back(p);
-    filtered_times_.push_back(timed ? scan.times_s[i] : 0.0F);
-  }
-
   // Prediction: wheel odometry when given, else constant velocity, carried
   // on from the middle of the last sweep (see the end of this function).
   const Eigen::Isometry3d constant_velocity_delta = start_to_mid_ * exp_se3(velocity_ * (dt - mid_offset_s_));
@@ -81,9 +67,13 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   const Eigen::Isometry3d predicted = pose_ * delta;
   const Vector6d scan_velocity = wheel && dt > 0.0 ? Vector6d(log_se3(wheel->delta) / dt) : velocity_;
 
-  // Downsampled as measured (a sweep moves points by cm, voxels are dm);
-  // each kept point keeps its time, to be deskewed once the sweep's motion is known.
-  downsampler_.downsample(filtered_, filtered_times_, 0.5F * config_.map_voxel_m, frame_, frame_times_);
+  // Finite points within range, downsampled as measured (a sweep moves
+  // points by cm, voxels are dm); each kept point keeps its time, to be
+  // deskewed once the sweep's motion is known (0 without firing times).
+  const bool timed = scan.times_s.size() == scan.points.size();
+  downsampler_.downsample(scan.points, timed ? scan.times_s : std::span<const float>{}, 0.5F * config_.map_voxel_m,
+                          frame_, frame_times_, config_.min_range_m, config_.max_range_m);
+  if (!timed) frame_times_.assign(frame_.size(), 0.0F);  // within reserved capacity
   downsampler_.downsample(frame_, frame_times_, config_.registration_voxel_m, source_, source_times_);
   result.registration_points = source_.size();
   // frame_ deskewed with `velocity` into deskewed_.

@@ -19,6 +19,24 @@ std::size_t VoxelDownsampler::downsample(std::span<const Eigen::Vector3f> in, fl
 std::size_t VoxelDownsampler::downsample(std::span<const Eigen::Vector3f> in, std::span<const float> in_times,
                                          float voxel_size_m, std::vector<Eigen::Vector3f>& out,
                                          std::vector<float>& out_times) {
+  return downsample_if(in, in_times, voxel_size_m, out, out_times, [](const Eigen::Vector3f&) { return true; });
+}
+
+std::size_t VoxelDownsampler::downsample(std::span<const Eigen::Vector3f> in, std::span<const float> in_times,
+                                         float voxel_size_m, std::vector<Eigen::Vector3f>& out,
+                                         std::vector<float>& out_times, float min_range_m, float max_range_m) {
+  const float min2 = min_range_m * min_range_m;
+  const float max2 = max_range_m * max_range_m;
+  return downsample_if(in, in_times, voxel_size_m, out, out_times, [&](const Eigen::Vector3f& p) {
+    const float r2 = p.squaredNorm();
+    return std::isfinite(r2) && r2 >= min2 && r2 <= max2;
+  });
+}
+
+template <typename Keep>
+std::size_t VoxelDownsampler::downsample_if(std::span<const Eigen::Vector3f> in, std::span<const float> in_times,
+                                            float voxel_size_m, std::vector<Eigen::Vector3f>& out,
+                                            std::vector<float>& out_times, Keep&& keep) {
   out.clear();
   out_times.clear();
   const bool timed = in_times.size() == in.size();
@@ -40,6 +58,7 @@ std::size_t VoxelDownsampler::downsample(std::span<const Eigen::Vector3f> in, st
   for (std::size_t k = 0; k < in.size(); ++k) {
     const Eigen::Vector3f& p = in[k];
     if (out.size() >= max_points_) break;
+    if (!keep(p)) continue;
     const VoxelKey key = voxel_key(p, inverse);
     if (has_previous && key == previous) continue;
     previous = key;

@@ -138,8 +138,6 @@ class Odometry {
   VoxelDownsampler downsampler_;
   Deskewer deskewer_;
   AdaptiveThreshold threshold_;
-  std::vector<Eigen::Vector3f> filtered_;   // in range, finite
-  std::vector<float> filtered_times_;
   std::vector<Eigen::Vector3f> deskewed_;
   std::vector<Eigen::Vector3f> frame_;       // map-resolution points, as measured
   std::vector<float> frame_times_;
