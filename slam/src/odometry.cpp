@@ -36,7 +36,8 @@ Odometry::Odometry(const OdometryConfig& config)
     : config_(config),
       map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
       downsampler_(config.max_scan_points),
-      threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m) {
+      threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m),
+      registration_voxel_m_(config.registration_voxel_m) {
   for (auto* buffer : {&deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
   for (auto* buffer : {&frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
   source_deskewed_.resize(config.max_scan_points);
@@ -74,8 +75,14 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   downsampler_.downsample(scan.points, timed ? scan.times_s : std::span<const float>{}, 0.5F * config_.map_voxel_m,
                           frame_, frame_times_, config_.min_range_m, config_.max_range_m);
   if (!timed) frame_times_.assign(frame_.size(), 0.0F);  // within reserved capacity
-  downsampler_.downsample(frame_, frame_times_, config_.registration_voxel_m, source_, source_times_);
+  downsampler_.downsample(frame_, frame_times_, registration_voxel_m_, source_, source_times_);
   result.registration_points = source_.size();
+  result.registration_voxel_m = registration_voxel_m_;
+  if (config_.target_registration_points > 0 && !source_.empty()) {
+    const float ratio = static_cast<float>(source_.size()) / static_cast<float>(config_.target_registration_points);
+    registration_voxel_m_ = std::clamp(registration_voxel_m_ * std::sqrt(ratio), config_.registration_voxel_m,
+                                       std::max(config_.registration_voxel_m, config_.max_registration_voxel_m));
+  }
   // frame_ deskewed with `velocity` into deskewed_.
   const auto deskew_frame = [&](const Vector6d& velocity) {
     deskewed_.resize(frame_.size());

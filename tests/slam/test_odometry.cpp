@@ -80,6 +80,38 @@ TEST(Odometry, TheLocalMapReachesNoFartherThanTheRangePlusTheRemovalStep) {
   }
 }
 
+// Downsampling adapts to the sensor: a dense scan's registration voxel grows
+// until about target_registration_points remain, while a scan that has fewer
+// keeps the finest voxel (what a VLP-16 gets, unchanged by the adaptation).
+TEST(Odometry, RegistrationPointsAdaptTowardsTheTargetOnlyWhenThereAreMore) {
+  const auto room = test::room(200000, 29, 12.0F, 5.0F, 2.5F);
+  for (const std::size_t target : {std::size_t{400}, std::size_t{100'000}}) {
+    OdometryConfig config;
+    config.max_range_m = 30.0F;
+    config.target_registration_points = target;
+    Odometry odometry(config);
+    OdometryResult r;
+    std::size_t at_finest = 0;
+    for (int k = 0; k < 12; ++k) {
+      const auto scan = observe(room, planar_pose(-3.0 + 0.1 * k, 0.0, 0.0), 40000, 500 + static_cast<unsigned>(k));
+      r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, scan, {}});
+      ASSERT_TRUE(r.valid) << "scan " << k;
+      if (k == 0) at_finest = r.registration_points;
+      ASSERT_NEAR(r.pose.translation().x(), 0.1 * k, 0.03) << "scan " << k << ", target " << target;
+    }
+    ASSERT_GT(at_finest, 600U);  // so the first target is below what the room gives
+    if (target < at_finest) {
+      EXPECT_GT(r.registration_voxel_m, config.registration_voxel_m);
+      EXPECT_NEAR(static_cast<double>(r.registration_points), static_cast<double>(target), 0.25 * static_cast<double>(target))
+          << "from " << at_finest << " at the finest voxel";
+    } else {
+      EXPECT_EQ(r.registration_voxel_m, config.registration_voxel_m);
+      EXPECT_NEAR(static_cast<double>(r.registration_points), static_cast<double>(at_finest), 0.1 * static_cast<double>(at_finest))
+          << "the same room from nearly the same place";
+    }
+  }
+}
+
 // A spinning sensor sees each azimuth at one instant of its sweep: here a
 // sweep of 0.1 s turns once, and a point's time follows its azimuth.
 std::vector<Eigen::Vector3f> spin_observe(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& start,

@@ -45,6 +45,7 @@ struct BenchOptions {
   int plane_neighbors = slam::RegistrationConfig{}.plane_neighbors;
   bool fixed_sweep_velocity = false;  // deskew with the prediction's velocity only
   double sweep_velocity_sigma_radps = slam::OdometryConfig{}.sweep_velocity_sigma_radps;
+  std::size_t target_registration_points = slam::OdometryConfig{}.target_registration_points;
 };
 
 double quantile(std::vector<double> v, double q) {
@@ -111,6 +112,7 @@ int bench_odometry(const BenchOptions& o) {
   config.registration.plane_neighbors = o.plane_neighbors;
   config.estimate_sweep_velocity = !o.fixed_sweep_velocity;
   config.sweep_velocity_sigma_radps = o.sweep_velocity_sigma_radps;
+  config.target_registration_points = o.target_registration_points;
   config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
@@ -126,6 +128,7 @@ int bench_odometry(const BenchOptions& o) {
   std::size_t invalid = 0;
   std::vector<double> iterations;
   std::vector<double> used_points;
+  std::vector<double> voxels;
   std::vector<double> weakest;
   std::size_t without_wheels = 0;
   std::size_t wheel_rejected = 0;
@@ -143,6 +146,7 @@ int bench_odometry(const BenchOptions& o) {
     wheel_rejected += r.wheel_rejected ? 1 : 0;
     iterations.push_back(r.registration.iterations);
     used_points.push_back(static_cast<double>(r.registration_points));
+    if (r.registration_points > 0) voxels.push_back(r.registration_voxel_m);
     if (r.status == slam::OdometryStatus::ok || r.status == slam::OdometryStatus::degenerate)
       weakest.push_back(r.registration.weakest_eigenvalue);
     estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
@@ -152,10 +156,10 @@ int bench_odometry(const BenchOptions& o) {
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
              "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
-             "  registration: {:.0f} points, {:.0f} iterations per scan (medians); weakest direction's "
+             "  registration: {:.0f} points (at most {:.0f}) at {:.2f} m voxels, {:.0f} iterations per scan (medians); weakest direction's "
              "eigenvalue median {:.4f}, 10th percentile {:.4f} (degenerate below {})\n",
              median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
-             peak_resident_mb(), quantile(used_points, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
+             peak_resident_mb(), quantile(used_points, 0.5), quantile(used_points, 1.0), voxels.empty() ? 0.0 : quantile(voxels, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
              quantile(weakest, 0.1), o.degeneracy_threshold);
   if (!o.out.empty()) {
     std::ofstream out(o.out);
@@ -226,6 +230,9 @@ void register_bench_commands(CLI::App& app, int& status) {
                      "Deskew with the prediction's velocity instead of estimating each sweep's (before continuous-time registration)");
   odometry->add_option("--sweep-velocity-sigma", o->sweep_velocity_sigma_radps,
                        "σ of the sweep's angular velocity around the constant-velocity prediction, rad/s (without wheels)");
+  odometry->add_option("--registration-points", o->target_registration_points,
+                       "Registration points per scan the downsampling adapts its voxel to (0 = fixed 1.5 x map voxel)")
+      ->capture_default_str();
   odometry->callback([o, &status] {
     if (o->input.scans_dir.empty() && o->input.pcap.empty())
       throw InputError("", "--scans/--pcap", "give a scan directory or a capture");
