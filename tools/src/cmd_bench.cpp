@@ -34,6 +34,7 @@ struct BenchOptions {
   BenchInput input;
   std::string truth;
   std::string out;
+  std::string baseline_out;
   std::string baseline = "gicp";
   std::string wheels_config;  // session config whose CAN log gives a wheel prior
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
@@ -190,6 +191,10 @@ int bench_odometry(const BenchOptions& o) {
                "adit is {:.1f}x faster (median)\n",
                o.map_voxel_m, baseline_median, quantile(baseline_ms, 0.99), baseline_median / median);
     if (truth) print_drift("baseline PCL GICP", *truth, baseline_estimate);
+    if (!o.baseline_out.empty()) {
+      std::ofstream out(o.baseline_out);
+      slam::write_tum(out, baseline_estimate);
+    }
   }
   return kExitOk;
 }
@@ -210,6 +215,7 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--max-scans", o->input.max_scans, "Use at most this many scans (0 = all)");
   odometry->add_option("--truth", o->truth, "Ground-truth trajectory (TUM) for drift");
   odometry->add_option("--out", o->out, "Write adit's trajectory (TUM) here");
+  odometry->add_option("--baseline-out", o->baseline_out, "Write the baseline's trajectory (TUM) here");
   odometry->add_option("--baseline", o->baseline, "gicp (PCL Generalized-ICP, scan to scan) or none")
       ->check(CLI::IsMember({"gicp", "none"}));
   odometry->add_option("--wheels", o->wheels_config,
