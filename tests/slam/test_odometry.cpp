@@ -112,6 +112,25 @@ TEST(Odometry, RegistrationPointsAdaptTowardsTheTargetOnlyWhenThereAreMore) {
   }
 }
 
+// A sensor that is already moving when the odometry starts (a car at
+// 25 km/h, 0.7 m per scan): the first prediction is "standing still", and
+// the walls across the motion lie beyond the plane search's reach. The
+// odometry must find the motion, not creep along near zero.
+TEST(Odometry, ASensorAlreadyMovingAtTheStartIsTrackedFromTheFirstScans) {
+  const auto room = test::room(300000, 31, 14.0F, 5.0F, 2.5F);
+  OdometryConfig config;
+  config.max_range_m = 30.0F;
+  Odometry odometry(config);
+  OdometryResult r;
+  for (int k = 0; k < 12; ++k) {
+    const double x = 0.7 * k;
+    const auto scan = observe(room, planar_pose(-6.0 + x, 0.0, 0.0), 20000, 700 + static_cast<unsigned>(k));
+    r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, scan, {}});
+    ASSERT_TRUE(r.valid) << "scan " << k;
+    EXPECT_NEAR(r.pose.translation().x(), x, 0.05) << "scan " << k;
+  }
+}
+
 // A spinning sensor sees each azimuth at one instant of its sweep: here a
 // sweep of 0.1 s turns once, and a point's time follows its azimuth.
 std::vector<Eigen::Vector3f> spin_observe(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& start,
