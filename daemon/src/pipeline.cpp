@@ -27,6 +27,7 @@
 #include "adit/drivers/udp.hpp"
 #include "adit/protocol/map_export.hpp"
 #include "adit/slam/lie.hpp"
+#include "adit/slam/map_refiner.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -168,6 +169,11 @@ struct Pipeline::Impl {
       pending.times_s.reserve(max_points);
       pending.intensities.reserve(max_points);
       keyframe_points.reserve(max_points);
+      if (c.map.refine) {
+        slam::MapRefinerConfig refine;
+        refine.max_scan_points = max_points;
+        refiner.emplace(refine);
+      }
       keyframe_downsampler.emplace(max_points);
     }
     body_points.reserve(options.odometry.max_scan_points);
@@ -452,20 +458,23 @@ struct Pipeline::Impl {
     }
     map_deskewed.resize(map_points.size());
     map_deskewer.deskew(map_points, map_times, velocity, map_deskewed);
-    const bool keyframe = keyframe_selector.take(slot.pose);
+    // The map's pose of the scan: the odometry's, refined against the map of
+    // the scans before it (slam::MapRefiner says why).
+    const Eigen::Isometry3d map_pose = refiner ? refiner->refine(slot.pose, map_deskewed) : slot.pose;
+    const bool keyframe = keyframe_selector.take(map_pose);
     if (keyframe) {
       keyframe_downsampler->downsample(map_deskewed, static_cast<float>(config.map.keyframe_voxel_m), keyframe_points);
-      keyframe_list.push_back({slot.stamp_ns, slot.pose, keyframe_points});
+      keyframe_list.push_back({slot.stamp_ns, map_pose, keyframe_points});
       keyframe_bytes += sizeof(slam::Keyframe) + keyframe_list.back().points.capacity() * sizeof(Eigen::Vector3f);
       stats.keyframes.store(keyframe_list.size(), std::memory_order_relaxed);
       stats.keyframe_bytes.store(keyframe_bytes, std::memory_order_relaxed);
     }
-    const Eigen::Isometry3f pose = slot.pose.cast<float>();
+    const Eigen::Isometry3f pose = map_pose.cast<float>();
     for (Eigen::Vector3f& p : map_deskewed) p = pose * p;
     if (spill) restore_tiles(map.evicted_hit_by(map_deskewed));
     map.add(map_deskewed, map_intensities, 1e-9 * static_cast<double>(slot.stamp_ns));
     if (spill && keyframe) {
-      const std::vector<slam::TileCoord> cold = eviction.cold_tiles(map, slot.pose.translation().cast<float>());
+      const std::vector<slam::TileCoord> cold = eviction.cold_tiles(map, map_pose.translation().cast<float>());
       const std::vector<slam::TileCoord> crowded = eviction.crowded_tiles(map);
       evict_tiles(cold);
       compact_tiles(crowded);
@@ -657,6 +666,7 @@ struct Pipeline::Impl {
   std::vector<slam::Keyframe> keyframe_list;
   std::optional<slam::VoxelDownsampler> keyframe_downsampler;
   slam::Deskewer map_deskewer;
+  std::optional<slam::MapRefiner> refiner;  // with map.refine
   std::vector<Eigen::Vector3f> map_points;
   std::vector<float> map_times;
   std::vector<float> map_intensities;

@@ -134,6 +134,10 @@ struct MapSection {
   // A tile holding more voxels than this in RAM (the sensor stays near it or
   // keeps coming back) is written out and keeps one bit per voxel; 0 = never.
   int compact_tile_voxels = 100'000;
+  // Each scan's pose is refined against a dense map of the scans mapped
+  // before it (slam::MapRefiner) before it enters the map; false = the map
+  // takes the odometry's poses as they are.
+  bool refine = true;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.
