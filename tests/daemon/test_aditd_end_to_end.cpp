@@ -216,12 +216,14 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   // window (the first ~6 s of the drive, as far as the real-time replay got
   // when the client stops it) measured 95.5-95.7 % in Release runs since the
   // odometry's map keeps 0.08 m between a voxel's points, but 94.3 % under
-  // ASan, where the slower pipeline maps a different window; the whole 12 s
-  // drive gives 93.3 % and the 60 s demo's drive 85.2 % (docs/ARCHITECTURE.md,
-  // docs/ODOMETRY.md). So this asserts a regression floor, not the target:
-  // 92 % (it was 85 % before this change; 92.9 % measured then). Mapping
-  // itself reaches 98.4 % with the true poses; what is left is the odometry's
-  // roll/pitch lag and, on longer drives, its position drift.
+  // ASan, where the slower pipeline maps a different window. Since the mapping
+  // thread refines the poses and leaves out far points off the mapped
+  // surfaces, it measured 96.7-96.8 % (two Release runs; not measured under
+  // ASan), the whole 12 s drive 95.5 % and the 60 s demo's drive 96.1 %
+  // (docs/ARCHITECTURE.md, docs/ODOMETRY.md). So this still asserts a
+  // regression floor, not the target: 92 % (85 % before the spacing; 92.9 %
+  // measured then). Mapping itself reaches 98.4 % with the true poses; what
+  // is left is the odometry's roll/pitch lag.
   EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.92) << accuracy.dump();
   RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
 
