@@ -217,7 +217,8 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   // when the client stops it) measured 95.5-95.7 % in Release runs since the
   // odometry's map keeps 0.08 m between a voxel's points, but 94.3 % under
   // ASan, where the slower pipeline maps a different window. Since the mapping
-  // thread refines the poses it measured 95.9-96.0 % (two Release runs), the
+  // thread refines the poses it measured 95.9-96.0 % (two Release runs) and
+  // 95.3 % under ASan (one run: too close to 95 % to assert it there), the
   // whole 12 s drive 94.5 % and the 60 s demo's drive 95.9 %
   // (docs/ARCHITECTURE.md, docs/ODOMETRY.md). So this still asserts a
   // regression floor, not the target: 92 % (85 % before the spacing; 92.9 %
