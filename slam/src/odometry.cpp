@@ -151,7 +151,16 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     if (wheel_information.allFinite()) sweep.information = wheel_information;
   }
   sweep.deskewed = std::span(source_deskewed_).first(source_.size());
-  result.registration = register_scan(source_, map_, prior, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, sweep);
+  const auto register_from = [&](const PosePrior& start, const SweepMotion& motion) {
+    return register_scan(source_, map_, start, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, motion);
+  };
+  // An alternative start replaces the registration only when it explains
+  // clearly more of the scan: where the scan cannot tell, the first keeps it.
+  const auto explains_clearly_more = [&](const RegistrationResult& alternative) {
+    return static_cast<double>(alternative.correspondences) >
+           (1.0 + config_.wheel_rejection_margin) * static_cast<double>(result.registration.correspondences);
+  };
+  result.registration = register_from(prior, sweep);
   // Wheels that slipped (or a wrong encoder) put the prediction where the
   // scan no longer overlaps the map: far fewer correspondences than the last
   // scan had. A wheel that spins a little (3° of false turn per scan, seen
@@ -165,10 +174,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     SweepMotion constant_sweep = sweep;
     constant_sweep.velocity = velocity_;
     constant_sweep.information = sweep_information.asDiagonal();
-    const RegistrationResult alternative =
-        register_scan(source_, map_, constant_velocity, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, constant_sweep);
-    if (static_cast<double>(alternative.correspondences) >
-        (1.0 + config_.wheel_rejection_margin) * static_cast<double>(result.registration.correspondences)) {
+    const RegistrationResult alternative = register_from(constant_velocity, constant_sweep);
+    if (explains_clearly_more(alternative)) {
       result.registration = alternative;
       result.wheel_rejected = true;
     }
@@ -190,11 +197,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
       start.mean = constant_velocity.mean * Eigen::Translation3d(offset[0], offset[1], 0.0);
       SweepMotion moving = sweep;
       moving.velocity.head<3>() += Eigen::Vector3d(offset[0], offset[1], 0.0) / dt;
-      const RegistrationResult alternative =
-          register_scan(source_, map_, start, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, moving);
-      if (static_cast<double>(alternative.correspondences) >
-          (1.0 + config_.wheel_rejection_margin) * static_cast<double>(result.registration.correspondences))
-        result.registration = alternative;
+      const RegistrationResult alternative = register_from(start, moving);
+      if (explains_clearly_more(alternative)) result.registration = alternative;
     }
   }
   velocity_known_ = true;

@@ -76,13 +76,15 @@ void VoxelHashMap::visit_around(const Eigen::Vector3f& query, Bound&& bound, F&&
   // no far-side step, then one, two and three, fills a k-nearest search from
   // its closest voxels first, so its bound shrinks early and more of the far
   // voxels are skipped (the set found is the same in any order).
-  std::array<int, 3> near_side{};
-  std::array<std::array<float, 3>, 3> gap{};  // [axis][step: 0 same, 1 near side, 2 far side]
+  // [axis][step: 0 same, 1 near side, 2 far side]: the key offset and the squared gap.
+  std::array<std::array<int, 3>, 3> offset{};
+  std::array<std::array<float, 3>, 3> gap{};
   for (int a = 0; a < 3; ++a) {
     const bool below = low[a] < high[a];
-    near_side[static_cast<std::size_t>(a)] = below ? -1 : 1;
+    const int near = below ? -1 : 1;
     const float near_gap = below ? low[a] : high[a];
     const float far_gap = below ? high[a] : low[a];
+    offset[static_cast<std::size_t>(a)] = {0, near, -near};
     gap[static_cast<std::size_t>(a)] = {0.0F, near_gap * near_gap, far_gap * far_gap};
   }
   // The 27 (x, y, z) steps sorted by (far steps, near steps).
@@ -100,12 +102,9 @@ void VoxelHashMap::visit_around(const Eigen::Vector3f& query, Bound&& bound, F&&
             }
     return order;
   }();
-  const auto step = [&](int axis, std::uint8_t s) {
-    return s == 0 ? 0 : s == 1 ? near_side[static_cast<std::size_t>(axis)] : -near_side[static_cast<std::size_t>(axis)];
-  };
   for (const auto& o : kOrder) {
     if (gap[0][o[0]] + gap[1][o[1]] + gap[2][o[2]] >= bound()) continue;
-    const std::size_t s = find({center.x + step(0, o[0]), center.y + step(1, o[1]), center.z + step(2, o[2])});
+    const std::size_t s = find({center.x + offset[0][o[0]], center.y + offset[1][o[1]], center.z + offset[2][o[2]]});
     if (s != kNone) f(voxels_[s].points, slots_[s].count);
   }
 }

@@ -164,8 +164,8 @@ class Odometry {
   double mid_offset_s_ = 0.0;                // time from pose_ to the middle of its sweep
   std::int64_t last_stamp_ns_ = 0;
   bool started_ = false;
-  bool reacquire_ = false;
-  bool velocity_known_ = false;  // a registration has measured the motion since the start or the last gap  // the next registration uses the initial threshold
+  bool reacquire_ = false;       // the next registration uses the initial threshold
+  bool velocity_known_ = false;  // a registration has measured the motion since the start or the last gap
   double last_correspondences_ = 0.0;
   float registration_voxel_m_;  // this scan's, adapted from the last (see OdometryConfig)
   Eigen::Vector3d removed_far_at_ = Eigen::Vector3d::Zero();  // sensor position at the last remove_far
