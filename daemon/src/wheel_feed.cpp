@@ -109,6 +109,13 @@ struct WheelFeed::Impl {
     return g;
   }
 
+  static slam::WheelLimits limits_of(const config::WheelOdometrySection& w) {
+    slam::WheelLimits l;
+    l.max_acceleration = w.max_acceleration_mps2;
+    l.max_slip_duration = w.max_slip_s;
+    return l;
+  }
+
   // The decoder of the two wheel signals; an unknown signal is named by its config key.
   static can::SignalDecoder make_decoder(const config::Config& c) {
     const config::WheelOdometrySection& w = c.wheel_odometry;
@@ -126,7 +133,7 @@ struct WheelFeed::Impl {
   explicit Impl(const config::Config& c)
       : config(c),
         decoder(make_decoder(c)),
-        odometry(geometry_of(c.wheel_odometry)) {
+        odometry(geometry_of(c.wheel_odometry), {}, limits_of(c.wheel_odometry)) {
     const int l = decoder.slot(c.wheel_odometry.left_signal);
     const int r = decoder.slot(c.wheel_odometry.right_signal);
     if (l < 0) throw InputError("", "wheel_odometry.left_signal", "no such signal in can.dbc / can.signals");
@@ -223,6 +230,7 @@ void WheelFeed::run() {
     value_left = value_right = NAN;
     if (step != slam::WheelStep::integrated && step != slam::WheelStep::first)
       stats_.untrusted.fetch_add(1, std::memory_order_relaxed);
+    stats_.slip_episodes.store(i.odometry.stats().slip_episodes, std::memory_order_relaxed);
     if (step == slam::WheelStep::time_backwards) continue;
     WheelSample* out = nullptr;
     while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {

@@ -32,7 +32,8 @@ void write_session_config(const std::filesystem::path& file, const SimOptions& o
         "    - {{name: right_wheel_position, id: {:#x}, start_bit: 0, length: 32, byte_order: intel, value_type: signed, unit: counts}}\n\n"
         "wheel_odometry:\n  enabled: true\n  model: differential\n  left_signal: left_wheel_position\n"
         "  right_signal: right_wheel_position\n  quantity: counts\n  counts_per_revolution: {}\n  counter_bits: 32\n"
-        "  left_radius_m: {}\n  right_radius_m: {}\n  track_width_m: {}\n  time_offset_s: {}\n\n",
+        "  left_radius_m: {}\n  right_radius_m: {}\n  track_width_m: {}\n  time_offset_s: {}\n"
+        "  max_acceleration_mps2: 4.0  # the robot's traction: a wheel speeding up faster slips\n\n",
         w.left_id, w.right_id, w.counts_per_revolution, w.radius_m, w.radius_m, w.track_m, 0.0 - o.can_offset_s);
   }
   text += "lcm:\n  url: udpm://239.255.76.67:7667?ttl=0\n";

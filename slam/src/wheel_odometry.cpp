@@ -55,6 +55,9 @@ void WheelOdometry::reset(const Pose2& pose) {
   have_previous_ = false;
   have_counts_ = false;
   rejected_in_a_row_ = 0;
+  slip_since_ = {kNotSlipping, kNotSlipping};
+  speeds_known_ = false;
+  earlier_known_ = false;
 }
 
 WheelStep WheelOdometry::add_speeds(double t, double v_left, double v_right) { return step(t, v_left, v_right, false); }
@@ -78,9 +81,10 @@ WheelStep WheelOdometry::add_counts(double t, std::uint64_t left, std::uint64_t 
   const WheelStep result =
       step(t, static_cast<double>(dl) * per_count * geometry_.left_radius / dt,
            static_cast<double>(dr) * per_count * geometry_.right_radius / dt, true);
-  // A rejected reading keeps the old baseline, so the next good reading
-  // covers the whole interval exactly (encoder counts are absolute).
-  if (result != WheelStep::impossible && result != WheelStep::slip && result != WheelStep::time_backwards) {
+  // An impossible reading keeps the old baseline, so the next good reading
+  // covers the whole interval exactly (encoder counts are absolute). A
+  // slipping wheel's counts are spent: step() integrated its trusted speed.
+  if (result != WheelStep::impossible && result != WheelStep::time_backwards) {
     if ((dl > 0 && left < left_count_) || (dl < 0 && left > left_count_)) ++stats_.counter_wraps;
     if ((dr > 0 && right < right_count_) || (dr < 0 && right > right_count_)) ++stats_.counter_wraps;
     left_count_ = left;
@@ -105,6 +109,9 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   }
   if (!have_previous_) {
     baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+    slip_since_ = {kNotSlipping, kNotSlipping};
+    speeds_known_ = plausible && !from_counts;  // one reading of counts has no speed yet
+    earlier_known_ = false;
     return WheelStep::first;
   }
   const double dt = t - t_previous_;
@@ -115,43 +122,98 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   if (dt > limits_.max_gap) {
     ++stats_.gaps;
     baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+    slip_since_ = {kNotSlipping, kNotSlipping};
+    speeds_known_ = plausible && !from_counts;
+    earlier_known_ = false;
     return WheelStep::gap;
   }
-  WheelStep verdict = WheelStep::integrated;
   if (!plausible) {
-    verdict = WheelStep::impossible;
-  } else if (const double dv_max = limits_.max_acceleration * std::max(dt, limits_.min_interval) + limits_.speed_noise;
-             !from_counts && (std::abs(v_left - v_left_previous_) > dv_max || std::abs(v_right - v_right_previous_) > dv_max)) {
-    // Not for counts: one count of quantisation at a high sample rate looks
-    // like a huge acceleration; counts are only checked for impossible speed.
-    verdict = WheelStep::slip;
-  }
-  if (verdict != WheelStep::integrated) {
-    ++(verdict == WheelStep::impossible ? stats_.impossible : stats_.slips);
+    ++stats_.impossible;
     if (++rejected_in_a_row_ > limits_.max_rejected) {
       ++stats_.rebaselined;
-      baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
+      baseline(0.0, 0.0);
+      slip_since_ = {kNotSlipping, kNotSlipping};
+      speeds_known_ = false;
+  earlier_known_ = false;
       return WheelStep::rebaselined;
     }
-    if (from_counts) return verdict;  // baseline kept; the next good reading covers this interval
-    // Speeds: hold the last trusted speed over this interval.
+    if (from_counts) return WheelStep::impossible;  // baseline kept; the next good reading covers this interval
+    // Speeds: hold the last trusted speeds over this interval.
     const double hl = v_left_previous_ * dt * geometry_.left_scale;
     const double hr = v_right_previous_ * dt * geometry_.right_scale;
     integrate_wheel_travel(pose_, covariance_, hl, hr, geometry_.effective_track(), noise_);
     distance_ += std::abs(0.5 * (hl + hr));
     t_previous_ = t;
-    return verdict;
+    return WheelStep::impossible;
+  }
+
+  // Slip, wheel by wheel: a speed change beyond what the wheel's traction
+  // allows over the interval, plus the measurement's noise. A speed from
+  // counts is uncertain by count_noise counts and by its speed times the
+  // timestamp jitter, both over the interval. A speed from counts is the
+  // mean over its interval, so a slip that starts within an interval shows
+  // half in one reading and half in the next, each below the bound, but not
+  // both together: counts are also judged against the trusted speed before
+  // the last one. (Reported speeds are samples: a step shows at once, and
+  // their noise, up to 1 m/s on a car's ABS sensors, does not shrink over two
+  // readings.)
+  const std::array<double, 2> measured{v_left, v_right};
+  const std::array<double, 2> trusted{v_left_previous_, v_right_previous_};
+  const std::array<double, 2> radius{geometry_.left_radius, geometry_.right_radius};
+  const double per_count = 2.0 * std::numbers::pi / geometry_.counts_per_revolution;
+  std::array<double, 2> used = measured;
+  std::array<double, 2> before = trusted;  // the next reading's earlier speeds
+  bool slipping = false;
+  bool accepted_after_slip = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const double noise =
+        from_counts ? (limits_.count_noise * per_count * radius[i] + std::abs(trusted[i]) * limits_.timestamp_jitter) / dt
+                    : limits_.speed_noise;
+    const bool jump =
+        std::abs(measured[i] - trusted[i]) > limits_.max_acceleration * std::max(dt, limits_.min_interval) + noise;
+    const bool ramp = from_counts && earlier_known_ && std::abs(measured[i] - earlier_speed_[i]) >
+                                            limits_.max_acceleration * std::max(t - earlier_t_, limits_.min_interval) + noise;
+    if (!speeds_known_ || (!jump && !ramp)) {
+      slip_since_[i] = kNotSlipping;  // traction (back)
+      continue;
+    }
+    const bool onset = std::isnan(slip_since_[i]);
+    if (onset) {
+      slip_since_[i] = jump ? t_previous_ : earlier_t_;
+      ++stats_.slip_episodes;
+    }
+    if (t - slip_since_[i] > limits_.max_slip_duration) {  // held too long: a real change of speed
+      slip_since_[i] = kNotSlipping;
+      accepted_after_slip = true;
+      before[i] = measured[i];  // the slip's history is no reference for what follows
+      continue;
+    }
+    // Held at the speed from before the slip began.
+    used[i] = onset && !jump ? earlier_speed_[i] : trusted[i];
+    slipping = true;
   }
   // Counts give the exact travel over the interval; speeds are sampled, so
   // the trapezoid rule integrates them.
-  const double vl = from_counts ? v_left : 0.5 * (v_left + v_left_previous_);
-  const double vr = from_counts ? v_right : 0.5 * (v_right + v_right_previous_);
+  const double vl = from_counts ? used[0] : 0.5 * (used[0] + trusted[0]);
+  const double vr = from_counts ? used[1] : 0.5 * (used[1] + trusted[1]);
   const double dl = vl * dt * geometry_.left_scale;
   const double dr = vr * dt * geometry_.right_scale;
   integrate_wheel_travel(pose_, covariance_, dl, dr, geometry_.effective_track(), noise_);
   distance_ += std::abs(0.5 * (dl + dr));
+  earlier_speed_ = before;
+  earlier_t_ = t_previous_;
+  earlier_known_ = speeds_known_;
+  baseline(used[0], used[1]);
+  speeds_known_ = true;
+  if (slipping) {
+    ++stats_.slips;
+    return WheelStep::slip;
+  }
+  if (accepted_after_slip) {
+    ++stats_.rebaselined;
+    return WheelStep::rebaselined;
+  }
   ++stats_.integrated;
-  baseline(v_left, v_right);
   return WheelStep::integrated;
 }
 

@@ -116,9 +116,9 @@ TEST(WheelOdometry, SpeedSpikeIsHeldNotIntegrated) {
   EXPECT_EQ(odo.stats().impossible, 2U);
 }
 
-TEST(WheelOdometry, RealStepChangeIsAcceptedAfterRepeatedRejections) {
+TEST(WheelOdometry, RealStepChangeIsAcceptedAfterTheLongestSlip) {
   slam::WheelLimits limits;
-  limits.max_rejected = 3;
+  limits.max_slip_duration = 0.035;
   slam::WheelOdometry odo(geometry(), {}, limits);
   odo.add_speeds(0.0, 0.0, 0.0);
   odo.add_speeds(0.01, 0.0, 0.0);
@@ -126,6 +126,105 @@ TEST(WheelOdometry, RealStepChangeIsAcceptedAfterRepeatedRejections) {
   EXPECT_EQ(odo.add_speeds(0.05, 5.0, 5.0), slam::WheelStep::rebaselined);
   EXPECT_EQ(odo.add_speeds(0.06, 5.0, 5.0), slam::WheelStep::integrated);
   EXPECT_EQ(odo.stats().rebaselined, 1U);
+  EXPECT_EQ(odo.stats().slip_episodes, 2U);  // one per wheel
+}
+
+TEST(WheelOdometry, RepeatedImpossibleReadingsBecomeTheNewBaseline) {
+  slam::WheelLimits limits;
+  limits.max_rejected = 3;
+  slam::WheelOdometry odo(geometry(), {}, limits);
+  odo.add_speeds(0.0, 1.0, 1.0);
+  for (int i = 1; i <= 3; ++i) EXPECT_EQ(odo.add_speeds(i * 0.01, 20.0, 1.0), slam::WheelStep::impossible);
+  EXPECT_EQ(odo.add_speeds(0.04, 20.0, 1.0), slam::WheelStep::rebaselined);
+  EXPECT_EQ(odo.stats().impossible, 4U);
+}
+
+// The simulator's slip (sim/src/wheel_encoders.cpp): one wheel's encoder runs
+// 30 % fast for 0.3 s while the robot drives straight at 1 m/s. Counts at
+// 100 Hz, 16384 per revolution. Without slip handling the false turn is
+// 0.3 * 1 m/s * 0.3 s / 0.555 m = 9.3 degrees.
+TEST(WheelOdometry, ASpinningWheelsCountsAreReplacedByItsTrustedSpeedUntilItGripsAgain) {
+  slam::WheelGeometry g;
+  g.left_radius = g.right_radius = 0.1651;
+  g.track_width = 0.555;
+  g.counts_per_revolution = 16384;
+  g.counter_bits = 32;
+  slam::WheelLimits limits;
+  limits.max_acceleration = 4.0;
+  slam::WheelOdometry odo(g, {}, limits);
+  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  double left = 0.0, right = 0.0;  // metres the wheels turned (rim)
+  int slips = 0;
+  for (int k = 0; k <= 300; ++k) {  // 3 s
+    const double t = k * 0.01;
+    const bool spinning = t > 1.0 + 1e-9 && t <= 1.3 + 1e-9;
+    if (k > 0) {
+      left += 0.01 * 1.0 * (spinning ? 1.3 : 1.0);
+      right += 0.01 * 1.0;
+    }
+    const auto step = odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
+                                     static_cast<std::uint64_t>(std::llround(right * counts_per_m)));
+    ASSERT_NE(step, slam::WheelStep::rebaselined) << t;
+    if (step == slam::WheelStep::slip) ++slips;
+  }
+  EXPECT_EQ(slips, 30);  // the whole spin, and only it
+  EXPECT_EQ(odo.stats().slip_episodes, 1U);
+  EXPECT_NEAR(odo.pose().theta * 180.0 / std::numbers::pi, 0.0, 0.05);  // 9.3° without slip handling
+  EXPECT_NEAR(odo.pose().x, 3.0, 0.002);
+  EXPECT_NEAR(odo.pose().y, 0.0, 0.002);
+}
+
+// A slip that begins halfway through a 10 ms interval shows as two steps of
+// 0.15 m/s, each within the bound over one interval (4 m/s² * 0.02 s plus the
+// counts' noise, 0.19 m/s at 1 m/s), but not together.
+TEST(WheelOdometry, ASlipThatStartsWithinAnIntervalIsStillCaught) {
+  slam::WheelGeometry g;
+  g.left_radius = g.right_radius = 0.1651;
+  g.track_width = 0.555;
+  g.counts_per_revolution = 16384;
+  slam::WheelLimits limits;
+  limits.max_acceleration = 4.0;
+  slam::WheelOdometry odo(g, {}, limits);
+  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  double left = 0.0, right = 0.0;
+  for (int k = 0; k <= 300; ++k) {
+    const double t = k * 0.01;
+    if (k > 0) {
+      const double gain = k == 101 ? 1.15 : (k > 101 && k <= 130) ? 1.3 : k == 131 ? 1.15 : 1.0;
+      left += 0.01 * gain;
+      right += 0.01;
+    }
+    odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
+                   static_cast<std::uint64_t>(std::llround(right * counts_per_m)));
+  }
+  EXPECT_EQ(odo.stats().slip_episodes, 1U);
+  // The half-steps at its two ends get through (0.15 * 1 m/s * 10 ms each,
+  // 0.31° in all); a slip that is missed turns the robot by 9.3°.
+  EXPECT_NEAR(odo.pose().theta * 180.0 / std::numbers::pi, 0.0, 0.5);
+}
+
+// The same at a steady turn and a slow, legal acceleration: nothing is held.
+TEST(WheelOdometry, AccelerationWithinTractionIsNeverTakenForSlip) {
+  slam::WheelGeometry g;
+  g.left_radius = g.right_radius = 0.1651;
+  g.track_width = 0.555;
+  g.counts_per_revolution = 16384;
+  slam::WheelLimits limits;
+  limits.max_acceleration = 4.0;
+  slam::WheelOdometry odo(g, {}, limits);
+  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  double left = 0.0, right = 0.0, v = 0.0;
+  for (int k = 0; k <= 500; ++k) {
+    const double t = k * 0.01;
+    v = std::min(1.5, 0.02 * k * 1.5);  // 1.5 m/s² up to 1.5 m/s, then steady
+    left += 0.01 * v * 0.8;             // turning left
+    right += 0.01 * v * 1.2;
+    EXPECT_NE(odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
+                             static_cast<std::uint64_t>(std::llround(right * counts_per_m))),
+              slam::WheelStep::slip)
+        << t;
+  }
+  EXPECT_EQ(odo.stats().slip_episodes, 0U);
 }
 
 TEST(WheelOdometry, TimeBackwardsAndGapsAreNotIntegrated) {

@@ -27,6 +27,7 @@ WheelTrack load_wheel_track(const std::string& config_file) {
   feed.drain_into(track.history, kEverything);
   feed.stop();
   track.rejected = feed.stats().untrusted.load();
+  track.slip_episodes = feed.stats().slip_episodes.load();
   track.samples = feed.stats().samples.load();
   if (!(track.history.latest() > -kEverything) || feed.stats().samples.load() < 2)
     throw InputError(c.can.log, "wheel_odometry", "fewer than 2 wheel samples decoded");

@@ -22,6 +22,7 @@ struct WheelTrack {
   double distance = 0.0;                   // m the wheels travelled over the log
   std::uint64_t samples = 0;
   std::uint64_t rejected = 0;              // samples the wheel odometry did not trust (slip, glitches)
+  std::uint64_t slip_episodes = 0;         // times a wheel lost traction
 };
 
 // Throws adit::InputError when the config has no usable wheel odometry.

@@ -118,8 +118,8 @@ int bench_odometry(const BenchOptions& o) {
   std::optional<WheelTrack> wheels;
   if (!o.wheels_config.empty()) {
     wheels = load_wheel_track(o.wheels_config);
-    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted)\n", wheels->samples,
-               wheels->distance, wheels->rejected);
+    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted; {} wheel slips held)\n",
+               wheels->samples, wheels->distance, wheels->rejected, wheels->slip_episodes);
   }
   const double rss_before = resident_mb();
   slam::Odometry odometry(config);

@@ -59,6 +59,7 @@ struct WheelFeedStats {
   std::atomic<std::uint64_t> frames{0};
   std::atomic<std::uint64_t> samples{0};
   std::atomic<std::uint64_t> untrusted{0};  // slip, glitches, gaps (slam::WheelStep other than integrated)
+  std::atomic<std::uint64_t> slip_episodes{0};  // a wheel lost traction and was held at its trusted speed
   std::atomic<std::uint64_t> dropped{0};    // live: the odometry thread fell behind
   std::atomic<std::uint64_t> recorded{0};
   std::atomic<std::int64_t> last_frame_us{0};

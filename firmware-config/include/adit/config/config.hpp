@@ -97,6 +97,11 @@ struct WheelOdometrySection {
   int counts_per_revolution = 4096;      // quantity: counts
   int counter_bits = 32;                 // quantity: counts (wrap-around)
   double time_offset_s = 0.0;            // encoder clock minus LiDAR clock
+  // A wheel whose speed changes faster than this slips (traction is about
+  // µ·g: 4 m/s² for rubber on wet rock) and is held at its last trusted speed
+  // for at most max_slip_s (slam/wheel_odometry.hpp).
+  double max_acceleration_mps2 = 15.0;
+  double max_slip_s = 1.0;
 };
 
 // A GPIO line: by offset on the chip, or by its name (one of them).

@@ -142,6 +142,8 @@ void describe(V& v, WheelOdometrySection& s) {
   v.optional("counts_per_revolution", s.counts_per_revolution, Range<int>{1, 1 << 24});
   v.optional("counter_bits", s.counter_bits, Range<int>{8, 64});
   v.optional("time_offset_s", s.time_offset_s, Range<double>{-10.0, 10.0});
+  v.optional("max_acceleration_mps2", s.max_acceleration_mps2, Range<double>{0.5, 100.0});
+  v.optional("max_slip_s", s.max_slip_s, Range<double>{0.0, 10.0});
 }
 
 template <typename V>

@@ -19,12 +19,27 @@
 //
 // Bad samples are flagged and not integrated blindly: time going backwards
 // (dropped), gaps longer than max_gap (baseline reset, nothing integrated),
-// speeds, accelerations (beyond max_acceleration over at least min_interval,
-// plus speed_noise) or counter jumps no vehicle can do (the interval is
-// integrated at the last trusted speed and the sample is not trusted; after
-// max_rejected in a row the new values are accepted as the new baseline).
+// speeds or counter jumps no vehicle can do (the interval is integrated at the
+// last trusted speeds and the sample is not trusted; after max_rejected in a
+// row the new values are accepted as the new baseline).
+//
+// Wheel slip: a wheel whose speed changes faster than max_acceleration allows
+// (over at least min_interval, plus the measurement's own noise) spins or
+// locks: its traction is gone, so its travel says nothing of the ground. A
+// slip lasts (the simulator's robot: one wheel 30 % fast for 0.3 s; on loose
+// rock, as long as the wheel spins), so each wheel has a slip episode: that
+// wheel is integrated at its last trusted speed until its measured speed
+// comes back within the same bound of it, or until max_slip_duration, after
+// which the new speed is accepted (a real change). The other wheel is used as
+// measured. Counts: the slipping wheel's counts are discarded, not carried
+// into the next reading. This is the wheel-acceleration test of traction
+// control (a wheel cannot accelerate beyond what friction allows, about µ·g),
+// e.g. Gustafsson, "Slip-based tire-road friction estimation", Automatica
+// 33(6), 1997, which estimates slip from wheel speeds against the vehicle's.
 
+#include <array>
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -57,9 +72,12 @@ struct WheelLimits {
   double max_acceleration = 15.0;  // m/s^2 per wheel between samples; more is slip or a glitch
   double min_interval = 0.02;      // s: accelerations are judged over at least this long, because
                                    // loggers bunch frames (timestamps jitter by milliseconds)
-  double speed_noise = 0.2;        // m/s: a jump this big between samples is measurement noise, never slip
+  double speed_noise = 0.2;        // m/s: a jump this big between reported speeds is measurement noise, never slip
+  double count_noise = 2.0;        // counts: a speed from counts is uncertain by this many counts over its interval
+  double timestamp_jitter = 0.001; // s: and by its speed times this over its interval (frames stamped late or early)
+  double max_slip_duration = 1.0;  // s: a wheel held longer than this is re-baselined at its new speed
   double max_gap = 0.5;            // s between samples; longer is a gap
-  unsigned max_rejected = 5;       // consecutive rejected samples before re-baselining
+  unsigned max_rejected = 5;       // consecutive impossible samples before re-baselining
 };
 
 enum class WheelStep : std::uint8_t {
@@ -68,8 +86,8 @@ enum class WheelStep : std::uint8_t {
   time_backwards, // time not after the previous sample: dropped
   gap,            // too long since the previous sample: baseline reset, nothing integrated
   impossible,     // speed or counter jump beyond max_speed: held at the last trusted speed
-  slip,           // acceleration beyond max_acceleration: held at the last trusted speed
-  rebaselined,    // accepted after max_rejected rejections in a row, nothing integrated
+  slip,           // a wheel slips (acceleration beyond max_acceleration): it is held at its last trusted speed
+  rebaselined,    // accepted after max_rejected impossible samples or max_slip_duration of slip
 };
 
 struct WheelOdometryStats {
@@ -77,7 +95,8 @@ struct WheelOdometryStats {
   std::uint64_t time_backwards = 0;
   std::uint64_t gaps = 0;
   std::uint64_t impossible = 0;
-  std::uint64_t slips = 0;
+  std::uint64_t slips = 0;          // samples with a wheel held for slip
+  std::uint64_t slip_episodes = 0;  // times a wheel started to slip
   std::uint64_t rebaselined = 0;
   std::uint64_t counter_wraps = 0;
 };
@@ -125,6 +144,13 @@ class WheelOdometry {
   std::uint64_t left_count_ = 0;
   std::uint64_t right_count_ = 0;
   unsigned rejected_in_a_row_ = 0;
+  static constexpr double kNotSlipping = std::numeric_limits<double>::quiet_NaN();
+  // Per wheel (0 left, 1 right): slipping since when (NaN: not slipping).
+  std::array<double, 2> slip_since_{kNotSlipping, kNotSlipping};
+  bool speeds_known_ = false;  // the trusted speeds were measured (counts: after two readings)
+  std::array<double, 2> earlier_speed_{};  // the trusted speeds before the last ones, and their time
+  double earlier_t_ = 0.0;
+  bool earlier_known_ = false;
   WheelOdometryStats stats_;
 };
 
