@@ -163,24 +163,44 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   const double per_count = 2.0 * std::numbers::pi / geometry_.counts_per_revolution;
   std::array<double, 2> used = measured;
   std::array<double, 2> before = trusted;  // the next reading's earlier speeds
-  bool slipping = false;
-  bool accepted_after_slip = false;
+  std::array<double, 2> bound{};
+  std::array<bool, 2> jump{};  // a new slip: beyond the bound from the last trusted speed ...
+  std::array<bool, 2> ramp{};  // ... or, counts, from the one before
   for (std::size_t i = 0; i < 2; ++i) {
     const double noise =
         from_counts ? (limits_.count_noise * per_count * radius[i] + std::abs(trusted[i]) * limits_.timestamp_jitter) / dt
                     : limits_.speed_noise;
-    const bool jump =
-        std::abs(measured[i] - trusted[i]) > limits_.max_acceleration * std::max(dt, limits_.min_interval) + noise;
-    const bool ramp = from_counts && earlier_known_ && std::abs(measured[i] - earlier_speed_[i]) >
-                                            limits_.max_acceleration * std::max(t - earlier_t_, limits_.min_interval) + noise;
-    if (!speeds_known_ || (!jump && !ramp)) {
-      slip_since_[i] = kNotSlipping;  // traction (back)
-      continue;
-    }
-    const bool onset = std::isnan(slip_since_[i]);
+    bound[i] = limits_.max_acceleration * std::max(dt, limits_.min_interval) + noise;
+    if (!speeds_known_ || !std::isnan(slip_since_[i])) continue;
+    jump[i] = std::abs(measured[i] - trusted[i]) > bound[i];
+    ramp[i] = from_counts && earlier_known_ &&
+              std::abs(measured[i] - earlier_speed_[i]) >
+                  limits_.max_acceleration * std::max(t - earlier_t_, limits_.min_interval) + noise;
+  }
+  const std::array<bool, 2> held_before{!std::isnan(slip_since_[0]), !std::isnan(slip_since_[1])};
+  bool slipping = false;
+  bool accepted_after_slip = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::size_t other = 1 - i;
+    const bool onset = jump[i] || ramp[i];
+    if (!onset && !held_before[i]) continue;
     if (onset) {
-      slip_since_[i] = jump ? t_previous_ : earlier_t_;
+      // The speeds from before the slip began, and what they said of the turn.
+      const std::array<double, 2>& pre = jump[i] ? trusted : earlier_speed_;
+      slip_since_[i] = jump[i] ? t_previous_ : earlier_t_;
+      slip_offset_[i] = pre[i] - pre[other];
+      slip_speed_[i] = pre[i];
       ++stats_.slip_episodes;
+    }
+    // What the wheel would read with traction: the other wheel's speed with
+    // the turn rate from before the slip (the vehicle accelerates, the spin
+    // does not steer it), or, if the other wheel is not trusted either, this
+    // wheel's speed from before the slip.
+    const bool other_trusted = !held_before[other] && !jump[other] && !ramp[other];
+    const double reference = other_trusted ? measured[other] + slip_offset_[i] : slip_speed_[i];
+    if (!onset && std::abs(measured[i] - reference) <= bound[i]) {
+      slip_since_[i] = kNotSlipping;  // grips again
+      continue;
     }
     if (t - slip_since_[i] > limits_.max_slip_duration) {  // held too long: a real change of speed
       slip_since_[i] = kNotSlipping;
@@ -188,8 +208,7 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
       before[i] = measured[i];  // the slip's history is no reference for what follows
       continue;
     }
-    // Held at the speed from before the slip began.
-    used[i] = onset && !jump ? earlier_speed_[i] : trusted[i];
+    used[i] = reference;
     slipping = true;
   }
   // Counts give the exact travel over the interval; speeds are sampled, so

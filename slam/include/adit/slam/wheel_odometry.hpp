@@ -28,10 +28,11 @@
 // locks: its traction is gone, so its travel says nothing of the ground. A
 // slip lasts (the simulator's robot: one wheel 30 % fast for 0.3 s; on loose
 // rock, as long as the wheel spins), so each wheel has a slip episode: that
-// wheel is integrated at its last trusted speed until its measured speed
-// comes back within the same bound of it, or until max_slip_duration, after
-// which the new speed is accepted (a real change). The other wheel is used as
-// measured. Counts: the slipping wheel's counts are discarded, not carried
+// wheel is integrated at the speed it would have with traction (the other
+// wheel's speed with the turn rate from before the slip; if both slip, its own
+// speed from before) until its measured speed comes back within the same
+// bound of that, or until max_slip_duration, after which the new speed is
+// accepted (a real change). The other wheel is used as measured. Counts: the slipping wheel's counts are discarded, not carried
 // into the next reading. This is the wheel-acceleration test of traction
 // control (a wheel cannot accelerate beyond what friction allows, about µ·g),
 // e.g. Gustafsson, "Slip-based tire-road friction estimation", Automatica
@@ -147,6 +148,8 @@ class WheelOdometry {
   static constexpr double kNotSlipping = std::numeric_limits<double>::quiet_NaN();
   // Per wheel (0 left, 1 right): slipping since when (NaN: not slipping).
   std::array<double, 2> slip_since_{kNotSlipping, kNotSlipping};
+  std::array<double, 2> slip_offset_{};  // this wheel's speed minus the other's before the slip
+  std::array<double, 2> slip_speed_{};   // this wheel's speed before the slip
   bool speeds_known_ = false;  // the trusted speeds were measured (counts: after two readings)
   std::array<double, 2> earlier_speed_{};  // the trusted speeds before the last ones, and their time
   double earlier_t_ = 0.0;
