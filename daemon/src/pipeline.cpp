@@ -101,6 +101,14 @@ slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
           static_cast<std::size_t>(m.compact_tile_voxels)};
 }
 
+// One TUM line: stamp (s) x y z qx qy qz qw.
+void write_tum_line(std::FILE* file, std::int64_t stamp_ns, const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d& t = pose.translation();
+  fmt::print(file, "{:.9f} {:.6f} {:.6f} {:.6f} {:.9f} {:.9f} {:.9f} {:.9f}\n", 1e-9 * static_cast<double>(stamp_ns),
+             t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+}
+
 }  // namespace
 
 struct Pipeline::Impl {
@@ -180,10 +188,11 @@ struct Pipeline::Impl {
     body_times.reserve(options.odometry.max_scan_points);
     timings.odometry_ms.reserve(kTimingCapacity);
     timings.latency_ms.reserve(kTimingCapacity);
-    open_files(options.trajectory_file, options.record_file);
+    open_files(options.trajectory_file, options.map_trajectory_file, options.record_file);
   }
 
-  void open_files(const std::filesystem::path& trajectory_file, const std::filesystem::path& record_file) {
+  void open_files(const std::filesystem::path& trajectory_file, const std::filesystem::path& map_trajectory_file,
+                  const std::filesystem::path& record_file) {
     if (!record_file.empty()) {
       if (!udp && !pcap)
         throw InputError(record_file.string(), "session.record_lidar", "only packet sources can be recorded");
@@ -194,6 +203,11 @@ struct Pipeline::Impl {
       if (trajectory_file.has_parent_path()) std::filesystem::create_directories(trajectory_file.parent_path());
       trajectory.reset(std::fopen(trajectory_file.c_str(), "w"));
       if (!trajectory) throw InputError(trajectory_file.string(), "", "cannot write the trajectory");
+    }
+    if (!map_trajectory_file.empty()) {
+      if (map_trajectory_file.has_parent_path()) std::filesystem::create_directories(map_trajectory_file.parent_path());
+      map_trajectory.reset(std::fopen(map_trajectory_file.c_str(), "w"));
+      if (!map_trajectory) throw InputError(map_trajectory_file.string(), "", "cannot write the map's trajectory");
     }
   }
 
@@ -436,6 +450,7 @@ struct Pipeline::Impl {
     if (have_pending && !stop.load()) map_scan(pending, map_velocity);  // the last sweep: the last motion known
     have_pending = false;
     flush_tiles();
+    if (map_trajectory) std::fflush(map_trajectory.get());
     stats.map_bytes.store(map.memory_bytes(), std::memory_order_relaxed);
     stats.dropped_map_scans.store(map_slots->dropped());
     mapping_beat.finished.store(true);
@@ -461,6 +476,7 @@ struct Pipeline::Impl {
     // The map's pose of the scan: the odometry's, refined against the map of
     // the scans before it (slam::MapRefiner says why).
     const Eigen::Isometry3d map_pose = refiner ? refiner->refine(slot.pose, map_deskewed) : slot.pose;
+    if (map_trajectory) write_tum_line(map_trajectory.get(), slot.stamp_ns, map_pose);
     const bool keyframe = keyframe_selector.take(map_pose);
     if (keyframe) {
       keyframe_downsampler->downsample(map_deskewed, static_cast<float>(config.map.keyframe_voxel_m), keyframe_points);
@@ -617,12 +633,7 @@ struct Pipeline::Impl {
       if (timings.latency_ms.size() < kTimingCapacity)
         timings.latency_ms.push_back(1e-6 * static_cast<double>(slot->pose_mono_ns - slot->last_packet_mono_ns));
       if (options.sinks.pose) options.sinks.pose(r);
-      if (trajectory && r.valid) {
-        const Eigen::Quaterniond q(r.pose.linear());
-        const Eigen::Vector3d& t = r.pose.translation();
-        fmt::print(trajectory.get(), "{:.9f} {:.6f} {:.6f} {:.6f} {:.9f} {:.9f} {:.9f} {:.9f}\n",
-                   1e-9 * static_cast<double>(r.stamp_ns), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-      }
+      if (trajectory && r.valid) write_tum_line(trajectory.get(), r.stamp_ns, r.pose);
       poses->release(slot);
     }
     if (trajectory) std::fflush(trajectory.get());
@@ -684,6 +695,7 @@ struct Pipeline::Impl {
     void operator()(std::FILE* f) const { std::fclose(f); }
   };
   std::unique_ptr<std::FILE, FileCloser> trajectory;
+  std::unique_ptr<std::FILE, FileCloser> map_trajectory;  // mapping thread
 
   PipelineStats stats;
   PipelineTimings timings;
@@ -714,7 +726,7 @@ Pipeline::~Pipeline() {
 void Pipeline::start(const SessionFiles& files) {
   Impl& i = *impl_;
   if (!i.threads.empty()) throw std::logic_error("Pipeline::start called twice");
-  i.open_files(files.trajectory_file, files.record_file);
+  i.open_files(files.trajectory_file, files.map_trajectory_file, files.record_file);
   if (!files.tiles_dir.empty() && i.config.map.evict_after_keyframes > 0) {
     i.spill.emplace(files.tiles_dir, stored_tile_params(i.config.map.tile_size_m));
   }

@@ -110,6 +110,7 @@ std::string Sessions::start_locked() {
   std::unique_ptr<Pipeline> pipeline = std::move(standby_);
   SessionFiles files;
   files.trajectory_file = dir / "trajectory.tum";
+  files.map_trajectory_file = dir / "map_trajectory.tum";  // the poses the map was built at
   files.tiles_dir = dir / "tiles";          // tiles the sensor has left go there during the session
   files.keyframes_dir = dir / "keyframes";  // and the scans of keyframes it has left
   if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
@@ -174,7 +175,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
   const PipelineStats& s = pipeline->stats();
   const PipelineTimings& t = pipeline->timings();
   const slam::TiledVoxelMap& map = pipeline->map();
-  nlohmann::json files = nlohmann::json::array({"trajectory.tum", "config.yaml"});
+  nlohmann::json files = nlohmann::json::array({"trajectory.tum", "map_trajectory.tum", "config.yaml"});
   try {
     // The tiles still in RAM join those the mapping thread evicted to tiles/
     // during the session; then the map files, streamed tile by tile (a long

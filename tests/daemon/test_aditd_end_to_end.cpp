@@ -184,6 +184,11 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(folder / "summary.json"));
   const std::size_t map_points = summary["map"]["points"];
   ASSERT_GT(map_points, 10'000U);
+  // The poses the map was built at, beside the odometry's.
+  std::ifstream map_trajectory(folder / "map_trajectory.tum");
+  std::size_t map_poses = 0;
+  for (std::string line; std::getline(map_trajectory, line);) ++map_poses;
+  EXPECT_GE(map_poses, 40U);  // 5 s of a 10 Hz sensor, at least
 
   for (const std::string format : {"ply", "pcd", "las"}) {
     const std::filesystem::path out = work / ("download." + format);

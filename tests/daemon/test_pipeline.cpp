@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -31,6 +32,7 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   std::filesystem::remove_all(out);
   PipelineOptions options;
   options.trajectory_file = out / "trajectory.tum";
+  options.map_trajectory_file = out / "map_trajectory.tum";
   Pipeline pipeline(hdl32e_replay(dir, out), options);
   pipeline.start();
   pipeline.join();
@@ -48,6 +50,25 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   std::size_t lines = 0;
   for (std::string line; std::getline(trajectory, line);) ++lines;
   EXPECT_EQ(lines, s.poses.load() - s.invalid_poses.load());
+
+  // The map's own poses: one per mapped scan, at the same stamps, the map's
+  // refinement (map.refine, on by default) moves them a little at most.
+  std::ifstream odometry_file(options.trajectory_file);
+  std::ifstream map_file(options.map_trajectory_file);
+  std::size_t mapped = 0;
+  for (std::string a, b; std::getline(map_file, b);) {
+    ++mapped;
+    ASSERT_TRUE(std::getline(odometry_file, a));
+    std::istringstream in_a(a), in_b(b);
+    double ta = 0, tb = 0;
+    Eigen::Vector3d pa, pb;
+    in_a >> ta >> pa.x() >> pa.y() >> pa.z();
+    in_b >> tb >> pb.x() >> pb.y() >> pb.z();
+    EXPECT_EQ(ta, tb) << mapped;
+    EXPECT_LT((pa - pb).norm(), 0.3) << mapped;
+  }
+  EXPECT_EQ(mapped, s.mapped_scans.load());
+  EXPECT_GE(mapped, 5U);
 }
 
 TEST(Pipeline, StopsOnRequestEvenMidReplay) {

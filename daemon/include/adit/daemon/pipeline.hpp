@@ -45,6 +45,9 @@ struct PipelineSinks {
 
 struct PipelineOptions {
   std::filesystem::path trajectory_file;  // TUM, written as poses arrive; empty = none
+  // TUM: each mapped scan's pose as the map placed it (with map.refine, the
+  // refined pose; the published one is the odometry's); empty = none.
+  std::filesystem::path map_trajectory_file;
   std::filesystem::path record_file;      // raw LiDAR packets as pcap; empty = none
   double replay_speed = -1.0;             // pcap/scan_dir: overrides lidar.replay_speed when ≥ 0
   slam::OdometryConfig odometry;          // range limits come from the lidar section
@@ -111,6 +114,7 @@ struct PipelineTimings {
 // built (and its memory allocated) before its session begins.
 struct SessionFiles {
   std::filesystem::path trajectory_file;  // TUM; empty = none (or PipelineOptions')
+  std::filesystem::path map_trajectory_file;  // TUM, the map's poses; empty = none (or PipelineOptions')
   std::filesystem::path record_file;      // raw packets as pcap; empty = none
   std::filesystem::path can_record_file;  // the CAN bus as candump -L; empty = none
   // Where tiles the sensor has left are written (tiles/<id>.adt) so they can
