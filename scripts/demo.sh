@@ -67,6 +67,6 @@ build/bin/adit eval map --map "$folder/download.ply" --scene "$session/scene.ply
 echo
 echo "demo: session    $folder (summary.json, map.ply, map.las, tiles/, keyframes.tum; aditd log build/state/aditd.log)"
 echo "demo: map        $folder/download.ply (as the tablet downloaded it)"
-echo "demo: trajectory $folder/trajectory.tum"
+echo "demo: trajectory $folder/trajectory.tum (the odometry's, as published), $folder/map_trajectory.tum (the map's poses)"
 echo "demo: plots      $folder/trajectory-plan.svg, $folder/trajectory-ape.svg"
 echo "demo: truth      $session/truth_body.tum, scene $session/scene.ply, targets $session/targets.csv"
