@@ -93,6 +93,71 @@ WheelStep WheelOdometry::add_counts(double t, std::uint64_t left, std::uint64_t 
   return result;
 }
 
+WheelOdometry::TractionCheck WheelOdometry::check_traction(double t, double dt, const std::array<double, 2>& measured,
+                                                          bool from_counts) {
+  // Slip, wheel by wheel: a speed change beyond what the wheel's traction
+  // allows over the interval, plus the measurement's noise. A speed from
+  // counts is uncertain by count_noise counts and by its speed times the
+  // timestamp jitter, both over the interval. A speed from counts is the
+  // mean over its interval, so a slip that starts within an interval shows
+  // half in one reading and half in the next, each below the bound, but not
+  // both together: counts are also judged against the trusted speed before
+  // the last one. (Reported speeds are samples: a step shows at once, and
+  // their noise, up to 1 m/s on a car's ABS sensors, does not shrink over two
+  // readings.)
+  const std::array<double, 2> trusted{v_left_previous_, v_right_previous_};
+  const std::array<double, 2> radius{geometry_.left_radius, geometry_.right_radius};
+  const double per_count = 2.0 * std::numbers::pi / geometry_.counts_per_revolution;
+  TractionCheck result{measured, trusted};
+  std::array<double, 2> bound{};
+  std::array<bool, 2> jump{};  // a new slip: beyond the bound from the last trusted speed ...
+  std::array<bool, 2> ramp{};  // ... or, counts, from the one before
+  for (std::size_t i = 0; i < 2; ++i) {
+    const double noise =
+        from_counts ? (limits_.count_noise * per_count * radius[i] + std::abs(trusted[i]) * limits_.timestamp_jitter) / dt
+                    : limits_.speed_noise;
+    bound[i] = limits_.max_acceleration * std::max(dt, limits_.min_interval) + noise;
+    if (!speeds_known_ || !std::isnan(slip_since_[i])) continue;
+    jump[i] = std::abs(measured[i] - trusted[i]) > bound[i];
+    ramp[i] = from_counts && earlier_known_ &&
+              std::abs(measured[i] - earlier_speed_[i]) >
+                  limits_.max_acceleration * std::max(t - earlier_t_, limits_.min_interval) + noise;
+  }
+  const std::array<bool, 2> held_before{!std::isnan(slip_since_[0]), !std::isnan(slip_since_[1])};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::size_t other = 1 - i;
+    const bool onset = jump[i] || ramp[i];
+    if (!onset && !held_before[i]) continue;
+    if (onset) {
+      // The speeds from before the slip began, and what they said of the turn.
+      const std::array<double, 2>& pre = jump[i] ? trusted : earlier_speed_;
+      slip_since_[i] = jump[i] ? t_previous_ : earlier_t_;
+      slip_offset_[i] = pre[i] - pre[other];
+      slip_speed_[i] = pre[i];
+      ++stats_.slip_episodes;
+    }
+    // What the wheel would read with traction: the other wheel's speed with
+    // the turn rate from before the slip (the vehicle accelerates, the spin
+    // does not steer it), or, if the other wheel is not trusted either, this
+    // wheel's speed from before the slip.
+    const bool other_trusted = !held_before[other] && !jump[other] && !ramp[other];
+    const double reference = other_trusted ? measured[other] + slip_offset_[i] : slip_speed_[i];
+    if (!onset && std::abs(measured[i] - reference) <= bound[i]) {
+      slip_since_[i] = kNotSlipping;  // grips again
+      continue;
+    }
+    if (t - slip_since_[i] > limits_.max_slip_duration) {  // held too long: a real change of speed
+      slip_since_[i] = kNotSlipping;
+      result.accepted_after_slip = true;
+      result.earlier[i] = measured[i];  // the slip's history is no reference for what follows
+      continue;
+    }
+    result.speeds[i] = reference;
+    result.slipping = true;
+  }
+  return result;
+}
+
 WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from_counts) {
   const auto baseline = [&](double vl, double vr) {
     t_previous_ = t;
@@ -134,7 +199,7 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
       baseline(0.0, 0.0);
       slip_since_ = {kNotSlipping, kNotSlipping};
       speeds_known_ = false;
-  earlier_known_ = false;
+      earlier_known_ = false;
       return WheelStep::rebaselined;
     }
     if (from_counts) return WheelStep::impossible;  // baseline kept; the next good reading covers this interval
@@ -147,70 +212,9 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
     return WheelStep::impossible;
   }
 
-  // Slip, wheel by wheel: a speed change beyond what the wheel's traction
-  // allows over the interval, plus the measurement's noise. A speed from
-  // counts is uncertain by count_noise counts and by its speed times the
-  // timestamp jitter, both over the interval. A speed from counts is the
-  // mean over its interval, so a slip that starts within an interval shows
-  // half in one reading and half in the next, each below the bound, but not
-  // both together: counts are also judged against the trusted speed before
-  // the last one. (Reported speeds are samples: a step shows at once, and
-  // their noise, up to 1 m/s on a car's ABS sensors, does not shrink over two
-  // readings.)
-  const std::array<double, 2> measured{v_left, v_right};
   const std::array<double, 2> trusted{v_left_previous_, v_right_previous_};
-  const std::array<double, 2> radius{geometry_.left_radius, geometry_.right_radius};
-  const double per_count = 2.0 * std::numbers::pi / geometry_.counts_per_revolution;
-  std::array<double, 2> used = measured;
-  std::array<double, 2> before = trusted;  // the next reading's earlier speeds
-  std::array<double, 2> bound{};
-  std::array<bool, 2> jump{};  // a new slip: beyond the bound from the last trusted speed ...
-  std::array<bool, 2> ramp{};  // ... or, counts, from the one before
-  for (std::size_t i = 0; i < 2; ++i) {
-    const double noise =
-        from_counts ? (limits_.count_noise * per_count * radius[i] + std::abs(trusted[i]) * limits_.timestamp_jitter) / dt
-                    : limits_.speed_noise;
-    bound[i] = limits_.max_acceleration * std::max(dt, limits_.min_interval) + noise;
-    if (!speeds_known_ || !std::isnan(slip_since_[i])) continue;
-    jump[i] = std::abs(measured[i] - trusted[i]) > bound[i];
-    ramp[i] = from_counts && earlier_known_ &&
-              std::abs(measured[i] - earlier_speed_[i]) >
-                  limits_.max_acceleration * std::max(t - earlier_t_, limits_.min_interval) + noise;
-  }
-  const std::array<bool, 2> held_before{!std::isnan(slip_since_[0]), !std::isnan(slip_since_[1])};
-  bool slipping = false;
-  bool accepted_after_slip = false;
-  for (std::size_t i = 0; i < 2; ++i) {
-    const std::size_t other = 1 - i;
-    const bool onset = jump[i] || ramp[i];
-    if (!onset && !held_before[i]) continue;
-    if (onset) {
-      // The speeds from before the slip began, and what they said of the turn.
-      const std::array<double, 2>& pre = jump[i] ? trusted : earlier_speed_;
-      slip_since_[i] = jump[i] ? t_previous_ : earlier_t_;
-      slip_offset_[i] = pre[i] - pre[other];
-      slip_speed_[i] = pre[i];
-      ++stats_.slip_episodes;
-    }
-    // What the wheel would read with traction: the other wheel's speed with
-    // the turn rate from before the slip (the vehicle accelerates, the spin
-    // does not steer it), or, if the other wheel is not trusted either, this
-    // wheel's speed from before the slip.
-    const bool other_trusted = !held_before[other] && !jump[other] && !ramp[other];
-    const double reference = other_trusted ? measured[other] + slip_offset_[i] : slip_speed_[i];
-    if (!onset && std::abs(measured[i] - reference) <= bound[i]) {
-      slip_since_[i] = kNotSlipping;  // grips again
-      continue;
-    }
-    if (t - slip_since_[i] > limits_.max_slip_duration) {  // held too long: a real change of speed
-      slip_since_[i] = kNotSlipping;
-      accepted_after_slip = true;
-      before[i] = measured[i];  // the slip's history is no reference for what follows
-      continue;
-    }
-    used[i] = reference;
-    slipping = true;
-  }
+  const TractionCheck traction = check_traction(t, dt, {v_left, v_right}, from_counts);
+  const std::array<double, 2>& used = traction.speeds;
   // Counts give the exact travel over the interval; speeds are sampled, so
   // the trapezoid rule integrates them.
   const double vl = from_counts ? used[0] : 0.5 * (used[0] + trusted[0]);
@@ -219,16 +223,16 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   const double dr = vr * dt * geometry_.right_scale;
   integrate_wheel_travel(pose_, covariance_, dl, dr, geometry_.effective_track(), noise_);
   distance_ += std::abs(0.5 * (dl + dr));
-  earlier_speed_ = before;
+  earlier_speed_ = traction.earlier;
   earlier_t_ = t_previous_;
   earlier_known_ = speeds_known_;
   baseline(used[0], used[1]);
   speeds_known_ = true;
-  if (slipping) {
+  if (traction.slipping) {
     ++stats_.slips;
     return WheelStep::slip;
   }
-  if (accepted_after_slip) {
+  if (traction.accepted_after_slip) {
     ++stats_.rebaselined;
     return WheelStep::rebaselined;
   }

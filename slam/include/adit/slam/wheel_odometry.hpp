@@ -131,6 +131,17 @@ class WheelOdometry {
  private:
   WheelStep step(double t, double v_left, double v_right, bool from_counts);
 
+  // Which wheels slip at this reading (time t, dt after the last), and the
+  // speeds to integrate: as measured, or a slipping wheel's speed with
+  // traction. Starts, continues and ends each wheel's slip episode.
+  struct TractionCheck {
+    std::array<double, 2> speeds;   // left, right, m/s
+    std::array<double, 2> earlier;  // the next reading's "speeds before the last"
+    bool slipping = false;
+    bool accepted_after_slip = false;  // a wheel held for max_slip_duration: its new speed is taken
+  };
+  TractionCheck check_traction(double t, double dt, const std::array<double, 2>& measured, bool from_counts);
+
   WheelGeometry geometry_;
   WheelNoise noise_;
   WheelLimits limits_;
