@@ -17,6 +17,32 @@ slam::WheelGeometry geometry() {
   g.counter_bits = 16;
   return g;
 }
+// The simulated mine robot's encoders (sim/src/wheel_encoders.cpp): 16384
+// counts per revolution on 0.1651 m wheels 0.555 m apart, 32-bit counters;
+// a wheel slips beyond 4 m/s² (the simulator's session.yaml).
+struct RobotEncoders {
+  static slam::WheelGeometry geometry() {
+    slam::WheelGeometry g;
+    g.left_radius = g.right_radius = 0.1651;
+    g.track_width = 0.555;
+    g.counts_per_revolution = 16384;
+    g.counter_bits = 32;
+    return g;
+  }
+  static slam::WheelLimits limits() {
+    slam::WheelLimits l;
+    l.max_acceleration = 4.0;
+    return l;
+  }
+  // The counters of wheels whose rims have turned left_m and right_m, read at t.
+  slam::WheelStep read(double t, double left_m, double right_m) {
+    const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+    return odometry.add_counts(t, static_cast<std::uint64_t>(std::llround(left_m * counts_per_m)),
+                               static_cast<std::uint64_t>(std::llround(right_m * counts_per_m)));
+  }
+  slam::WheelOdometry odometry{geometry(), {}, limits()};
+};
+
 }  // namespace
 
 TEST(WheelOdometry, StraightLineAndCovarianceGrowsWithDistance) {
@@ -144,15 +170,8 @@ TEST(WheelOdometry, RepeatedImpossibleReadingsBecomeTheNewBaseline) {
 // 100 Hz, 16384 per revolution. Without slip handling the false turn is
 // 0.3 * 1 m/s * 0.3 s / 0.555 m = 9.3 degrees.
 TEST(WheelOdometry, ASpinningWheelsCountsAreReplacedByItsTrustedSpeedUntilItGripsAgain) {
-  slam::WheelGeometry g;
-  g.left_radius = g.right_radius = 0.1651;
-  g.track_width = 0.555;
-  g.counts_per_revolution = 16384;
-  g.counter_bits = 32;
-  slam::WheelLimits limits;
-  limits.max_acceleration = 4.0;
-  slam::WheelOdometry odo(g, {}, limits);
-  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  RobotEncoders encoders;
+  const slam::WheelOdometry& odo = encoders.odometry;
   double left = 0.0, right = 0.0;  // metres the wheels turned (rim)
   int slips = 0;
   for (int k = 0; k <= 300; ++k) {  // 3 s
@@ -162,8 +181,7 @@ TEST(WheelOdometry, ASpinningWheelsCountsAreReplacedByItsTrustedSpeedUntilItGrip
       left += 0.01 * 1.0 * (spinning ? 1.3 : 1.0);
       right += 0.01 * 1.0;
     }
-    const auto step = odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
-                                     static_cast<std::uint64_t>(std::llround(right * counts_per_m)));
+    const auto step = encoders.read(t, left, right);
     ASSERT_NE(step, slam::WheelStep::rebaselined) << t;
     if (step == slam::WheelStep::slip) ++slips;
   }
@@ -178,14 +196,8 @@ TEST(WheelOdometry, ASpinningWheelsCountsAreReplacedByItsTrustedSpeedUntilItGrip
 // 0.15 m/s, each within the bound over one interval (4 m/s² * 0.02 s plus the
 // counts' noise, 0.19 m/s at 1 m/s), but not together.
 TEST(WheelOdometry, ASlipThatStartsWithinAnIntervalIsStillCaught) {
-  slam::WheelGeometry g;
-  g.left_radius = g.right_radius = 0.1651;
-  g.track_width = 0.555;
-  g.counts_per_revolution = 16384;
-  slam::WheelLimits limits;
-  limits.max_acceleration = 4.0;
-  slam::WheelOdometry odo(g, {}, limits);
-  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  RobotEncoders encoders;
+  const slam::WheelOdometry& odo = encoders.odometry;
   double left = 0.0, right = 0.0;
   for (int k = 0; k <= 300; ++k) {
     const double t = k * 0.01;
@@ -194,8 +206,7 @@ TEST(WheelOdometry, ASlipThatStartsWithinAnIntervalIsStillCaught) {
       left += 0.01 * gain;
       right += 0.01;
     }
-    odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
-                   static_cast<std::uint64_t>(std::llround(right * counts_per_m)));
+    encoders.read(t, left, right);
   }
   EXPECT_EQ(odo.stats().slip_episodes, 1U);
   // The half-steps at its two ends get through (0.15 * 1 m/s * 10 ms each,
@@ -209,14 +220,8 @@ TEST(WheelOdometry, ASlipThatStartsWithinAnIntervalIsStillCaught) {
 // slip, it would stay 'slipping' after the spin ended (the drift session of
 // docs/ODOMETRY.md lost 0.19 % that way).
 TEST(WheelOdometry, AWheelHeldForSlipFollowsTheOtherWheelsAcceleration) {
-  slam::WheelGeometry g;
-  g.left_radius = g.right_radius = 0.1651;
-  g.track_width = 0.555;
-  g.counts_per_revolution = 16384;
-  slam::WheelLimits limits;
-  limits.max_acceleration = 4.0;
-  slam::WheelOdometry odo(g, {}, limits);
-  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  RobotEncoders encoders;
+  const slam::WheelOdometry& odo = encoders.odometry;
   double left = 0.0, right = 0.0, x = 0.0;
   int slips = 0;
   for (int k = 0; k <= 200; ++k) {
@@ -228,9 +233,7 @@ TEST(WheelOdometry, AWheelHeldForSlipFollowsTheOtherWheelsAcceleration) {
       right += 0.01 * v;
       x += 0.01 * v;
     }
-    if (odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
-                       static_cast<std::uint64_t>(std::llround(right * counts_per_m))) == slam::WheelStep::slip)
-      ++slips;
+    if (encoders.read(t, left, right) == slam::WheelStep::slip) ++slips;
   }
   EXPECT_EQ(slips, 30);
   EXPECT_EQ(odo.stats().slip_episodes, 1U);
@@ -240,24 +243,15 @@ TEST(WheelOdometry, AWheelHeldForSlipFollowsTheOtherWheelsAcceleration) {
 
 // The same at a steady turn and a slow, legal acceleration: nothing is held.
 TEST(WheelOdometry, AccelerationWithinTractionIsNeverTakenForSlip) {
-  slam::WheelGeometry g;
-  g.left_radius = g.right_radius = 0.1651;
-  g.track_width = 0.555;
-  g.counts_per_revolution = 16384;
-  slam::WheelLimits limits;
-  limits.max_acceleration = 4.0;
-  slam::WheelOdometry odo(g, {}, limits);
-  const double counts_per_m = 16384 / (2.0 * std::numbers::pi * 0.1651);
+  RobotEncoders encoders;
+  const slam::WheelOdometry& odo = encoders.odometry;
   double left = 0.0, right = 0.0, v = 0.0;
   for (int k = 0; k <= 500; ++k) {
     const double t = k * 0.01;
     v = std::min(1.5, 0.02 * k * 1.5);  // 1.5 m/s² up to 1.5 m/s, then steady
     left += 0.01 * v * 0.8;             // turning left
     right += 0.01 * v * 1.2;
-    EXPECT_NE(odo.add_counts(t, static_cast<std::uint64_t>(std::llround(left * counts_per_m)),
-                             static_cast<std::uint64_t>(std::llround(right * counts_per_m))),
-              slam::WheelStep::slip)
-        << t;
+    EXPECT_NE(encoders.read(t, left, right), slam::WheelStep::slip) << t;
   }
   EXPECT_EQ(odo.stats().slip_episodes, 0U);
 }
