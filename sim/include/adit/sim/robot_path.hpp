@@ -18,6 +18,7 @@ struct RobotPathOptions {
   double lateral_offset_m = 0.0;  // from the route's centre line, + to the left
   double bump_deg = 1.0;          // roll/pitch amplitude from the floor
   double body_height_m = 0.1651;  // body origin above the floor (the axle)
+  double track_m = 0.555;         // between the wheels (as WheelOptions::track_m)
   std::uint64_t seed = 0;
 
   static constexpr double kMaxSpeed = 1.5;
