@@ -20,6 +20,7 @@
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/trajectory.hpp"
 #include "adit/slam/trajectory_io.hpp"
+#include "bench_attitude.hpp"
 #include "bench_baseline.hpp"
 #include "bench_pipeline.hpp"
 #include "bench_scans.hpp"
@@ -245,6 +246,7 @@ void register_bench_commands(CLI::App& app, int& status) {
     status = bench_odometry(*o);
   });
   add_bench_pipeline_command(*bench, status);
+  add_bench_attitude_command(*bench, status);
 }
 
 }  // namespace adit::tools
