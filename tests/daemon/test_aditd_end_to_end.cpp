@@ -234,7 +234,10 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   // client's own latency decides the last scan). So this still asserts a
   // regression floor, not the target: 92 % (85 % before the spacing; 92.9 %
   // measured then). Mapping itself reaches 98.4 % with the true poses; what
-  // is left is the odometry's roll/pitch lag.
+  // is left is the odometry's roll/pitch lag. Session 7 (the simulator's
+  // robot no longer shakes while it turns on the spot): 95.73, 95.73,
+  // 95.75 % in three Release runs; `adit bench attitude` shows the tilt a
+  // scan-to-map odometry gathers through its own map (docs/ODOMETRY.md).
   EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.92) << accuracy.dump();
   RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
 
