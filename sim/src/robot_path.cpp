@@ -37,7 +37,8 @@ Trajectory robot_path(const Scene& scene, const RobotPathOptions& o) {
     // of the distance the wheels have rolled). Turning on the spot, each wheel
     // rolls half the track per radian, so the tilt changes as slowly as the
     // wheels move. (It was the route distance plus 1000 m per turn, which
-    // shook the body by up to ±1° at ~190 Hz while it turned on the spot.)
+    // shook the body by up to ±1° some 200 times a second while it turned on
+    // the spot.)
     if (i > 0)
       travelled += std::abs(arc[i] - arc[i - 1]) +
                    0.5 * o.track_m * std::numbers::pi * std::abs(turn_fraction[i] - turn_fraction[i - 1]);

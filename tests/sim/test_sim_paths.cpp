@@ -68,7 +68,8 @@ TEST(SimPaths, RobotDrivesOutAndBackWithinItsLimits) {
   // The floor tilts the body as fast as the wheels roll over it: at 1.5 m/s
   // over ~1 m bumps a few °/s, turning on the spot (the wheels roll 0.17 m/s)
   // well under 1 °/s. The bumps once followed the route distance plus 1000 m
-  // per turn, and the body shook by ±1° at ~200 Hz while it turned: 50 °/s.
+  // per turn, and the body shook by ±1° some 200 times a second while it
+  // turned: 37 °/s over 50 ms.
   EXPECT_GT(m.top_tilt_rate_turning_on_spot, 0.0);  // it did turn on the spot
   EXPECT_LT(m.top_tilt_rate_turning_on_spot, 1.0 * kDeg);
   EXPECT_LT(m.top_tilt_rate, 10.0 * kDeg);
