@@ -166,6 +166,14 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
     rejected_in_a_row_ = 0;
     have_previous_ = true;
   };
+  // A new baseline with no slip and no earlier speeds: `known` says whether
+  // its speeds are measured (one reading of counts has none yet).
+  const auto restart = [&](double vl, double vr, bool known) {
+    baseline(vl, vr);
+    slip_since_ = {kNotSlipping, kNotSlipping};
+    speeds_known_ = known;
+    earlier_known_ = false;
+  };
   const bool plausible = std::isfinite(v_left) && std::isfinite(v_right) && std::abs(v_left) <= limits_.max_speed &&
                          std::abs(v_right) <= limits_.max_speed;
   if (!std::isfinite(t)) {
@@ -173,10 +181,7 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
     return WheelStep::time_backwards;
   }
   if (!have_previous_) {
-    baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
-    slip_since_ = {kNotSlipping, kNotSlipping};
-    speeds_known_ = plausible && !from_counts;  // one reading of counts has no speed yet
-    earlier_known_ = false;
+    restart(plausible ? v_left : 0.0, plausible ? v_right : 0.0, plausible && !from_counts);
     return WheelStep::first;
   }
   const double dt = t - t_previous_;
@@ -186,20 +191,14 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   }
   if (dt > limits_.max_gap) {
     ++stats_.gaps;
-    baseline(plausible ? v_left : 0.0, plausible ? v_right : 0.0);
-    slip_since_ = {kNotSlipping, kNotSlipping};
-    speeds_known_ = plausible && !from_counts;
-    earlier_known_ = false;
+    restart(plausible ? v_left : 0.0, plausible ? v_right : 0.0, plausible && !from_counts);
     return WheelStep::gap;
   }
   if (!plausible) {
     ++stats_.impossible;
     if (++rejected_in_a_row_ > limits_.max_rejected) {
       ++stats_.rebaselined;
-      baseline(0.0, 0.0);
-      slip_since_ = {kNotSlipping, kNotSlipping};
-      speeds_known_ = false;
-      earlier_known_ = false;
+      restart(0.0, 0.0, false);
       return WheelStep::rebaselined;
     }
     if (from_counts) return WheelStep::impossible;  // baseline kept; the next good reading covers this interval

@@ -33,6 +33,7 @@
 #include "adit/slam/lie.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/registration.hpp"
+#include "adit/slam/stats.hpp"
 #include "adit/slam/trajectory_io.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -63,16 +64,11 @@ struct TiltSeries {
   }
 };
 
-double rms(const std::vector<double>& v) {
-  double s = 0.0;
-  for (const double x : v) s += x * x;
-  return v.empty() ? 0.0 : std::sqrt(s / static_cast<double>(v.size()));
-}
+double rms(const std::vector<double>& v) { return slam::compute_stats(v).rmse; }
 
 double max_abs(const std::vector<double>& v) {
-  double m = 0.0;
-  for (const double x : v) m = std::max(m, std::abs(x));
-  return m;
+  const slam::Stats s = slam::compute_stats(v);
+  return std::max(std::abs(s.min), std::abs(s.max));
 }
 
 // The share of the true change recovered: 1 + the least-squares slope of the
