@@ -106,6 +106,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   }
 
   if (!started_ || map_.empty()) {
+    if (scan.gravity) settle_up(*scan.gravity, scan.stamp_ns);
     deskew_frame(scan_velocity);
     transform_into(deskewed_, pose_, registered_);
     map_.add(registered_);
@@ -124,6 +125,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
   information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
   constant_velocity.information = information.asDiagonal();
+  if (scan.gravity && up_frame_ && scan.gravity->sigma_rad > 0.0)
+    constant_velocity.gravity = {scan.gravity->up, *up_frame_, 1.0 / (scan.gravity->sigma_rad * scan.gravity->sigma_rad)};
   PosePrior prior = constant_velocity;
   if (wheel) {
     prior.mean = predicted;
@@ -231,6 +234,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   mid_offset_s_ = half;
   pose_ = corrected;
   last_stamp_ns_ = scan.stamp_ns;
+  if (scan.gravity) settle_up(*scan.gravity, scan.stamp_ns);
 
   deskew_frame(result.registration.sweep_velocity);
   transform_into(deskewed_, pose_, registered_);
@@ -245,6 +249,14 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   result.valid = true;
   result.status = result.registration.degenerate ? OdometryStatus::degenerate : OdometryStatus::ok;
   return result;
+}
+
+void Odometry::settle_up(const UpMeasurement& gravity, std::int64_t stamp_ns) {
+  if (!(gravity.sigma_rad > 0.0)) return;
+  if (!up_frame_) first_up_ns_ = stamp_ns;
+  else if (1e-9 * static_cast<double>(stamp_ns - first_up_ns_) > config_.gravity_settle_s) return;
+  up_sum_ += (pose_.linear() * gravity.up) / (gravity.sigma_rad * gravity.sigma_rad);
+  up_frame_ = up_sum_.normalized();
 }
 
 }  // namespace adit::slam

@@ -131,6 +131,27 @@ Degeneracy analyse(const NormalEquations& ne, double threshold, int min_correspo
   return d;
 }
 
+// The gravity factor's normal equations at rotation R: residual
+// r = R·u_b − u_f; with R·exp(δω), R·exp(δω)·u_b ≈ R·(u_b + δω × u_b), so
+// ∂r/∂δω = −R·[u_b]×, and JᵀJ = I − u_b·u_bᵀ (no information about yaw).
+struct GravityTerms {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+};
+
+GravityTerms gravity_terms(const GravityPrior& gravity, const Eigen::Matrix3d& R) {
+  GravityTerms terms;
+  if (gravity.information <= 0.0) return terms;
+  Eigen::Matrix3d skew;
+  skew << 0.0, -gravity.up_body.z(), gravity.up_body.y(), gravity.up_body.z(), 0.0, -gravity.up_body.x(),
+      -gravity.up_body.y(), gravity.up_body.x(), 0.0;
+  const Eigen::Matrix3d J = -R * skew;
+  const Eigen::Vector3d r = R * gravity.up_body - gravity.up_frame;
+  terms.H = gravity.information * J.transpose() * J;
+  terms.g = gravity.information * J.transpose() * r;
+  return terms;
+}
+
 }  // namespace
 
 RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
@@ -196,6 +217,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
     // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
     // e(T·exp(δ)) ≈ e + δ to first order.
     const Vector6d e = log_se3(prior.mean.inverse() * result.pose);
+    const GravityTerms gravity = gravity_terms(prior.gravity, result.pose.linear());
     Vector6d delta;
     Vector6d delta_velocity = Vector6d::Zero();
     if (estimate) {
@@ -204,6 +226,8 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
       Vector12d g = ne.g12 * data_scale;
       H.topLeftCorner<6, 6>() += prior.information;
       g.head<6>() += prior.information * e;
+      H.block<3, 3>(3, 3) += gravity.H;
+      g.segment<3>(3) += gravity.g;
       H.bottomRightCorner<6, 6>() += sweep.information;
       g.tail<6>() += sweep.information * (velocity - sweep.velocity);
       Vector12d step = H.ldlt().solve(-g);
@@ -211,8 +235,10 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
       delta = step.head<6>();
       delta_velocity = step.tail<6>();
     } else {
-      const Matrix6d H = ne.H * data_scale + prior.information;
-      const Vector6d g = ne.g * data_scale + prior.information * e;
+      Matrix6d H = ne.H * data_scale + prior.information;
+      Vector6d g = ne.g * data_scale + prior.information * e;
+      H.bottomRightCorner<3, 3>() += gravity.H;
+      g.tail<3>() += gravity.g;
       delta = H.ldlt().solve(-g);
       if (!delta.allFinite()) delta.setZero();
     }
@@ -247,7 +273,8 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
   // instead of an infinite one. Solved in the body frame, reported for a
   // world-frame perturbation.
   const double sigma = std::max(config.point_sigma_m, result.rmse_m);
-  const Matrix6d H = ne.H / (sigma * sigma) + prior.information;
+  Matrix6d H = ne.H / (sigma * sigma) + prior.information;
+  H.bottomRightCorner<3, 3>() += gravity_terms(prior.gravity, result.pose.linear()).H;
   const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(H);
   constexpr double kUnconstrainedVariance = 1e6;
   Vector6d inverse_eigenvalues;

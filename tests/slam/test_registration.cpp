@@ -138,6 +138,33 @@ TEST(Registration, EstimatesTheSweepVelocityOfAScanMeasuredWhileTurning) {
   EXPECT_LT(worst, 0.02);
 }
 
+// A map tilted by 1° (as one whose early scans went astray) pulls the scan's
+// roll and pitch with it; gravity, measured in the body and known in the
+// frame, holds them, and leaves yaw and position to the scan.
+TEST(Registration, GravityHoldsRollAndPitchAgainstATiltedMap) {
+  const Eigen::Isometry3d tilt = pose(0.0, 0.0, 0.0, 0.0, 1.0, -0.5);
+  VoxelHashMap map(0.5F, 1 << 14);
+  map.add(test::transformed(test::room(60000, 1), tilt));
+  const Eigen::Isometry3d truth = pose(0.25, -0.15, 0.05, 4.0, 0.6, -0.4);
+  const auto scan = test::transformed(test::room(8000, 2), truth.inverse());
+  const RegistrationResult free = register_scan(scan, map, PosePrior{}, 1.0, 0.2);
+  EXPECT_LT(rotation_error_deg(free.pose, tilt * truth), 0.05) << "without gravity the scan follows the map";
+
+  PosePrior prior;
+  prior.gravity.up_body = truth.linear().transpose() * Eigen::Vector3d::UnitZ();
+  prior.gravity.up_frame = Eigen::Vector3d::UnitZ();
+  prior.gravity.information = 1.0 / (1e-4 * 1e-4);  // σ 0.006°: gravity decides
+  const RegistrationResult held = register_scan(scan, map, prior, 1.0, 0.2);
+  const Eigen::Vector3d up = held.pose.linear() * prior.gravity.up_body;
+  EXPECT_LT(std::acos(std::min(1.0, up.z())) * 180.0 / M_PI, 0.02) << "the body's up stays the frame's";
+  // Yaw is the scan's: the tilted map's heading at the truth, to within what the tilt's coupling moves.
+  const auto heading = [](const Eigen::Isometry3d& T) {
+    const Eigen::Vector3d x = T.linear() * Eigen::Vector3d::UnitX();
+    return std::atan2(x.y(), x.x()) * 180.0 / M_PI;
+  };
+  EXPECT_NEAR(heading(held.pose), heading(tilt * truth), 0.05);
+}
+
 TEST(Registration, AnEmptyMapOrScanLeavesThePriorAndFlagsIt) {
   VoxelHashMap map(0.5F, 1024);
   PosePrior prior;

@@ -61,9 +61,22 @@ struct RegistrationConfig {
 // A Gaussian prior on the pose: mean and information (inverse covariance) in
 // the body-frame tangent space at the mean, twist order [v; ω]: the pose is
 // mean·exp(ε), ε ~ N(0, information⁻¹).
+// Gravity's direction as an accelerometer measures it (the kinematic
+// acceleration removed): `up_body`, a unit vector in the body frame, should
+// be `up_frame` once rotated into the map frame, R·up_body = up_frame. The
+// residual R·up_body − up_frame constrains roll and pitch only (yaw turns
+// about the vertical). Unlike a prior on the pose, it does not follow the
+// map: a tilt the odometry took into its own map cannot drag it along.
+struct GravityPrior {
+  Eigen::Vector3d up_body = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d up_frame = Eigen::Vector3d::UnitZ();
+  double information = 0.0;  // 1/σ², σ the tilt error in rad; 0 = no gravity
+};
+
 struct PosePrior {
   Eigen::Isometry3d mean = Eigen::Isometry3d::Identity();
   Matrix6d information = Matrix6d::Zero();
+  GravityPrior gravity;
 };
 
 // Continuous-time registration (in the spirit of CT-ICP, Dellenbach et al.
