@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <numbers>
 #include <optional>
 
 #include <malloc.h>
@@ -26,6 +27,7 @@
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/drivers/udp.hpp"
 #include "adit/protocol/map_export.hpp"
+#include "adit/slam/gravity.hpp"
 #include "adit/slam/lie.hpp"
 #include "adit/slam/map_refiner.hpp"
 
@@ -345,10 +347,13 @@ struct Pipeline::Impl {
         body_points.push_back(extrinsic * Eigen::Vector3f(p.x, p.y, p.z));
         body_times.push_back(1e-9F * static_cast<float>(p.time_offset_ns));
       }
-      const std::optional<slam::MotionPrior> prior = wheel_prior_for(slot->scan.start_time_ns);
+      float sweep_s = 0.0F;
+      for (const float t : body_times) sweep_s = std::max(sweep_s, t);
+      const std::optional<slam::MotionPrior> prior = wheel_prior_for(slot->scan.start_time_ns, sweep_s);
+      const std::optional<slam::UpMeasurement> up = up_for(slot->scan.start_time_ns, sweep_s);
       const std::int64_t t0 = monotonic_ns();
       const slam::OdometryResult result =
-          odometry->process({slot->scan.start_time_ns, body_points, body_times}, prior);
+          odometry->process({slot->scan.start_time_ns, body_points, body_times, up}, prior);
       const std::int64_t t1 = monotonic_ns();
       if (timings.odometry_ms.size() < kTimingCapacity) timings.odometry_ms.push_back(1e-6 * static_cast<double>(t1 - t0));
       if (first_stamp_ns == 0) first_stamp_ns = slot->scan.start_time_ns;
@@ -376,23 +381,42 @@ struct Pipeline::Impl {
   // Odometry thread: the wheels' motion since the previous scan, or nullopt
   // (then odometry predicts with constant velocity). A replayed CAN log is
   // waited for, so a replay as fast as possible still gets its priors.
-  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns) {
+  // The samples are taken up to the sweep's end and a little past it, for
+  // the accelerometer's mean over the sweep and the wheels' speed there.
+  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns, float sweep_s) {
     if (!wheels) return std::nullopt;
     const double t = 1e-9 * static_cast<double>(stamp_ns);
-    wheels->drain_into(wheel_history, t);
-    while (wheels->replay() && wheel_history.latest() < t && !wheels->finished() &&
+    const double until = t + sweep_s + kSpeedHalfWindow_s;
+    ImuHistory* imu = config.imu.enabled ? &imu_history : nullptr;
+    wheels->drain_into(wheel_history, until, imu);
+    while (wheels->replay() && wheel_history.latest() < until && !wheels->finished() &&
            !stop.load(std::memory_order_relaxed)) {
       odometry_beat.beat();
       wait_a_little();
-      wheels->drain_into(wheel_history, t);
+      wheels->drain_into(wheel_history, until, imu);
     }
-    wheels->drain_into(wheel_history, t);  // what the feed handed over just before it finished
+    wheels->drain_into(wheel_history, until, imu);  // what the feed handed over just before it finished
     const double previous = previous_odometry_stamp_s;
     previous_odometry_stamp_s = t;
     if (previous <= 0.0) return std::nullopt;
     std::optional<slam::MotionPrior> prior = wheel_history.prior(previous, t);
     (prior ? stats.wheel_priors : stats.scans_without_wheels).fetch_add(1, std::memory_order_relaxed);
     return prior;
+  }
+
+  // Odometry thread, after wheel_prior_for: gravity's up in the body frame
+  // over the sweep, from the accelerometer's mean with the wheels' kinematic
+  // acceleration removed (slam/gravity.hpp), or nullopt.
+  std::optional<slam::UpMeasurement> up_for(std::int64_t stamp_ns, float sweep_s) {
+    if (!wheels || !config.imu.enabled) return std::nullopt;
+    const double t0 = 1e-9 * static_cast<double>(stamp_ns);
+    const double t1 = t0 + std::max(sweep_s, 0.01F);
+    const std::optional<Eigen::Vector3d> force = imu_history.mean(t0, t1);
+    const std::optional<Eigen::Vector3d> acceleration = wheel_history.acceleration(t0, t1, kSpeedHalfWindow_s);
+    std::optional<slam::UpMeasurement> up;
+    if (force && acceleration) up = slam::measured_up(*force, *acceleration, gravity_sigma_rad);
+    (up ? stats.gravity_priors : stats.scans_without_gravity).fetch_add(1, std::memory_order_relaxed);
+    return up;
   }
 
   // Odometry thread: copies (no allocation: the slot's buffers are reserved).
@@ -664,6 +688,9 @@ struct Pipeline::Impl {
   std::optional<drivers::PcapWriter> recorder;
   std::optional<WheelFeed> wheels;
   WheelHistory wheel_history{8192};       // odometry thread only: 80 s at 100 Hz
+  ImuHistory imu_history{4096};           // odometry thread only: 40 s at 100 Hz
+  const double gravity_sigma_rad = config.imu.gravity_sigma_deg * std::numbers::pi / 180.0;
+  static constexpr double kSpeedHalfWindow_s = 0.05;  // the wheels' speed: central differences over ±50 ms
   double previous_odometry_stamp_s = 0.0;  // odometry thread only
   std::optional<Handoff<MapSlot>> map_slots;
   // Mapping thread only:

@@ -1,8 +1,12 @@
 #include "adit/daemon/wheel_feed.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
@@ -85,6 +89,70 @@ std::optional<slam::MotionPrior> WheelHistory::prior(double t0, double t1) const
   return slam::wheel_motion_prior(p0, p1, d1 - d0);
 }
 
+std::optional<Eigen::Vector3d> WheelHistory::acceleration(double t0, double t1, double half_window) const {
+  if (!(t1 > t0) || !(half_window > 0.0)) return std::nullopt;
+  // Forward speed at t: the displacement over [t − h, t + h] along the heading at t.
+  const auto speed = [&](double t, double& v, double& heading) {
+    slam::Pose2 a, b, mid;
+    double d = 0.0;
+    if (!interpolate(t - half_window, a, d) || !interpolate(t + half_window, b, d) || !interpolate(t, mid, d)) return false;
+    v = ((b.x - a.x) * std::cos(mid.theta) + (b.y - a.y) * std::sin(mid.theta)) / (2.0 * half_window);
+    heading = mid.theta;
+    return true;
+  };
+  double v0 = 0.0, v1 = 0.0, h0 = 0.0, h1 = 0.0;
+  if (!speed(t0, v0, h0) || !speed(t1, v1, h1)) return std::nullopt;
+  const double dt = t1 - t0;
+  const double omega = slam::wrap_angle(h1 - h0) / dt;
+  return Eigen::Vector3d((v1 - v0) / dt, omega * 0.5 * (v0 + v1), 0.0);
+}
+
+// --- ImuHistory -------------------------------------------------------------
+
+ImuHistory::ImuHistory(std::size_t capacity) : ring_(std::max<std::size_t>(capacity, 2)) {}
+
+void ImuHistory::push(const ImuSample& sample) {
+  if (size_ > 0 && !(sample.t > ring_[(first_ + size_ - 1) % ring_.size()].t)) return;  // time must advance
+  if (size_ == ring_.size()) {
+    first_ = (first_ + 1) % ring_.size();
+    --size_;
+  }
+  ring_[(first_ + size_) % ring_.size()] = sample;
+  ++size_;
+}
+
+double ImuHistory::latest() const {
+  return size_ == 0 ? -std::numeric_limits<double>::infinity() : ring_[(first_ + size_ - 1) % ring_.size()].t;
+}
+
+std::optional<Eigen::Vector3d> ImuHistory::mean(double t0, double t1, std::size_t min_samples) const {
+  // The time average over [t0, t1] of the readings joined by straight lines
+  // (trapezoids; the ends interpolated): a plain mean of the readings inside
+  // would stand for an interval shifted by up to one reading period, and
+  // while the robot speeds up at 4 m/s³ a 5 ms shift is 0.02 m/s² (0.1°).
+  if (!(t1 > t0) || size_ < 2) return std::nullopt;
+  const auto at = [&](std::size_t i) -> const ImuSample& { return ring_[(first_ + i) % ring_.size()]; };
+  if (at(0).t > t0 || at(size_ - 1).t < t1) return std::nullopt;
+  // The last reading at or before t0 (newest first: the wanted ones are the last few).
+  std::size_t i = size_ - 1;
+  while (i > 0 && at(i).t > t0) --i;
+  const auto value = [&](std::size_t k, double t) {
+    const ImuSample& a = at(k);
+    const ImuSample& b = at(k + 1);
+    return Eigen::Vector3d(a.specific_force + (b.specific_force - a.specific_force) * ((t - a.t) / (b.t - a.t)));
+  };
+  Eigen::Vector3d integral = Eigen::Vector3d::Zero();
+  std::size_t inside = 0;
+  for (; i + 1 < size_ && at(i).t < t1; ++i) {
+    const double from = std::max(at(i).t, t0);
+    const double to = std::min(at(i + 1).t, t1);
+    if (to > from) integral += 0.5 * (value(i, from) + value(i, to)) * (to - from);
+    if (at(i + 1).t <= t1) ++inside;
+  }
+  if (inside < min_samples) return std::nullopt;
+  return integral / (t1 - t0);
+}
+
 // --- WheelFeed --------------------------------------------------------------
 
 struct WheelFeed::Impl {
@@ -97,6 +165,8 @@ struct WheelFeed::Impl {
   std::optional<can::CanSocket> socket;
   std::optional<can::CandumpWriter> recorder;
   std::vector<double> values;
+  std::array<std::size_t, 3> accel{};  // decoder slots of the accelerometer's x, y, z (config.imu.enabled)
+  Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
 
   static slam::WheelGeometry geometry_of(const config::WheelOdometrySection& w) {
     slam::WheelGeometry g;
@@ -116,17 +186,29 @@ struct WheelFeed::Impl {
     return l;
   }
 
-  // The decoder of the two wheel signals; an unknown signal is named by its config key.
+  // The signals the feed decodes, with the config key that names each.
+  static std::vector<std::pair<std::string, std::string>> wanted_signals(const config::Config& c) {
+    std::vector<std::pair<std::string, std::string>> wanted{{c.wheel_odometry.left_signal, "wheel_odometry.left_signal"},
+                                                            {c.wheel_odometry.right_signal, "wheel_odometry.right_signal"}};
+    if (c.imu.enabled) {
+      wanted.emplace_back(c.imu.accel_x_signal, "imu.accel_x_signal");
+      wanted.emplace_back(c.imu.accel_y_signal, "imu.accel_y_signal");
+      wanted.emplace_back(c.imu.accel_z_signal, "imu.accel_z_signal");
+    }
+    return wanted;
+  }
+
+  // The decoder of the wheel (and accelerometer) signals; an unknown signal is named by its config key.
   static can::SignalDecoder make_decoder(const config::Config& c) {
-    const config::WheelOdometrySection& w = c.wheel_odometry;
+    const auto wanted = wanted_signals(c);
+    std::vector<std::string> names;
+    for (const auto& [name, key] : wanted) names.push_back(name);
     try {
-      return can::SignalDecoder(can_messages_of(c), std::vector<std::string>{w.left_signal, w.right_signal},
-                                w.quantity != config::WheelQuantity::counts);
+      return can::SignalDecoder(can_messages_of(c), names, c.wheel_odometry.quantity != config::WheelQuantity::counts);
     } catch (const InputError& e) {
-      const std::string key = e.key() == w.left_signal    ? "wheel_odometry.left_signal"
-                              : e.key() == w.right_signal ? "wheel_odometry.right_signal"
-                                                          : e.key();
-      throw InputError(e.where(), key, e.reason());
+      for (const auto& [name, key] : wanted)
+        if (e.key() == name) throw InputError(e.where(), key, e.reason());
+      throw;
     }
   }
 
@@ -140,6 +222,20 @@ struct WheelFeed::Impl {
     if (r < 0) throw InputError("", "wheel_odometry.right_signal", "no such signal in can.dbc / can.signals");
     left = static_cast<std::size_t>(l);
     right = static_cast<std::size_t>(r);
+    if (c.imu.enabled) {
+      const auto wanted = wanted_signals(c);
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        const auto& [name, key] = wanted[2 + axis];
+        const int slot = decoder.slot(name);
+        if (slot < 0) throw InputError("", key, "no such signal in can.dbc / can.signals");
+        accel[axis] = static_cast<std::size_t>(slot);
+      }
+      const auto rad = [](double deg) { return deg * std::numbers::pi / 180.0; };
+      imu_to_body = (Eigen::AngleAxisd(rad(c.imu.rpy_deg[2]), Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[1]), Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[0]), Eigen::Vector3d::UnitX()))
+                        .toRotationMatrix();
+    }
     values.resize(decoder.slot_count());
     if (c.can.source == config::CanSource::candump) {
       log.emplace(c.can.log);
@@ -158,7 +254,7 @@ struct WheelFeed::Impl {
 WheelFeed::WheelFeed(const config::Config& config)
     : impl_(std::make_unique<Impl>(config)),
       replay_(config.can.source == config::CanSource::candump),
-      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return WheelSample{}; }) {}
+      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return CanSample{}; }) {}
 
 WheelFeed::~WheelFeed() { stop(); }
 
@@ -179,13 +275,37 @@ void WheelFeed::stop() {
   }
 }
 
-void WheelFeed::drain_into(WheelHistory& history, double until_t) {
-  while (!(replay_ && history.latest() >= until_t)) {
-    WheelSample* s = samples_.take();
+void WheelFeed::drain_into(WheelHistory& history, double until_t, ImuHistory* imu) {
+  // A replay stops once both streams reach until_t, or a second past it
+  // (an accelerometer that fell silent must not drain the whole log).
+  const auto covered = [&] {
+    if (history.latest() < until_t) return false;
+    return imu == nullptr || !impl_->config.imu.enabled || imu->latest() >= until_t || drained_t_ >= until_t + 1.0;
+  };
+  while (!(replay_ && covered())) {
+    CanSample* s = samples_.take();
     if (s == nullptr) return;
-    history.push(*s);
+    if (const auto* wheel = std::get_if<WheelSample>(s)) {
+      history.push(*wheel);
+      drained_t_ = wheel->t;
+    } else if (const auto* reading = std::get_if<ImuSample>(s)) {
+      if (imu != nullptr) imu->push(*reading);
+      drained_t_ = reading->t;
+    }
     samples_.release(s);
   }
+}
+
+bool WheelFeed::hand_over(const CanSample& sample) {
+  CanSample* out = nullptr;
+  while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {
+    beat_.beat();  // replay: the odometry thread has not caught up
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  if (out == nullptr) return false;
+  *out = sample;
+  samples_.publish(out);
+  return true;
 }
 
 void WheelFeed::run() {
@@ -209,11 +329,18 @@ void WheelFeed::run() {
     }
     const can::DecodeResult r = i.decoder.decode(frame, i.values);
     if (r.status != can::DecodeStatus::decoded) continue;
-    // Left and right may come in separate frames: a sample is taken when both
-    // have a value newer than the last sample.
     const auto written = [&](std::size_t slot) {
       return slot >= r.first && slot < r.first + r.count && !std::isnan(i.values[slot]);
     };
+    // An accelerometer frame carries all three axes.
+    if (i.config.imu.enabled && written(i.accel[0]) && written(i.accel[1]) && written(i.accel[2])) {
+      const Eigen::Vector3d f(i.values[i.accel[0]], i.values[i.accel[1]], i.values[i.accel[2]]);
+      if (!hand_over(ImuSample{1e-6 * static_cast<double>(frame.time_us) - i.config.imu.time_offset_s, i.imu_to_body * f}))
+        break;
+      stats_.imu_samples.fetch_add(1, std::memory_order_relaxed);
+    }
+    // Left and right may come in separate frames: a sample is taken when both
+    // have a value newer than the last sample.
     if (written(i.left)) value_left = i.values[i.left];
     if (written(i.right)) value_right = i.values[i.right];
     if (std::isnan(value_left) || std::isnan(value_right)) continue;
@@ -232,14 +359,7 @@ void WheelFeed::run() {
       stats_.untrusted.fetch_add(1, std::memory_order_relaxed);
     stats_.slip_episodes.store(i.odometry.stats().slip_episodes, std::memory_order_relaxed);
     if (step == slam::WheelStep::time_backwards) continue;
-    WheelSample* out = nullptr;
-    while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {
-      beat_.beat();  // replay: the odometry thread has not caught up
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-    if (out == nullptr) break;
-    *out = {t, i.odometry.pose(), i.odometry.distance()};
-    samples_.publish(out);
+    if (!hand_over(WheelSample{t, i.odometry.pose(), i.odometry.distance()})) break;
     stats_.samples.fetch_add(1, std::memory_order_relaxed);
   }
   stats_.dropped.store(samples_.dropped());

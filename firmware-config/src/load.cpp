@@ -55,6 +55,18 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
       fail("wheel_odometry.right_signal", "wheel_odometry.enabled", "required when wheel odometry is enabled");
   }
 
+  if (c.imu.enabled) {
+    // The accelerometer is read by the CAN thread that integrates the wheels.
+    if (!c.can.enabled) fail("imu.enabled", "imu.enabled", "needs can.enabled: true (the accelerometer is read from CAN)");
+    if (!c.wheel_odometry.enabled)
+      fail("imu.enabled", "imu.enabled", "needs wheel_odometry.enabled: true (the wheels give the acceleration to remove)");
+    const std::pair<const char*, const std::string*> axes[] = {
+        {"imu.accel_x_signal", &c.imu.accel_x_signal}, {"imu.accel_y_signal", &c.imu.accel_y_signal},
+        {"imu.accel_z_signal", &c.imu.accel_z_signal}};
+    for (const auto& [key, name] : axes)
+      if (name->empty()) fail(key, "imu.enabled", "required when the IMU is enabled");
+  }
+
   if (c.map.tile_size_m / c.map.voxel_m > 1600.0)
     fail("map.voxel_m", "map.tile_size_m", "at most 1600 voxels per tile edge: raise map.voxel_m or lower map.tile_size_m");
 

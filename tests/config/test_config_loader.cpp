@@ -153,6 +153,18 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(wheels.key(), "wheel_odometry.enabled");
   EXPECT_EQ(wheels.reason(), "needs can.enabled: true");
 
+  const InputError imu = parse_error(std::string(kMinimal) + "imu:\n  enabled: true\n");
+  EXPECT_EQ(imu.key(), "imu.enabled");
+  EXPECT_EQ(imu.reason(), "needs can.enabled: true (the accelerometer is read from CAN)");
+  const std::string can_and_wheels = std::string(kMinimal) +
+                                     "can:\n  enabled: true\n  source: candump\n  log: can.log\n"
+                                     "wheel_odometry:\n  enabled: true\n  left_signal: l\n  right_signal: r\n";
+  const InputError axis =
+      parse_error(can_and_wheels + "imu:\n  enabled: true\n  accel_x_signal: ax\n  accel_y_signal: ay\n");
+  EXPECT_EQ(axis.key(), "imu.accel_z_signal");
+  EXPECT_EQ(axis.reason(), "required when the IMU is enabled");
+  EXPECT_EQ(parse_error(can_and_wheels + "imu:\n  gravity_sigma_deg: 0\n").key(), "imu.gravity_sigma_deg");
+
   const InputError fifo = parse_error(std::string(kMinimal) + "threads:\n  odometry:\n    policy: fifo\n");
   EXPECT_EQ(fifo.key(), "threads.odometry.priority");
 }

@@ -89,6 +89,8 @@ struct PipelineStats {
   std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
+  std::atomic<std::uint64_t> gravity_priors{0};        // scans registered with the accelerometer's up
+  std::atomic<std::uint64_t> scans_without_gravity{0}; // IMU configured, but no readings or not gravity-sized
 };
 
 // A stage's queue and its thread's CPU time, for the status message.

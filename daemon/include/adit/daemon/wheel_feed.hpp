@@ -1,5 +1,6 @@
 #pragma once
-// Wheel encoders for the odometry's prior (config `can:` + `wheel_odometry:`).
+// Wheel encoders for the odometry's prior (config `can:` + `wheel_odometry:`),
+// and an accelerometer on the same bus for its gravity prior (config `imu:`).
 // A thread reads CAN frames (SocketCAN on the payload, or a candump -L log
 // for replays), records the bus when `can.record` is set, decodes the two
 // wheel signals, integrates slam::WheelOdometry and hands timed planar poses
@@ -10,10 +11,14 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <thread>
+#include <variant>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/handoff.hpp"
@@ -34,6 +39,32 @@ struct WheelSample {
   double distance = 0.0;  // m travelled so far
 };
 
+// One accelerometer reading: specific force in the body frame (the config's
+// imu.rpy_deg applied), m/s².
+struct ImuSample {
+  double t = 0.0;  // s, on the LiDAR clock (imu.time_offset_s removed)
+  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();
+};
+
+// What the CAN thread hands over, in bus order.
+using CanSample = std::variant<WheelSample, ImuSample>;
+
+// The odometry thread's recent accelerometer readings: fixed capacity, oldest dropped.
+class ImuHistory {
+ public:
+  explicit ImuHistory(std::size_t capacity);
+  void push(const ImuSample& sample);
+  double latest() const;
+  // The mean specific force over [t0, t1], the readings joined by straight
+  // lines; nullopt unless readings lie on both sides and `min_samples` within.
+  std::optional<Eigen::Vector3d> mean(double t0, double t1, std::size_t min_samples = 3) const;
+
+ private:
+  std::vector<ImuSample> ring_;
+  std::size_t first_ = 0;
+  std::size_t size_ = 0;
+};
+
 // The odometry thread's recent wheel samples: fixed capacity, oldest dropped.
 class WheelHistory {
  public:
@@ -46,6 +77,12 @@ class WheelHistory {
   // The body motion from t0 to t1 by the wheels (interpolated), nullopt
   // when the samples do not cover [t0, t1].
   std::optional<slam::MotionPrior> prior(double t0, double t1) const;
+  // The body's mean kinematic acceleration over [t0, t1] in the body frame
+  // (x forward, y left), as a planar vehicle on its wheels moves: the change
+  // of forward speed over the interval, v(t1) − v(t0) over t1 − t0, plus the
+  // centripetal ω·v to the left (ω × v). The speeds are central differences
+  // over ±`half_window` s; nullopt when the samples do not cover that.
+  std::optional<Eigen::Vector3d> acceleration(double t0, double t1, double half_window = 0.05) const;
 
  private:
   const WheelSample& at(std::size_t i) const { return ring_[(first_ + i) % ring_.size()]; }
@@ -62,6 +99,7 @@ struct WheelFeedStats {
   std::atomic<std::uint64_t> slip_episodes{0};  // a wheel lost traction and was held at its trusted speed
   std::atomic<std::uint64_t> dropped{0};    // live: the odometry thread fell behind
   std::atomic<std::uint64_t> recorded{0};
+  std::atomic<std::uint64_t> imu_samples{0};
   std::atomic<std::int64_t> last_frame_us{0};
 };
 
@@ -82,7 +120,8 @@ class WheelFeed {
   // at or after `until_t` has moved (a replay: the rest waits in the
   // hand-off, so the history keeps the window the next scans need) or none
   // is left (live: everything).
-  void drain_into(WheelHistory& history, double until_t);
+  // Accelerometer readings go to `imu` (dropped when null).
+  void drain_into(WheelHistory& history, double until_t, ImuHistory* imu = nullptr);
   // A replayed log has been read to its end and every sample handed over.
   bool finished() const { return finished_.load(std::memory_order_acquire); }
   bool replay() const { return replay_; }
@@ -92,9 +131,12 @@ class WheelFeed {
  private:
   struct Impl;
   void run();
+  // Waits for room in a replay; false when stopped meanwhile.
+  bool hand_over(const CanSample& sample);
   std::unique_ptr<Impl> impl_;
   bool replay_ = false;
-  Handoff<WheelSample> samples_;
+  Handoff<CanSample> samples_;
+  double drained_t_ = -std::numeric_limits<double>::infinity();  // the last sample taken (odometry thread)
   WheelFeedStats stats_;
   Heartbeat beat_{"wheels"};
   std::atomic<bool> stop_{false};

@@ -104,6 +104,19 @@ struct WheelOdometrySection {
   double max_slip_s = 1.0;
 };
 
+// An accelerometer on the CAN bus: gravity's direction for the odometry's
+// roll and pitch (slam/gravity.hpp). Three signals in m/s² (after the
+// signal's factor), the IMU's axes given in the body frame.
+struct ImuSection {
+  bool enabled = false;
+  std::string accel_x_signal;            // required when enabled: DBC "MESSAGE.SIGNAL" or inline name
+  std::string accel_y_signal;
+  std::string accel_z_signal;
+  std::array<double, 3> rpy_deg{0.0, 0.0, 0.0};  // the IMU's axes in the body frame (roll, pitch, yaw)
+  double time_offset_s = 0.0;            // IMU clock minus LiDAR clock
+  double gravity_sigma_deg = 0.2;        // the odometry's trust in the measured up, per scan
+};
+
 // A GPIO line: by offset on the chip, or by its name (one of them).
 struct GpioLine {
   int offset = -1;
@@ -178,6 +191,7 @@ struct Config {
   LidarSection lidar;
   CanSection can;
   WheelOdometrySection wheel_odometry;
+  ImuSection imu;
   GpioSection gpio;
   MapSection map;
   SessionSection session;

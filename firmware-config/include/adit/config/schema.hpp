@@ -147,6 +147,17 @@ void describe(V& v, WheelOdometrySection& s) {
 }
 
 template <typename V>
+void describe(V& v, ImuSection& s) {
+  v.optional("enabled", s.enabled);
+  v.optional("accel_x_signal", s.accel_x_signal);
+  v.optional("accel_y_signal", s.accel_y_signal);
+  v.optional("accel_z_signal", s.accel_z_signal);
+  v.optional("rpy_deg", s.rpy_deg, Range<double>{-360.0, 360.0});
+  v.optional("time_offset_s", s.time_offset_s, Range<double>{-10.0, 10.0});
+  v.optional("gravity_sigma_deg", s.gravity_sigma_deg, Range<double>{0.01, 10.0});
+}
+
+template <typename V>
 void describe(V& v, GpioLine& s) {
   v.optional("offset", s.offset, Range<int>{-1, 1023});
   v.optional("name", s.name);
@@ -216,6 +227,7 @@ void describe(V& v, Config& c) {
   v.section("lidar", c.lidar);
   v.section("can", c.can);
   v.section("wheel_odometry", c.wheel_odometry);
+  v.section("imu", c.imu);
   v.section("gpio", c.gpio);
   v.section("map", c.map);
   v.section("session", c.session);
