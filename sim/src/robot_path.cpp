@@ -15,6 +15,7 @@ ScheduleOptions schedule_options(const RobotPathOptions& o) {
   s.speed_mps = o.speed_mps;
   s.turn_rate_rps = RobotPathOptions::kTurnRate;
   s.ramp_s = RobotPathOptions::kRamp;
+  s.hold_start_s = RobotPathOptions::kHoldStart;
   return s;
 }
 }  // namespace

@@ -13,7 +13,9 @@
 #include "adit/sim/spinning_lidar.hpp"
 #include "adit/sim/targets.hpp"
 #include "adit/sim/truth.hpp"
+#include "adit/sim/imu.hpp"
 #include "adit/sim/wheel_encoders.hpp"
+#include "adit/drivers/can/candump.hpp"
 
 namespace adit::sim {
 namespace {
@@ -140,16 +142,31 @@ SimSummary run_simulation(const SimOptions& o) {
   wheels.time_offset_s = o.can_offset_s;
   wheels.start_time_ns = o.start_time_ns;
   wheels.seed = o.seed;
+  ImuOptions imu;
+  imu.bias_sigma_mps2 = o.imu_bias_sigma_mps2;
+  imu.time_offset_s = o.can_offset_s;
+  imu.start_time_ns = o.start_time_ns;
+  imu.seed = o.seed;
   if (o.wheels && !is_drone(o)) {
-    const WheelTruth truth = simulate_wheel_encoders(body, wheels, o.out / "can.log");
+    std::vector<drivers::can::Frame> frames;
+    const WheelTruth truth = simulate_wheel_encoders(body, wheels, frames);
     write_wheel_truth(o.out / "truth_wheels.csv", truth, o.start_time_ns);
+    if (o.imu) {
+      const ImuTruth imu_truth = simulate_imu(body, imu, frames);
+      log::info("sim: accelerometer bias {:+.4f} {:+.4f} {:+.4f} m/s²", imu_truth.bias.x(), imu_truth.bias.y(),
+                imu_truth.bias.z());
+    }
+    std::stable_sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.time_us < b.time_us; });
+    drivers::can::CandumpWriter writer(o.out / "can.log");
+    for (const drivers::can::Frame& f : frames) writer.write(f);
+    writer.flush();
   }
   write_tum(o.out / "truth_body.tum", body, Eigen::Isometry3d::Identity(), o.start_time_ns);
   write_tum(o.out / "truth_sensor.tum", body, lidar.extrinsics, o.start_time_ns);
   write_ply(o.out / "scene.ply", scene.mesh);
   if (!scene.design.triangles.empty()) write_ply_points(o.out / "bim.ply", sample_surface(scene.design, 100.0, o.seed));
   write_targets_csv(o.out / "targets.csv", targets);
-  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels, lidar.extrinsics);
+  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels, imu, lidar.extrinsics);
 
   SimSummary summary;
   summary.packets = stats.packets;

@@ -7,7 +7,6 @@
 #include <numbers>
 
 #include "adit/common/error.hpp"
-#include "adit/drivers/can/candump.hpp"
 #include "adit/sim/hash_noise.hpp"
 
 namespace adit::sim {
@@ -31,8 +30,7 @@ drivers::can::Frame tpdo(std::int64_t time_us, std::uint32_t id, std::int32_t co
 
 }  // namespace
 
-WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& o, const std::filesystem::path& log) {
-  drivers::can::CandumpWriter writer(log);
+WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& o, std::vector<drivers::can::Frame>& frames_out) {
   const double true_radius = o.radius_m * (1.0 + o.radius_error);
   const double counts_per_rad = o.counts_per_revolution / (2.0 * std::numbers::pi);
   const auto& samples = body.samples();
@@ -66,10 +64,9 @@ WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& o
       return static_cast<std::int32_t>(std::lround(angle * counts_per_rad + o.count_noise * gaussian(o.seed, kCountStream, index)));
     };
     const std::int64_t time_us = (o.start_time_ns + std::llround((t + o.time_offset_s) * 1e9)) / 1000;
-    writer.write(tpdo(time_us, o.left_id, counts(left, 2 * k)));
-    writer.write(tpdo(time_us + 150, o.right_id, counts(right, 2 * k + 1)));  // the second PDO follows on the bus
+    frames_out.push_back(tpdo(time_us, o.left_id, counts(left, 2 * k)));
+    frames_out.push_back(tpdo(time_us + 150, o.right_id, counts(right, 2 * k + 1)));  // the second PDO follows on the bus
   }
-  writer.flush();
   return truth;
 }
 

@@ -13,6 +13,7 @@
 #include "adit/drivers/can/candump.hpp"
 #include "adit/drivers/can/decoder.hpp"
 #include "adit/drivers/can/signal.hpp"
+#include "adit/sim/imu.hpp"
 #include "adit/sim/session.hpp"
 #include "sim_session.hpp"
 
@@ -111,7 +112,7 @@ TEST(SimSession, CanLogDecodesBackToTheWheelSpeedsWithinQuantisation) {
     if (frame.id == 0x181) {
       left.push_back(values[static_cast<std::size_t>(decoder.slot("left"))]);
       left_time.push_back(frame.time_us);
-    } else {
+    } else if (frame.id == 0x182) {
       right.push_back(values[static_cast<std::size_t>(decoder.slot("right"))]);
     }
   }
@@ -136,6 +137,56 @@ TEST(SimSession, CanLogDecodesBackToTheWheelSpeedsWithinQuantisation) {
     fastest = std::max(fastest, v_true);
   }
   EXPECT_GT(fastest, 3.0);  // the robot really drove (≥ 0.5 m/s on a 0.165 m wheel)
+}
+
+// The accelerometer's frames, decoded with the signals session.yaml gives
+// them, read the robot's specific force (sim/imu.hpp) plus a small constant
+// bias and noise: gravity's up within 0.1°.
+TEST(SimSession, CanLogCarriesTheAccelerometerAsSessionYamlDescribesIt) {
+  SimOptions o = test::short_session("imu");
+  run_simulation(o);
+  const config::Config c = config::load_config(o.out / "session.yaml");
+  ASSERT_TRUE(c.imu.enabled);
+  std::vector<drivers::can::MessageSpec> messages;
+  for (const config::CanSignal& cs : c.can.signals) {
+    drivers::can::SignalSpec spec;
+    spec.name = cs.name;
+    spec.start_bit = static_cast<unsigned>(cs.start_bit);
+    spec.length = static_cast<unsigned>(cs.length);
+    spec.is_signed = cs.value_type == config::ValueType::signed_int;
+    spec.factor = cs.factor;
+    drivers::can::add_inline_signal(messages, cs.id, false, spec);
+  }
+  drivers::can::SignalDecoder decoder(messages, {}, false);
+  std::vector<double> values(decoder.slot_count());
+  const auto slot = [&](const std::string& name) { return static_cast<std::size_t>(decoder.slot(name)); };
+  const Trajectory path = simulated_path(simulated_scene(o), o);
+  drivers::can::CandumpReader reader(o.out / "can.log");
+  drivers::can::Frame frame;
+  std::size_t readings = 0;
+  Eigen::Vector3d sum_error = Eigen::Vector3d::Zero();
+  double worst = 0.0;
+  while (reader.next(frame)) {
+    const drivers::can::DecodeResult r = decoder.decode(frame, values);
+    if (r.status != drivers::can::DecodeStatus::decoded || frame.id != 0x190) continue;
+    const Eigen::Vector3d f(values[slot(c.imu.accel_x_signal)], values[slot(c.imu.accel_y_signal)],
+                            values[slot(c.imu.accel_z_signal)]);
+    const double t = 1e-6 * static_cast<double>(frame.time_us) - 1e-9 * static_cast<double>(o.start_time_ns);
+    const auto i = static_cast<std::size_t>(std::lround(t * Trajectory::kRate));
+    const Eigen::Vector3d error = f - specific_force_at(path, std::min(i, path.samples().size() - 2));
+    sum_error += error;
+    worst = std::max(worst, error.cwiseAbs().maxCoeff());
+    ++readings;
+  }
+  EXPECT_EQ(readings, static_cast<std::size_t>(o.duration_s * 100.0) + 1);
+  // Bias (σ 9.8 mm/s² per axis) plus noise (σ 4.2) plus quantisation (0.5).
+  EXPECT_LT(worst, 4.0 * 0.0098 + 5.0 * 0.0042);
+  const Eigen::Vector3d bias = sum_error / static_cast<double>(readings);
+  EXPECT_LT(bias.cwiseAbs().maxCoeff(), 4.0 * 0.0098) << bias.transpose();
+  // At rest (the first second) the reading is gravity's reaction: up in the body, 9.81 m/s² long.
+  const Eigen::Vector3d still = specific_force_at(path, 10);
+  EXPECT_NEAR(still.norm(), 9.80665, 1e-6);
+  EXPECT_NEAR((path.samples()[10].orientation * still).normalized().z(), 1.0, 1e-12);
 }
 
 TEST(SimSession, SessionConfigIsValidAndPointsAtTheFiles) {

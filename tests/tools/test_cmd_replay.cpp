@@ -22,16 +22,16 @@ namespace fs = std::filesystem;
 using adit::test::CommandRun;
 CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
 
-// A 10 s simulated drift with a VLP-16 (about 100 scans), written once and
+// An 11 s simulated drift with a VLP-16 (about 100 scans), written once and
 // shared by the test processes (renamed into place whole, so never half-read);
 // each process writes its outputs in a folder of its own.
 class Replay : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    session_ = adit::test::binary_dir() / "test-sessions" / "replay-drift-10s";
+    session_ = adit::test::binary_dir() / "test-sessions" / "replay-drift-11s";
     if (!fs::exists(session_ / "session.yaml")) {
       const fs::path partial = session_.string() + ".partial-" + std::to_string(::getpid());
-      const CommandRun sim = adit("sim --scene drift --platform robot --sensor VLP-16 --duration 10 --seed 7 --out " +
+      const CommandRun sim = adit("sim --scene drift --platform robot --sensor VLP-16 --duration 11 --seed 7 --out " +
                                   partial.string());
       ASSERT_EQ(sim.status, 0) << sim.output;
       std::error_code already_there;

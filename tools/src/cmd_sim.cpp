@@ -33,6 +33,10 @@ void register_sim_commands(CLI::App& app, int& status) {
       ->capture_default_str();
   cmd->add_option("--slips-per-minute", o->slips_per_minute, "Wheel slip events per minute")->capture_default_str();
   cmd->add_option("--can-offset-s", o->can_offset_s, "CAN clock minus LiDAR clock, seconds")->capture_default_str();
+  cmd->add_option("--imu", o->imu, "Robot: an accelerometer on the CAN bus (0x190, m/s² × 1000 in three int16)")
+      ->capture_default_str();
+  cmd->add_option("--imu-bias-mps2", o->imu_bias_sigma_mps2, "σ of the accelerometer's constant bias per axis, m/s²")
+      ->capture_default_str();
   cmd->add_option("--targets", o->targets, "Surveyed wall targets to place")->capture_default_str();
   cmd->add_option("--people", o->people, "People walking along the route (moving obstacles, not in scene.ply)")
       ->capture_default_str();

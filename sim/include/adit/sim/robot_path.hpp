@@ -24,6 +24,9 @@ struct RobotPathOptions {
   static constexpr double kMaxSpeed = 1.5;
   static constexpr double kTurnRate = 0.6;  // rad/s on the spot
   static constexpr double kRamp = 1.0;      // s to reach cruise speed
+  // s standing still before moving off, as a crew starts a survey: the
+  // accelerometer's gravity then needs no motion removed (slam/gravity.hpp).
+  static constexpr double kHoldStart = 1.0;
 };
 
 Trajectory robot_path(const Scene& scene, const RobotPathOptions& options);

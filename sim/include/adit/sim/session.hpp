@@ -1,7 +1,7 @@
 #pragma once
 // One simulated survey session: options in, a folder of files out, laid out
 // like a field recording plus its ground truth:
-//   lidar.pcap        the sensor's UDP packets       can.log          wheel TPDOs (candump -L)
+//   lidar.pcap        the sensor's UDP packets       can.log          wheel TPDOs and accelerometer (candump -L)
 //   VLP16.yaml, RS16.csv, PandarXT32.csv or OS1-64.json (metadata): the calibration
 //   session.yaml      an adit config that replays it
 //   truth_body.tum    body trajectory (TUM)          truth_sensor.tum sensor trajectory (TUM)
@@ -41,6 +41,9 @@ struct SimOptions {
   double wheel_radius_error = 0.004;
   double slips_per_minute = 1.0;
   double can_offset_s = 0.0;  // CAN clock minus LiDAR clock
+  // The robot's accelerometer on the same bus (sim/imu.hpp); its bias σ per axis.
+  bool imu = true;
+  double imu_bias_sigma_mps2 = 0.0098;
   int targets = 8;
   int people = 0;  // walkers along the route (dynamic objects)
   std::int64_t start_time_ns = 1'767'225'600'000'000'000;  // 2026-01-01T00:00:00Z

@@ -10,13 +10,14 @@
 #include <Eigen/Geometry>
 
 #include "adit/sim/session.hpp"
+#include "adit/sim/imu.hpp"
 #include "adit/sim/wheel_encoders.hpp"
 
 namespace adit::sim {
 
 // Throws adit::InputError when the file cannot be written.
 void write_session_config(const std::filesystem::path& file, const SimOptions& options,
-                          const std::string& calibration_file, const WheelOptions& wheels,
+                          const std::string& calibration_file, const WheelOptions& wheels, const ImuOptions& imu,
                           const Eigen::Isometry3d& extrinsics);
 
 }  // namespace adit::sim

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "adit/drivers/can/frame.hpp"
 #include "adit/sim/trajectory.hpp"
 
 namespace adit::sim {
@@ -37,9 +38,10 @@ struct WheelTruth {
   std::vector<double> left_rad, right_rad;  // wheel angles (with slip)
 };
 
-// Writes the log; throws adit::InputError when it cannot be written.
+// Appends the wheels' frames to `frames` (time order; the session merges
+// them with the IMU's into can.log).
 WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& options,
-                                   const std::filesystem::path& candump_log);
+                                   std::vector<drivers::can::Frame>& frames);
 // "time,left_rad,right_rad" per frame (time in seconds on the common clock).
 void write_wheel_truth(const std::filesystem::path& file, const WheelTruth& truth, std::int64_t start_time_ns);
 
