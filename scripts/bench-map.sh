@@ -9,7 +9,7 @@
 #
 # Usage: scripts/bench-map.sh [DRIVE ...]
 #   DRIVE = scene:platform:seconds:seed, e.g. mine:robot:60:3 (adit sim's options);
-#   without arguments, the set of docs/ODOMETRY.md (12 drives, about 12 minutes on 2 cores).
+#   without arguments, the set of docs/ODOMETRY.md (12 drives, about 3 minutes on 2 cores).
 # Sessions are made once under build/sessions/bench-map/; each run's files go to build/bench-map/.
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds those folders (default: build).
 set -euo pipefail
