@@ -45,34 +45,20 @@ std::vector<can::MessageSpec> can_messages_of(const config::Config& c) {
 
 // --- WheelHistory ---------------------------------------------------------
 
-WheelHistory::WheelHistory(std::size_t capacity) : ring_(std::max<std::size_t>(capacity, 2)) {}
-
-void WheelHistory::push(const WheelSample& sample) {
-  if (size_ > 0 && !(sample.t > at(size_ - 1).t)) return;  // time must advance
-  if (size_ == ring_.size()) {
-    first_ = (first_ + 1) % ring_.size();
-    --size_;
-  }
-  ring_[(first_ + size_) % ring_.size()] = sample;
-  ++size_;
-}
-
-double WheelHistory::latest() const {
-  return size_ == 0 ? -std::numeric_limits<double>::infinity() : at(size_ - 1).t;
-}
-
 bool WheelHistory::interpolate(double t, slam::Pose2& pose, double& distance) const {
-  if (size_ < 2 || t < at(0).t || t > at(size_ - 1).t) return false;
+  const TimedRing<WheelSample>& at = samples_;
+  const std::size_t size = at.size();
+  if (size < 2 || t < at[0].t || t > at.back().t) return false;
   // Binary search over the ring for the first sample at or after t.
   std::size_t lo = 1;
-  std::size_t hi = size_ - 1;
+  std::size_t hi = size - 1;
   while (lo < hi) {
     const std::size_t mid = (lo + hi) / 2;
-    if (at(mid).t < t) lo = mid + 1;
+    if (at[mid].t < t) lo = mid + 1;
     else hi = mid;
   }
-  const WheelSample& a = at(lo - 1);
-  const WheelSample& b = at(lo);
+  const WheelSample& a = at[lo - 1];
+  const WheelSample& b = at[lo];
   const double u = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
   pose = {a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
           a.pose.theta + u * slam::wrap_angle(b.pose.theta - a.pose.theta)};
@@ -109,45 +95,29 @@ std::optional<Eigen::Vector3d> WheelHistory::acceleration(double t0, double t1, 
 
 // --- ImuHistory -------------------------------------------------------------
 
-ImuHistory::ImuHistory(std::size_t capacity) : ring_(std::max<std::size_t>(capacity, 2)) {}
-
-void ImuHistory::push(const ImuSample& sample) {
-  if (size_ > 0 && !(sample.t > ring_[(first_ + size_ - 1) % ring_.size()].t)) return;  // time must advance
-  if (size_ == ring_.size()) {
-    first_ = (first_ + 1) % ring_.size();
-    --size_;
-  }
-  ring_[(first_ + size_) % ring_.size()] = sample;
-  ++size_;
-}
-
-double ImuHistory::latest() const {
-  return size_ == 0 ? -std::numeric_limits<double>::infinity() : ring_[(first_ + size_ - 1) % ring_.size()].t;
-}
-
 std::optional<Eigen::Vector3d> ImuHistory::mean(double t0, double t1, std::size_t min_samples) const {
   // The time average over [t0, t1] of the readings joined by straight lines
   // (trapezoids; the ends interpolated): a plain mean of the readings inside
   // would stand for an interval shifted by up to one reading period, and
   // while the robot speeds up at 4 m/s³ a 5 ms shift is 0.02 m/s² (0.1°).
-  if (!(t1 > t0) || size_ < 2) return std::nullopt;
-  const auto at = [&](std::size_t i) -> const ImuSample& { return ring_[(first_ + i) % ring_.size()]; };
-  if (at(0).t > t0 || at(size_ - 1).t < t1) return std::nullopt;
+  const TimedRing<ImuSample>& at = samples_;
+  const std::size_t size = at.size();
+  if (!(t1 > t0) || size < 2 || at[0].t > t0 || at.back().t < t1) return std::nullopt;
   // The last reading at or before t0 (newest first: the wanted ones are the last few).
-  std::size_t i = size_ - 1;
-  while (i > 0 && at(i).t > t0) --i;
+  std::size_t i = size - 1;
+  while (i > 0 && at[i].t > t0) --i;
   const auto value = [&](std::size_t k, double t) {
-    const ImuSample& a = at(k);
-    const ImuSample& b = at(k + 1);
+    const ImuSample& a = at[k];
+    const ImuSample& b = at[k + 1];
     return Eigen::Vector3d(a.specific_force + (b.specific_force - a.specific_force) * ((t - a.t) / (b.t - a.t)));
   };
   Eigen::Vector3d integral = Eigen::Vector3d::Zero();
   std::size_t inside = 0;
-  for (; i + 1 < size_ && at(i).t < t1; ++i) {
-    const double from = std::max(at(i).t, t0);
-    const double to = std::min(at(i + 1).t, t1);
+  for (; i + 1 < size && at[i].t < t1; ++i) {
+    const double from = std::max(at[i].t, t0);
+    const double to = std::min(at[i + 1].t, t1);
     if (to > from) integral += 0.5 * (value(i, from) + value(i, to)) * (to - from);
-    if (at(i + 1).t <= t1) ++inside;
+    if (at[i + 1].t <= t1) ++inside;
   }
   if (inside < min_samples) return std::nullopt;
   return integral / (t1 - t0);

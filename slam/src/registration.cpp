@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "adit/slam/deskew.hpp"
+#include "adit/slam/lie.hpp"
 
 namespace adit::slam {
 namespace {
@@ -142,10 +143,7 @@ struct GravityTerms {
 GravityTerms gravity_terms(const GravityPrior& gravity, const Eigen::Matrix3d& R) {
   GravityTerms terms;
   if (gravity.information <= 0.0) return terms;
-  Eigen::Matrix3d skew;
-  skew << 0.0, -gravity.up_body.z(), gravity.up_body.y(), gravity.up_body.z(), 0.0, -gravity.up_body.x(),
-      -gravity.up_body.y(), gravity.up_body.x(), 0.0;
-  const Eigen::Matrix3d J = -R * skew;
+  const Eigen::Matrix3d J = -R * skew(gravity.up_body);
   const Eigen::Vector3d r = R * gravity.up_body - gravity.up_frame;
   terms.H = gravity.information * J.transpose() * J;
   terms.g = gravity.information * J.transpose() * r;

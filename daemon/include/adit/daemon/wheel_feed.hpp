@@ -8,6 +8,7 @@
 // keeps the recent ones in a WheelHistory and asks it for the motion between
 // two scans (slam::wheel_motion_prior).
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -49,31 +50,57 @@ struct ImuSample {
 // What the CAN thread hands over, in bus order.
 using CanSample = std::variant<WheelSample, ImuSample>;
 
+// The odometry thread's recent samples of one kind (with a time `t`): fixed
+// capacity, the oldest dropped, time strictly advancing (others are ignored).
+template <typename Sample>
+class TimedRing {
+ public:
+  explicit TimedRing(std::size_t capacity) : ring_(std::max<std::size_t>(capacity, 2)) {}
+  void push(const Sample& sample) {
+    if (size_ > 0 && !(sample.t > back().t)) return;
+    if (size_ == ring_.size()) {
+      first_ = (first_ + 1) % ring_.size();
+      --size_;
+    }
+    ring_[(first_ + size_) % ring_.size()] = sample;
+    ++size_;
+  }
+  std::size_t size() const { return size_; }
+  // Oldest first; i < size().
+  const Sample& operator[](std::size_t i) const { return ring_[(first_ + i) % ring_.size()]; }
+  const Sample& back() const { return (*this)[size_ - 1]; }
+  // Time of the newest sample; -infinity when empty.
+  double latest() const { return size_ == 0 ? -std::numeric_limits<double>::infinity() : back().t; }
+
+ private:
+  std::vector<Sample> ring_;
+  std::size_t first_ = 0;
+  std::size_t size_ = 0;
+};
+
 // The odometry thread's recent accelerometer readings: fixed capacity, oldest dropped.
 class ImuHistory {
  public:
-  explicit ImuHistory(std::size_t capacity);
-  void push(const ImuSample& sample);
-  double latest() const;
+  explicit ImuHistory(std::size_t capacity) : samples_(capacity) {}
+  void push(const ImuSample& sample) { samples_.push(sample); }
+  double latest() const { return samples_.latest(); }
   // The mean specific force over [t0, t1], the readings joined by straight
   // lines; nullopt unless readings lie on both sides and `min_samples` within.
   std::optional<Eigen::Vector3d> mean(double t0, double t1, std::size_t min_samples = 3) const;
 
  private:
-  std::vector<ImuSample> ring_;
-  std::size_t first_ = 0;
-  std::size_t size_ = 0;
+  TimedRing<ImuSample> samples_;
 };
 
 // The odometry thread's recent wheel samples: fixed capacity, oldest dropped.
 class WheelHistory {
  public:
-  explicit WheelHistory(std::size_t capacity);
-  void push(const WheelSample& sample);
+  explicit WheelHistory(std::size_t capacity) : samples_(capacity) {}
+  void push(const WheelSample& sample) { samples_.push(sample); }
   // Time of the newest sample; -infinity when empty.
-  double latest() const;
+  double latest() const { return samples_.latest(); }
   // Distance travelled at the newest sample (0 when empty).
-  double latest_distance() const { return size_ == 0 ? 0.0 : at(size_ - 1).distance; }
+  double latest_distance() const { return samples_.size() == 0 ? 0.0 : samples_.back().distance; }
   // The body motion from t0 to t1 by the wheels (interpolated), nullopt
   // when the samples do not cover [t0, t1].
   std::optional<slam::MotionPrior> prior(double t0, double t1) const;
@@ -85,11 +112,8 @@ class WheelHistory {
   std::optional<Eigen::Vector3d> acceleration(double t0, double t1, double half_window = 0.05) const;
 
  private:
-  const WheelSample& at(std::size_t i) const { return ring_[(first_ + i) % ring_.size()]; }
   bool interpolate(double t, slam::Pose2& pose, double& distance) const;
-  std::vector<WheelSample> ring_;
-  std::size_t first_ = 0;
-  std::size_t size_ = 0;
+  TimedRing<WheelSample> samples_;
 };
 
 struct WheelFeedStats {
