@@ -19,7 +19,7 @@
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
 #include "adit/protocol/command_gate.hpp"
-#include "adit/protocol/utime.hpp"
+#include "adit/common/clock.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
@@ -31,7 +31,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using protocol::Channel;
 
-using protocol::now_utime;
 
 // The hand-offs carry items by swapping them with the pool's: the producer
 // gets the slot's old buffers back, so nothing is allocated once warm.
@@ -169,7 +168,7 @@ struct LcmEndpoint::Impl final : TileSink {
       return;
     }
     command_ack_t ack;
-    ack.utime = now_utime();
+    ack.utime = realtime_us();
     ack.schema = 1;
     ack.request_id = r.command.request_id;
     ack.payload_id = options.payload_id;
@@ -238,7 +237,7 @@ struct LcmEndpoint::Impl final : TileSink {
     ack.reason = t.reason;
     if (!t.accepted) return;
     if (event == protocol::SessionEvent::start) {
-      std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", now_utime());
+      std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", realtime_us());
       session_id = std::move(started);
       publisher.reset(session_id, hooks.session_folder ? hooks.session_folder(session_id) : std::filesystem::path{});
       pose_seq = 0;

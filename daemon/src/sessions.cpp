@@ -14,14 +14,15 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
-#include "adit/protocol/utime.hpp"
 #include "adit/daemon/tile_spill.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/slam/tum.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -75,7 +76,7 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
   }
   if (outputs_.tile) {
     options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
-      tile(TileUpdate{protocol::now_utime(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
+      tile(TileUpdate{realtime_us(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
     };
   }
   return std::make_unique<Pipeline>(config_, options);
@@ -319,7 +320,7 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
     // Only the tile's segment table stays in RAM; its frames are read from the file when sent.
     const std::string problem = err != std::errc{} || end != stem.data() + stem.size()
                                     ? entry.path().string() + ": not named <tile id>.adt"
-                                    : into.insert_file(tile_id, entry.path(), protocol::now_utime());
+                                    : into.insert_file(tile_id, entry.path(), realtime_us());
     if (!problem.empty() && bad++ == 0) first_problem = problem;
   }
   if (bad > 0)
@@ -329,7 +330,7 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
 
 StatusSample Sessions::status_sample() {
   StatusSample sample;
-  sample.utime = protocol::now_utime();
+  sample.utime = realtime_us();
   sample.disk_free_bytes = disk_free_bytes(std::filesystem::exists(root_) ? root_ : std::filesystem::path(config_.payload.state_dir));
   const std::lock_guard lock(mutex_);
   if (!pipeline_) return sample;
@@ -355,7 +356,7 @@ StatusSample Sessions::status_sample() {
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
   const std::int64_t last_packet_ns = s.last_packet_realtime_ns.load();
-  const double silent_s = 1e-9 * static_cast<double>(protocol::now_utime() * 1000 - last_packet_ns);
+  const double silent_s = 1e-9 * static_cast<double>(realtime_us() * 1000 - last_packet_ns);
   if (pipeline_->drained()) sample.fault = "the recording has ended";
   else if (last_packet_ns == 0) sample.fault = "no LiDAR packets yet";
   else if (silent_s > 1.0) sample.fault = fmt::format("no LiDAR packets for {:.0f} s", silent_s);

@@ -1,5 +1,5 @@
 #include "adit/daemon/tile_publisher.hpp"
-#include "adit/protocol/utime.hpp"
+#include "adit/common/clock.hpp"
 
 #include <algorithm>
 #include <array>
@@ -17,7 +17,6 @@ constexpr std::size_t kIndexEntriesPerPart = 2000;
 // (212 992 bytes on Linux) holds little more.
 constexpr double kBurstBytes = 2.0 * protocol::kChunkPayloadBytes;
 
-using protocol::now_utime;
 
 }  // namespace
 
@@ -141,7 +140,7 @@ void TilePublisher::send_index(const std::vector<const EncodedTile*>& tiles, boo
       std::max<std::size_t>(1, (tiles.size() + kIndexEntriesPerPart - 1) / kIndexEntriesPerPart));
   for (std::int32_t part = 0; part < n_parts; ++part) {
     tile_index_t m;
-    m.utime = now_utime();
+    m.utime = realtime_us();
     m.schema = 1;
     m.payload_id = options_.payload_id;
     m.session_id = session_id_;

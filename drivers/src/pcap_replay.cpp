@@ -4,14 +4,9 @@
 
 #include <cerrno>
 
+#include "adit/common/clock.hpp"
+
 namespace adit::drivers {
-namespace {
-std::int64_t monotonic_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
-}
-}  // namespace
 
 PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed) : reader_(file), speed_(speed) {}
 

@@ -30,11 +30,11 @@ ScheduleOptions schedule_options(const DronePathOptions& o) {
 
 double drone_min_duration_s() { return min_schedule_duration_s(schedule_options(DronePathOptions{})); }
 
-Trajectory drone_path(const Scene& scene, const DronePathOptions& o) {
+BodyTrack drone_path(const Scene& scene, const DronePathOptions& o) {
   const Route& route = scene.route;
   const RouteSchedule schedule = route_schedule(route, schedule_options(o));
   const std::size_t n = schedule.arc.size();
-  const double dt = 1.0 / Trajectory::kRate;
+  const double dt = 1.0 / BodyTrack::kRate;
   // Position and yaw first; the tilt needs their accelerations.
   std::vector<Eigen::Vector3d> position(n);
   std::vector<double> yaw(n);
@@ -80,7 +80,7 @@ Trajectory drone_path(const Scene& scene, const DronePathOptions& o) {
                              Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                              Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
   }
-  return Trajectory(std::move(samples));
+  return BodyTrack(std::move(samples));
 }
 
 }  // namespace adit::sim

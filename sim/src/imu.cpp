@@ -29,9 +29,9 @@ drivers::can::Frame accel_frame(std::int64_t time_us, std::uint32_t id, const Ei
 
 }  // namespace
 
-Eigen::Vector3d specific_force_at(const Trajectory& body, std::size_t i) {
+Eigen::Vector3d specific_force_at(const BodyTrack& body, std::size_t i) {
   const auto& s = body.samples();
-  const double dt = 1.0 / Trajectory::kRate;
+  const double dt = 1.0 / BodyTrack::kRate;
   const std::size_t last = s.size() - 1;
   const auto at = [&](std::ptrdiff_t k) { return std::clamp<std::ptrdiff_t>(k, 0, static_cast<std::ptrdiff_t>(last)); };
   const auto index = static_cast<std::ptrdiff_t>(i);
@@ -53,7 +53,7 @@ Eigen::Vector3d specific_force_at(const Trajectory& body, std::size_t i) {
   return s[i].orientation.conjugate() * (acceleration + Eigen::Vector3d(0.0, 0.0, kGravity));
 }
 
-ImuTruth simulate_imu(const Trajectory& body, const ImuOptions& o, std::vector<drivers::can::Frame>& frames) {
+ImuTruth simulate_imu(const BodyTrack& body, const ImuOptions& o, std::vector<drivers::can::Frame>& frames) {
   ImuTruth truth;
   for (int axis = 0; axis < 3; ++axis)
     truth.bias(axis) = o.bias_sigma_mps2 * gaussian(o.seed, kBiasStream, static_cast<std::uint64_t>(axis));
@@ -62,7 +62,7 @@ ImuTruth simulate_imu(const Trajectory& body, const ImuOptions& o, std::vector<d
   const auto count = static_cast<std::uint64_t>(body.duration() * o.rate_hz);
   for (std::uint64_t k = 0; k <= count; ++k) {
     const double t = static_cast<double>(k) / o.rate_hz;
-    const auto i = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(t * Trajectory::kRate)), 1, samples - 2);
+    const auto i = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(t * BodyTrack::kRate)), 1, samples - 2);
     Eigen::Vector3d f = specific_force_at(body, i) + truth.bias;
     for (int axis = 0; axis < 3; ++axis)
       f(axis) += o.noise_mps2 * gaussian(o.seed, kNoiseStream, 3 * k + static_cast<std::uint64_t>(axis));

@@ -22,7 +22,7 @@ ScheduleOptions schedule_options(const RobotPathOptions& o) {
 
 double robot_min_duration_s() { return min_schedule_duration_s(schedule_options(RobotPathOptions{})); }
 
-Trajectory robot_path(const Scene& scene, const RobotPathOptions& o) {
+BodyTrack robot_path(const Scene& scene, const RobotPathOptions& o) {
   const Route& route = scene.route;
   const RouteSchedule schedule = route_schedule(route, schedule_options(o));
   const std::vector<double>& arc = schedule.arc;
@@ -39,7 +39,7 @@ Trajectory robot_path(const Scene& scene, const RobotPathOptions& o) {
     // rolls half the track per radian, so the tilt changes as slowly as the
     // wheels move. (It was the route distance plus 1000 m per turn, which
     // shook the body by up to ±1° some 200 times a second while it turned on
-    // the spot.)
+    // the spot: docs/decisions/016-sim-bumps-follow-odometer.md.)
     if (i > 0)
       travelled += std::abs(arc[i] - arc[i - 1]) +
                    0.5 * o.track_m * std::numbers::pi * std::abs(turn_fraction[i] - turn_fraction[i - 1]);
@@ -56,14 +56,14 @@ Trajectory robot_path(const Scene& scene, const RobotPathOptions& o) {
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, samples.size() - 1);
     if (a == b) continue;
-    const double dt = static_cast<double>(b - a) / Trajectory::kRate;
+    const double dt = static_cast<double>(b - a) / BodyTrack::kRate;
     const Eigen::Vector3d forward = samples[i].orientation * Eigen::Vector3d::UnitX();
     samples[i].speed_mps = (samples[b].position - samples[a].position).dot(forward) / dt;
     const Eigen::Vector3d fa = samples[a].orientation * Eigen::Vector3d::UnitX();
     const Eigen::Vector3d fb = samples[b].orientation * Eigen::Vector3d::UnitX();
     samples[i].yaw_rate_rps = std::remainder(std::atan2(fb.y(), fb.x()) - std::atan2(fa.y(), fa.x()), 2 * std::numbers::pi) / dt;
   }
-  return Trajectory(std::move(samples));
+  return BodyTrack(std::move(samples));
 }
 
 }  // namespace adit::sim

@@ -4,16 +4,16 @@
 #include <cmath>
 #include <numbers>
 
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 namespace {
 
-// Arc length travelled on one leg of `duration` with cruise speed v, sampled at Trajectory::kRate.
+// Arc length travelled on one leg of `duration` with cruise speed v, sampled at BodyTrack::kRate.
 std::vector<double> leg_profile(double duration, double v, double ramp) {
-  const auto n = static_cast<std::size_t>(std::llround(duration * Trajectory::kRate));
+  const auto n = static_cast<std::size_t>(std::llround(duration * BodyTrack::kRate));
   std::vector<double> s(n + 1, 0.0);
-  const double dt = 1.0 / Trajectory::kRate;
+  const double dt = 1.0 / BodyTrack::kRate;
   const auto speed = [&](double t) { return v * smoothstep(t / ramp) * smoothstep((duration - t) / ramp); };
   for (std::size_t i = 1; i <= n; ++i) {
     const double t = static_cast<double>(i) * dt;
@@ -40,7 +40,7 @@ RouteSchedule route_schedule(const Route& route, const ScheduleOptions& o) {
   const double cruise_time = moving - o.ramp_s;  // two half-ramps lose one ramp time
   RouteSchedule r;
   const auto hold = [&](double seconds, double arc, double turned) {
-    const auto n = static_cast<std::size_t>(std::llround(seconds * Trajectory::kRate));
+    const auto n = static_cast<std::size_t>(std::llround(seconds * BodyTrack::kRate));
     r.arc.insert(r.arc.end(), n, arc);
     r.turn_fraction.insert(r.turn_fraction.end(), n, turned);
   };
@@ -58,7 +58,7 @@ RouteSchedule route_schedule(const Route& route, const ScheduleOptions& o) {
     const double far = out.back();
     r.arc.insert(r.arc.end(), out.begin(), out.end());
     r.turn_fraction.insert(r.turn_fraction.end(), out.size(), 0.0);
-    const auto turn_samples = static_cast<std::size_t>(std::llround(turn * Trajectory::kRate));
+    const auto turn_samples = static_cast<std::size_t>(std::llround(turn * BodyTrack::kRate));
     for (std::size_t i = 1; i <= turn_samples; ++i) {
       r.arc.push_back(far);
       r.turn_fraction.push_back(smoothstep(static_cast<double>(i) / static_cast<double>(turn_samples)));
@@ -69,7 +69,7 @@ RouteSchedule route_schedule(const Route& route, const ScheduleOptions& o) {
     }
   }
   // Exactly the requested duration: rounding may leave a sample or two; stand still.
-  const auto total = static_cast<std::size_t>(std::llround(o.duration_s * Trajectory::kRate)) + 1;
+  const auto total = static_cast<std::size_t>(std::llround(o.duration_s * BodyTrack::kRate)) + 1;
   r.arc.resize(total, r.arc.back());
   r.turn_fraction.resize(total, r.turn_fraction.back());
   return r;

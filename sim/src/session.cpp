@@ -45,7 +45,7 @@ Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extr
 
 People simulated_people(const Scene& scene, const SimOptions& o) { return make_people(scene, o.people, o.seed); }
 
-Trajectory simulated_path(const Scene& scene, const SimOptions& o) {
+BodyTrack simulated_path(const Scene& scene, const SimOptions& o) {
   if (is_drone(o)) {
     DronePathOptions d;
     d.duration_s = o.duration_s;
@@ -98,14 +98,14 @@ void validate(const SimOptions& o) {
 SimSummary run_simulation(const SimOptions& o) {
   validate(o);
   const Scene scene = simulated_scene(o);
-  const Trajectory body = simulated_path(scene, o);
+  const BodyTrack body = simulated_path(scene, o);
   // The platform (about 0.6 m wide) must stay clear of the walls, floor and roof all the way.
   double path_length = 0.0;
   for (std::size_t i = 0; i < body.samples().size(); ++i) {
     const Eigen::Vector3d& p = body.samples()[i].position;
     if (scene.plan.distance(p.head<2>()) > -0.4 || p.z() > scene.plan.roof(p.head<2>()) - 0.5) {
       throw InputError("adit sim", "--lateral-offset-m",
-                       "the path leaves the " + scene.name + " at t = " + std::to_string(static_cast<double>(i) / Trajectory::kRate) +
+                       "the path leaves the " + scene.name + " at t = " + std::to_string(static_cast<double>(i) / BodyTrack::kRate) +
                            " s (x " + std::to_string(p.x()) + ", y " + std::to_string(p.y()) + ")");
     }
     if (i > 0) path_length += (p - body.samples()[i - 1].position).norm();

@@ -30,7 +30,7 @@ SpinningSensor make_spinning_sensor(std::string_view model) {
                    "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32, OS1-64)");
 }
 
-LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
+LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTrack& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
                                       const People& people, const LidarSimOptions& o,
                                       drivers::PcapWriter& pcap) {

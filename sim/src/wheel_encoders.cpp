@@ -30,11 +30,11 @@ drivers::can::Frame tpdo(std::int64_t time_us, std::uint32_t id, std::int32_t co
 
 }  // namespace
 
-WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& o, std::vector<drivers::can::Frame>& frames_out) {
+WheelTruth simulate_wheel_encoders(const BodyTrack& body, const WheelOptions& o, std::vector<drivers::can::Frame>& frames_out) {
   const double true_radius = o.radius_m * (1.0 + o.radius_error);
   const double counts_per_rad = o.counts_per_revolution / (2.0 * std::numbers::pi);
   const auto& samples = body.samples();
-  const double dt = 1.0 / Trajectory::kRate;
+  const double dt = 1.0 / BodyTrack::kRate;
   // Slip events: in each second, with probability slips_per_minute/60, one wheel slips.
   const auto slip_gain = [&](double t, int wheel) {
     const auto second = static_cast<std::uint64_t>(t);

@@ -169,7 +169,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // scan had. A wheel that spins a little (3° of false turn per scan, seen
   // on simulated 30-minute sessions) keeps the overlap but departs from any
   // plausible change of motion. Either way the constant-velocity prediction
-  // is tried too, and the registration that explains more of the scan wins.
+  // is tried too, and the registration that explains more of the scan wins
+  // (docs/decisions/006-wheel-spin-check.md).
   const auto enough = [&](const RegistrationResult& r) {
     return static_cast<double>(r.correspondences) >= config_.min_correspondence_share * last_correspondences_;
   };
@@ -191,7 +192,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // stands across it lies beyond the plane search's reach (one map voxel), so
   // the odometry crept along at 0.1 m per scan. The registration is also
   // started from offsets along the body's x and y axes, and one that explains
-  // clearly more of the scan wins (as a slipped wheel is overruled above).
+  // clearly more of the scan wins (as a slipped wheel is overruled above;
+  // docs/decisions/012-start-search.md).
   if (!wheel && !velocity_known_ && dt > 0.0) {
     static constexpr std::array<std::array<double, 2>, 8> kStartOffsets{
         {{0.5, 0.0}, {-0.5, 0.0}, {1.0, 0.0}, {-1.0, 0.0}, {0.0, 0.5}, {0.0, -0.5}, {0.0, 1.0}, {0.0, -1.0}}};
@@ -220,8 +222,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // 2022, §III-B, with the better-observed pose as the anchor).
   // Not with wheels: their covariance over dt² is ξ's prior, so ξ is theirs,
   // and a spinning wheel's false turn would enter the sweep middles and with
-  // them the constant velocity that is the check against that wheel (the
-  // 30-minute robot session then followed nine spins: KITTI 0.95 % → 4.1 %).
+  // them the constant velocity that is the check against that wheel
+  // (docs/decisions/002-sweep-middle-velocity.md).
   // There the velocity stays the difference of the start poses, which the
   // scan corrects.
   float duration = 0.0F;

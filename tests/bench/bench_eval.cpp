@@ -8,18 +8,19 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include "adit/slam/align.hpp"
-#include "adit/slam/ape.hpp"
-#include "adit/slam/associate.hpp"
-#include "adit/slam/kitti_drift.hpp"
-#include "adit/slam/rpe.hpp"
-#include "adit/slam/stats.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/align.hpp"
+#include "adit/eval/ape.hpp"
+#include "adit/eval/associate.hpp"
+#include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/rpe.hpp"
+#include "adit/eval/stats.hpp"
+#include "adit/eval/trajectory_io.hpp"
 #include "shared_data.hpp"
 
 namespace {
 
 using namespace adit::slam;
+using namespace adit::eval;
 
 struct Kitti00 {
   std::filesystem::path dir;

@@ -13,12 +13,12 @@
 #include <fmt/format.h>
 
 #include "adit/sim/scene.hpp"
-#include "adit/slam/mesh_distance.hpp"
+#include "adit/eval/mesh_distance.hpp"
 
 namespace {
 
-using adit::slam::MeshDistance;
-using adit::slam::Triangle;
+using adit::eval::MeshDistance;
+using adit::eval::Triangle;
 
 constexpr std::size_t kGridPoints = 1'000'000;
 constexpr std::size_t kBrutePoints = 200;
@@ -76,7 +76,7 @@ void BM_BruteForce(benchmark::State& state) {
   const auto& m = mine();
   for (auto _ : state)
     for (std::size_t i = 0; i < kBrutePoints; ++i)
-      benchmark::DoNotOptimize(adit::slam::brute_force_distance(m.triangles, m.points[i]));
+      benchmark::DoNotOptimize(adit::eval::brute_force_distance(m.triangles, m.points[i]));
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kBrutePoints));
 }
 BENCHMARK(BM_BruteForce)->Unit(benchmark::kMillisecond);

@@ -217,13 +217,11 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
       (folder / "trajectory.tum").string()));
   ASSERT_EQ(eval.status, 0) << eval.output;
   const nlohmann::json accuracy = nlohmann::json::parse(eval.output.substr(eval.output.find('{')));
-  // The target: 95 % of the downloaded points within 5 cm. Until
-  // session 7 this asserted a 92 % floor: the window measured 95.3-96.0 %,
-  // too close to assert, and whole drives fell far below (a mean of 77.9 %
-  // over twelve), because the odometry's roll and pitch ran away through its
-  // own map. With the simulated robot's accelerometer holding them to
-  // gravity (docs/ODOMETRY.md, "Gravity"), this window measured 99.26 % in
-  // two Release runs, and the twelve whole drives a mean of 96.6 %.
+  // The target: 95 % of the downloaded points within 5 cm. It holds since
+  // the simulated robot's accelerometer keeps the odometry's roll and pitch
+  // to gravity, which they ran away from through the odometry's own map
+  // (docs/decisions/008-accelerometer-gravity-prior.md); the window's figure
+  // is in docs/ODOMETRY.md.
   EXPECT_GE(accuracy["fraction_within"].get<double>(), 0.95) << accuracy.dump();
   RecordProperty("fraction_within_5cm", std::to_string(accuracy["fraction_within"].get<double>()));
 

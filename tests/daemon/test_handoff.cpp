@@ -90,5 +90,50 @@ TEST(Handoff, ConcurrentDropOldestLosesNothingUncounted) {
   EXPECT_EQ(last, kItems);  // the newest is never dropped
 }
 
+TEST(Handoff, AcquireOrWaitWaitsForTheConsumerAndGivesUpWhenToldTo) {
+  Handoff<int> handoff(1, Overflow::wait, [] { return 0; });
+  int* first = handoff.acquire();
+  ASSERT_NE(first, nullptr);
+  handoff.publish(first);
+  int calls = 0;
+  EXPECT_EQ(handoff.acquire_or_wait([&] { return ++calls < 3; }), nullptr) << "the pool stays empty";
+  EXPECT_EQ(calls, 3);
+  // A consumer that releases the item later lets the producer go on.
+  std::thread consumer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    handoff.release(handoff.take());
+  });
+  EXPECT_NE(handoff.acquire_or_wait([] { return true; }), nullptr);
+  consumer.join();
+}
+
+TEST(Handoff, TakeOrWaitDrainsWhatWasPublishedBeforeCloseThenEnds) {
+  Handoff<int> handoff(4, Overflow::wait, [] { return 0; });
+  std::thread producer([&] {
+    for (int i = 1; i <= 100; ++i) {
+      int* item = handoff.acquire_or_wait([] { return true; });
+      *item = i;
+      handoff.publish(item);
+    }
+    handoff.close();
+  });
+  int expected = 1;
+  while (int* item = handoff.take_or_wait([] { return true; })) {
+    EXPECT_EQ(*item, expected++);
+    handoff.release(item);
+  }
+  producer.join();
+  EXPECT_EQ(expected, 101) << "every published item came through, in order";
+  EXPECT_TRUE(handoff.drained());
+}
+
+TEST(Handoff, TakeOrWaitGivesUpWhenToldToBeforeAnythingCame) {
+  Handoff<int> handoff(2, Overflow::wait, [] { return 0; });
+  int calls = 0;
+  EXPECT_EQ(handoff.take_or_wait([&] { return ++calls < 2; }), nullptr);
+  EXPECT_EQ(calls, 2);
+  EXPECT_FALSE(handoff.drained()) << "not closed: the producer may still publish";
+}
+
 }  // namespace
 }  // namespace adit::daemon

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "adit/common/error.hpp"
-#include "adit/slam/targets_io.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/targets_io.hpp"
+#include "adit/eval/trajectory_io.hpp"
 
 namespace {
 
@@ -26,9 +26,9 @@ void expect_only_input_errors(const std::string& text, Read&& read) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_tum(in, "fuzz.txt"); });
-  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_kitti(in, "fuzz.txt"); });
-  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_euroc_csv(in, "fuzz.csv"); });
-  expect_only_input_errors(text, [](std::istream& in) { adit::slam::read_targets_csv(in, "fuzz.csv"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::eval::read_tum(in, "fuzz.txt"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::eval::read_kitti(in, "fuzz.txt"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::eval::read_euroc_csv(in, "fuzz.csv"); });
+  expect_only_input_errors(text, [](std::istream& in) { adit::eval::read_targets_csv(in, "fuzz.csv"); });
   return 0;
 }

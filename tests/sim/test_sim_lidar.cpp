@@ -60,7 +60,7 @@ struct Residuals {
 Residuals check_capture(const SimOptions& o) {
   Residuals out;
   const Scene scene = simulated_scene(o);
-  const Trajectory body = simulated_path(scene, o);
+  const BodyTrack body = simulated_path(scene, o);
   const RayCaster caster(scene.mesh);
   const Eigen::Isometry3d extrinsics = simulated_extrinsics(o);
   const People people = simulated_people(scene, o);

@@ -21,12 +21,12 @@ struct Motion {
 
 Motion measure(const SimOptions& o) {
   const Scene scene = simulated_scene(o);
-  const Trajectory path = simulated_path(scene, o);
+  const BodyTrack path = simulated_path(scene, o);
   const auto& s = path.samples();
   Motion m;
   m.start = s.front().position;
   m.end = s.back().position;
-  const double dt = 1.0 / Trajectory::kRate;
+  const double dt = 1.0 / BodyTrack::kRate;
   for (std::size_t i = 1; i < s.size(); ++i) {
     const Eigen::Vector3d step = s[i].position - s[i - 1].position;
     m.length += step.norm();
@@ -115,7 +115,7 @@ TEST(SimPaths, DroneHoversClimbsAndTurnsWithinItsLimits) {
   o.platform = "drone";
   o.duration_s = 40;
   const Scene scene = simulated_scene(o);
-  const Trajectory path = simulated_path(scene, o);
+  const BodyTrack path = simulated_path(scene, o);
   EXPECT_LT((path.pose(5.9).translation() - path.pose(4.1).translation()).norm(), 1e-3);
 }
 

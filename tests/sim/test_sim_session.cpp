@@ -160,7 +160,7 @@ TEST(SimSession, CanLogCarriesTheAccelerometerAsSessionYamlDescribesIt) {
   drivers::can::SignalDecoder decoder(messages, {}, false);
   std::vector<double> values(decoder.slot_count());
   const auto slot = [&](const std::string& name) { return static_cast<std::size_t>(decoder.slot(name)); };
-  const Trajectory path = simulated_path(simulated_scene(o), o);
+  const BodyTrack path = simulated_path(simulated_scene(o), o);
   drivers::can::CandumpReader reader(o.out / "can.log");
   drivers::can::Frame frame;
   std::size_t readings = 0;
@@ -172,7 +172,7 @@ TEST(SimSession, CanLogCarriesTheAccelerometerAsSessionYamlDescribesIt) {
     const Eigen::Vector3d f(values[slot(c.imu.accel_x_signal)], values[slot(c.imu.accel_y_signal)],
                             values[slot(c.imu.accel_z_signal)]);
     const double t = 1e-6 * static_cast<double>(frame.time_us) - 1e-9 * static_cast<double>(o.start_time_ns);
-    const auto i = static_cast<std::size_t>(std::lround(t * Trajectory::kRate));
+    const auto i = static_cast<std::size_t>(std::lround(t * BodyTrack::kRate));
     const Eigen::Vector3d error = f - specific_force_at(path, std::min(i, path.samples().size() - 2));
     sum_error += error;
     worst = std::max(worst, error.cwiseAbs().maxCoeff());

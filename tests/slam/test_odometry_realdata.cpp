@@ -1,9 +1,9 @@
 // Odometry on the real 64-beam sequence (../shared/data/sequences/hdl64-urban-22).
 // The sequence has no poses; PCL's GICP, run scan to scan on the same scans
 // (`adit bench odometry --baseline-out`), finds the car 17.0 m along after 21
-// scans, 0.74 m per scan from the first one, nearly straight. Until session 5
-// adit's odometry crept along at 0.1 m per scan here (1.98 m in all) because
-// its first prediction was "standing still" (docs/ODOMETRY.md, "Session 5").
+// scans, 0.74 m per scan from the first one, nearly straight. Without the
+// start search, adit's odometry crept along at 0.1 m per scan here (1.98 m in
+// all): its first prediction was "standing still" (docs/decisions/012-start-search.md).
 
 #include <cmath>
 #include <vector>

@@ -217,8 +217,8 @@ TEST(WheelOdometry, ASlipThatStartsWithinAnIntervalIsStillCaught) {
 // The robot speeds up while the left wheel spins: the held wheel follows the
 // other one (the turn rate from before the slip), so the slip ends when the
 // spin does, and the distance is right. Held at its own speed from before the
-// slip, it would stay 'slipping' after the spin ended (the drift session of
-// docs/ODOMETRY.md lost 0.19 % that way).
+// slip, it would stay 'slipping' after the spin ended, and the simulated
+// drift lost accuracy that way (docs/decisions/005-wheel-slip-held.md).
 TEST(WheelOdometry, AWheelHeldForSlipFollowsTheOtherWheelsAcceleration) {
   RobotEncoders encoders;
   const slam::WheelOdometry& odo = encoders.odometry;

@@ -12,18 +12,19 @@
 #include "adit/drivers/can/candump.hpp"
 #include "adit/drivers/can/dbc.hpp"
 #include "adit/drivers/can/decoder.hpp"
-#include "adit/slam/wheel_calibration.hpp"
+#include "adit/eval/wheel_calibration.hpp"
 #include "adit/slam/wheel_odometry.hpp"
 #include "shared_data.hpp"
 
 namespace can = adit::drivers::can;
 namespace slam = adit::slam;
+namespace eval = adit::eval;
 
 namespace {
 
 struct Drive {
-  std::vector<slam::WheelSpeedSample> rear;  // rear wheels: not steered, a differential pair
-  std::vector<slam::PlanarPosition> reference;
+  std::vector<eval::WheelSpeedSample> rear;  // rear wheels: not steered, a differential pair
+  std::vector<eval::PlanarPosition> reference;
   double length_3d = 0.0;  // the pose track's path length including height
 };
 
@@ -45,7 +46,7 @@ Drive load(const std::filesystem::path& dir) {
   double previous_up = 0.0;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#' || line[0] == 't') continue;
-    slam::PlanarPosition p;
+    eval::PlanarPosition p;
     char comma = 0;
     std::istringstream s(line);
     double up = 0.0;
@@ -73,7 +74,7 @@ TEST(Rav4Odometry, IntegratedDistanceWithinOnePercentOfThePoseTrack) {
   car.speed_noise = 1.0;  // ABS wheel speeds of this car jump by up to 0.96 m/s between 12 ms samples
   slam::WheelOdometry odo(g, {}, car);
   for (const auto& s : d.rear) odo.add_speeds(s.t, s.left, s.right);
-  const double planar = slam::path_length(d.reference, d.reference.front().t, d.reference.back().t);
+  const double planar = eval::path_length(d.reference, d.reference.front().t, d.reference.back().t);
   fmt::print("wheel distance {:.1f} m, pose track {:.1f} m (planar {:.1f} m), ratio {:.4f}; flagged: slip {}\n",
              odo.distance(), d.length_3d, planar, odo.distance() / d.length_3d, odo.stats().slips);
   EXPECT_NEAR(d.length_3d, 1011.8, 0.1);  // the README's figure
@@ -86,9 +87,9 @@ TEST(Rav4Odometry, IntegratedDistanceWithinOnePercentOfThePoseTrack) {
 TEST(Rav4Odometry, CalibrationFitsRearTrackAndReducesEndpointError) {
   ADIT_REQUIRE_SHARED_DATA(dir, "can/toyota-rav4-2017");
   const Drive d = load(dir);
-  slam::CalibrationOptions o;
+  eval::CalibrationOptions o;
   o.nominal.track_width = 1.6;
-  const slam::CalibrationResult r = slam::calibrate_wheels(d.rear, d.reference, o);
+  const eval::CalibrationResult r = eval::calibrate_wheels(d.rear, d.reference, o);
   fmt::print("scales {:.5f} {:.5f} track {:.4f} m offset {:.3f} s; endpoint {:.2f} -> {:.2f} m; "
              "rms heading {:.4f} -> {:.4f} rad, distance {:.3f} -> {:.3f} m over {} windows\n",
              r.left_scale, r.right_scale, r.effective_track, r.time_offset, r.endpoint_error_before,

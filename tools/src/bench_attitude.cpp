@@ -29,12 +29,12 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
-#include "adit/slam/interpolate.hpp"
+#include "adit/eval/interpolate.hpp"
 #include "adit/slam/lie.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/registration.hpp"
-#include "adit/slam/stats.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/stats.hpp"
+#include "adit/eval/trajectory_io.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
 #include "bench_scans.hpp"
@@ -64,10 +64,10 @@ struct TiltSeries {
   }
 };
 
-double rms(const std::vector<double>& v) { return slam::compute_stats(v).rmse; }
+double rms(const std::vector<double>& v) { return eval::compute_stats(v).rmse; }
 
 double max_abs(const std::vector<double>& v) {
-  const slam::Stats s = slam::compute_stats(v);
+  const eval::Stats s = eval::compute_stats(v);
   return std::max(std::abs(s.min), std::abs(s.max));
 }
 
@@ -89,18 +89,18 @@ bool deskew_by_truth(const BenchScan& scan, const slam::Trajectory& truth, const
                      std::vector<Eigen::Vector3f>& out) {
   constexpr int kBins = 64;
   float duration = 0.0F;
-  for (const float t : scan.times_s) duration = std::max(duration, t);
+  for (std::size_t i = 0; i < scan.time_offsets_ns.size(); ++i) duration = std::max(duration, scan.time_s(i));
   std::array<Eigen::Isometry3f, kBins> table;
   const double t0 = 1e-9 * static_cast<double>(scan.stamp_ns);
   for (int b = 0; b < kBins; ++b) {
-    const std::optional<slam::Pose> pose = interpolate_pose(truth, t0 + duration * b / (kBins - 1.0));
+    const std::optional<slam::Pose> pose = eval::interpolate_pose(truth, t0 + duration * b / (kBins - 1.0));
     if (!pose) return false;
     table[static_cast<std::size_t>(b)] = (start.inverse() * *pose).cast<float>();
   }
   out.resize(scan.points.size());
-  const bool timed = scan.times_s.size() == scan.points.size() && duration > 0.0F;
+  const bool timed = scan.time_offsets_ns.size() == scan.points.size() && duration > 0.0F;
   for (std::size_t i = 0; i < scan.points.size(); ++i) {
-    const int b = timed ? static_cast<int>(std::lround(scan.times_s[i] / duration * (kBins - 1))) : 0;
+    const int b = timed ? static_cast<int>(std::lround(scan.time_s(i) / duration * (kBins - 1))) : 0;
     out[i] = table[static_cast<std::size_t>(std::clamp(b, 0, kBins - 1))] * scan.points[i];
   }
   return true;
@@ -114,7 +114,7 @@ void transform_into(std::span<const Eigen::Vector3f> in, const Eigen::Isometry3d
 
 int bench_attitude(const AttitudeOptions& o) {
   const std::vector<BenchScan> scans = load_bench_scans(o.input);
-  const slam::Trajectory truth = slam::read_tum(o.truth);
+  const slam::Trajectory truth = eval::read_tum(o.truth);
   const slam::OdometryConfig odometry;
   const slam::RegistrationConfig& registration = odometry.registration;
   std::size_t most_points = 0;
@@ -139,7 +139,7 @@ int bench_attitude(const AttitudeOptions& o) {
   Eigen::Isometry3d previous_truth = Eigen::Isometry3d::Identity(), previous_own = previous_truth;
   std::size_t used = 0, uncovered = 0;
   for (const BenchScan& scan : scans) {
-    const std::optional<slam::Pose> pose = interpolate_pose(truth, 1e-9 * static_cast<double>(scan.stamp_ns));
+    const std::optional<slam::Pose> pose = eval::interpolate_pose(truth, 1e-9 * static_cast<double>(scan.stamp_ns));
     if (!pose || !deskew_by_truth(scan, truth, *pose, deskewed)) {
       ++uncovered;
       continue;

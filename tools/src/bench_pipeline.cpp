@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/daemon/heartbeat.hpp"
 #include "adit/daemon/pipeline.hpp"
@@ -60,12 +61,6 @@ std::int64_t first_capture_time_ns(const std::filesystem::path& pcap, int port) 
   return 0;
 }
 
-std::int64_t realtime_now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 void sleep_until_realtime(std::int64_t ns) {
   const timespec until{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
   while (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &until, nullptr) == EINTR) {
@@ -85,7 +80,7 @@ std::int64_t align_recorded_wheels(config::Config& c, double speed, int capture_
     return 0;
   }
   constexpr std::int64_t kStartupNs = 1'500'000'000;  // pipeline construction and start, with room to spare
-  const std::int64_t send_at = realtime_now_ns() + kStartupNs;
+  const std::int64_t send_at = realtime_ns() + kStartupNs;
   c.wheel_odometry.time_offset_s += 1e-9 * static_cast<double>(first_capture_time_ns(c.lidar.pcap, capture_port) - send_at);
   return send_at;
 }
@@ -112,7 +107,7 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
   std::exception_ptr send_error;
   std::thread sender;
   std::uint64_t last_count = 0;
-  std::int64_t last_change_ns = daemon::monotonic_ns();
+  std::int64_t last_change_ns = monotonic_ns();
   RunHooks hooks;
   hooks.started = [&] {
     sender = std::thread([&] {
@@ -130,7 +125,7 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
   hooks.stop_when = [&] {
     const daemon::PipelineStats& s = pipeline.stats();
     const std::uint64_t count = s.datagrams.load() + s.poses.load();
-    const std::int64_t now = daemon::monotonic_ns();
+    const std::int64_t now = monotonic_ns();
     if (count != last_count) {
       last_count = count;
       last_change_ns = now;

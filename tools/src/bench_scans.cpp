@@ -15,7 +15,7 @@ BenchScan to_bench_scan(const drivers::LidarScan& scan, bool timed) {
   out.points.reserve(scan.points.size());
   for (const auto& p : scan.points) {
     out.points.emplace_back(p.x, p.y, p.z);
-    if (timed) out.times_s.push_back(1e-9F * static_cast<float>(p.time_offset_ns));
+    if (timed) out.time_offsets_ns.push_back(p.time_offset_ns);
   }
   return out;
 }
@@ -43,6 +43,22 @@ std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
   while (!full() && reader.next(d))
     if (d.dst_port == decoder->default_port()) stream.push(d.payload, d.capture_time_ns);
   return scans;
+}
+
+void to_lidar_scan(const BenchScan& scan, drivers::LidarScan& out) {
+  out.clear();
+  out.start_time_ns = scan.stamp_ns;
+  const bool timed = scan.time_offsets_ns.size() == scan.points.size();
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    drivers::LidarPoint p;
+    p.x = scan.points[i].x();
+    p.y = scan.points[i].y();
+    p.z = scan.points[i].z();
+    p.range_m = scan.points[i].norm();
+    p.time_offset_ns = timed ? scan.time_offsets_ns[i] : 0;
+    out.points.push_back(p);
+  }
+  out.stats.complete = true;
 }
 
 }  // namespace adit::tools

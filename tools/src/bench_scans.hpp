@@ -9,12 +9,15 @@
 
 #include <Eigen/Core>
 
+#include "adit/drivers/lidar/point.hpp"
+
 namespace adit::tools {
 
 struct BenchScan {
   std::int64_t stamp_ns = 0;
   std::vector<Eigen::Vector3f> points;
-  std::vector<float> times_s;  // empty when the source has no per-point times
+  std::vector<std::uint32_t> time_offsets_ns;  // per point after stamp_ns; empty when the source has none
+  float time_s(std::size_t i) const { return 1e-9F * static_cast<float>(time_offsets_ns[i]); }
 };
 
 struct BenchInput {
@@ -26,5 +29,9 @@ struct BenchInput {
 };
 
 std::vector<BenchScan> load_bench_scans(const BenchInput& input);
+
+// The scan as the drivers hand it to aditd's odometry (sensor frame; no
+// intensities), into `out`'s storage.
+void to_lidar_scan(const BenchScan& scan, drivers::LidarScan& out);
 
 }  // namespace adit::tools

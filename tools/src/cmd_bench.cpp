@@ -4,27 +4,31 @@
 // (adit bench pipeline lives in bench_pipeline.cpp.)
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
 #include <memory>
 #include <optional>
 
 #include <fmt/format.h>
 
+#include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
-#include "adit/slam/align.hpp"
-#include "adit/slam/ape.hpp"
-#include "adit/slam/associate.hpp"
-#include "adit/slam/stats.hpp"
-#include "adit/slam/kitti_drift.hpp"
+#include "adit/common/quantile.hpp"
+#include "adit/config/load.hpp"
+#include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/scan_odometry.hpp"
+#include "adit/eval/align.hpp"
+#include "adit/eval/ape.hpp"
+#include "adit/eval/associate.hpp"
+#include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/stats.hpp"
+#include "adit/eval/trajectory_io.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/trajectory.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/slam/tum.hpp"
 #include "bench_attitude.hpp"
 #include "bench_baseline.hpp"
 #include "bench_pipeline.hpp"
 #include "bench_scans.hpp"
-#include "bench_wheels.hpp"
 #include "commands.hpp"
 #include "process_memory.hpp"
 
@@ -37,7 +41,7 @@ struct BenchOptions {
   std::string out;
   std::string baseline_out;
   std::string baseline = "gicp";
-  std::string wheels_config;  // session config whose CAN log gives a wheel prior
+  std::string config_file;  // the payload's config (aditd's): extrinsics, ranges, CAN wheels and accelerometer
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
   float max_range_m = 100.0F;
   float map_voxel_m = 0.5F;
@@ -50,37 +54,30 @@ struct BenchOptions {
   std::size_t target_registration_points = slam::OdometryConfig{}.target_registration_points;
 };
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 template <typename F>
 double time_ms(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const std::int64_t t0 = monotonic_ns();
   f();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return 1e-6 * static_cast<double>(monotonic_ns() - t0);
 }
 
 // Drift of `est` against the reference, the KITTI way over 100–800 m segments,
 // or, for shorter paths, the end-to-end error over the path length.
 void print_drift(const std::string& label, const slam::Trajectory& truth, const slam::Trajectory& est) {
-  const slam::Associated a = slam::associate(truth, est, 0.02);
+  const eval::Associated a = eval::associate(truth, est, 0.02);
   if (a.pairs.size() < 2) {
     fmt::print("{}: no poses associated with the ground truth within 20 ms\n", label);
     return;
   }
   // APE after an SE(3) fit as well: a drift figure alone can look good for an
   // estimate that went wrong and came back (or never moved on an out-and-back path).
-  if (const auto fit = slam::align_trajectory(a.ref, a.est, slam::Alignment::se3)) {
+  if (const auto fit = eval::align_trajectory(a.ref, a.est, eval::Alignment::se3)) {
     std::vector<slam::Pose> aligned;
     for (const auto& pose : a.est) aligned.push_back(fit->apply(pose));
-    const slam::Stats ape = slam::compute_stats(slam::absolute_pose_errors(a.ref, aligned).translation);
+    const eval::Stats ape = eval::compute_stats(eval::absolute_pose_errors(a.ref, aligned).translation);
     fmt::print("{}: APE (SE(3)-aligned) rmse {:.3f} m, max {:.3f} m over {} poses\n", label, ape.rmse, ape.max, ape.count);
   }
-  if (const auto kitti = slam::kitti_drift(a.ref, a.est)) {
+  if (const auto kitti = eval::kitti_drift(a.ref, a.est)) {
     fmt::print("{}: drift {:.3f} % and {:.4f} deg/100 m (KITTI, {} segments of 100-800 m)\n", label,
                kitti->translation_percent, kitti->rotation_deg_per_100m, kitti->segments);
     return;
@@ -115,15 +112,26 @@ int bench_odometry(const BenchOptions& o) {
   config.estimate_sweep_velocity = !o.fixed_sweep_velocity;
   config.sweep_velocity_sigma_radps = o.sweep_velocity_sigma_radps;
   config.target_registration_points = o.target_registration_points;
-  config.max_scan_points = std::max<std::size_t>(config.max_scan_points, static_cast<std::size_t>(quantile(sizes, 1.0)));
-  std::optional<WheelTrack> wheels;
-  if (!o.wheels_config.empty()) {
-    wheels = load_wheel_track(o.wheels_config);
-    fmt::print("wheels: {} samples over {:.1f} m as the motion prior ({} not trusted; {} wheel slips held)\n",
-               wheels->samples, wheels->distance, wheels->rejected, wheels->slip_episodes);
+  const auto most_points = static_cast<std::size_t>(quantile(sizes, 1.0));
+  config.max_scan_points = std::max<std::size_t>(config.max_scan_points, most_points);
+  // The payload as aditd reads it: its extrinsics, ranges and CAN bus; or
+  // none (sensor frame, no wheels, no accelerometer).
+  config::Config payload;
+  std::unique_ptr<daemon::CanFeed> can;
+  if (!o.config_file.empty()) {
+    payload = config::load_config(o.config_file);
+    config = daemon::odometry_config_of(payload, config, most_points);
+    if (payload.can.enabled && payload.wheel_odometry.enabled) {
+      can = std::make_unique<daemon::CanFeed>(payload);
+      can->start({});
+    }
+    fmt::print("payload: {} (body frame; {}{})\n", o.config_file, can ? "CAN wheels" : "no wheels",
+               can && payload.imu.enabled ? " and accelerometer" : "");
   }
   const double rss_before = resident_mb();
-  slam::Odometry odometry(config);
+  daemon::ScanOdometry odometry(payload, config, can.get(), [] { return true; });
+  drivers::LidarScan lidar_scan;
+  lidar_scan.points.reserve(most_points);
   slam::Trajectory estimate;
   std::vector<double> ms;
   std::size_t degenerate = 0;
@@ -132,17 +140,11 @@ int bench_odometry(const BenchOptions& o) {
   std::vector<double> used_points;
   std::vector<double> voxels;
   std::vector<double> weakest;
-  std::size_t without_wheels = 0;
   std::size_t wheel_rejected = 0;
-  for (std::size_t i = 0; i < scans.size(); ++i) {
-    const BenchScan& scan = scans[i];
-    std::optional<slam::MotionPrior> prior;
-    if (wheels && i > 0) {
-      prior = wheel_prior(*wheels, 1e-9 * static_cast<double>(scans[i - 1].stamp_ns), 1e-9 * static_cast<double>(scan.stamp_ns));
-      without_wheels += prior ? 0 : 1;
-    }
-    slam::OdometryResult r;
-    ms.push_back(time_ms([&] { r = odometry.process({scan.stamp_ns, scan.points, scan.times_s}, prior); }));
+  for (const BenchScan& scan : scans) {
+    to_lidar_scan(scan, lidar_scan);
+    const slam::OdometryResult& r = odometry.process(lidar_scan);
+    ms.push_back(odometry.registration_ms());
     degenerate += r.status == slam::OdometryStatus::degenerate ? 1 : 0;
     invalid += r.valid ? 0 : 1;
     wheel_rejected += r.wheel_rejected ? 1 : 0;
@@ -153,8 +155,18 @@ int bench_odometry(const BenchOptions& o) {
       weakest.push_back(r.registration.weakest_eigenvalue);
     estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
   }
-  if (without_wheels > 0) fmt::print("wheels: {} scans outside the wheel log ran on constant velocity\n", without_wheels);
-  if (wheels) fmt::print("wheels: the prior disagreed with the scan on {} scans (constant velocity used)\n", wheel_rejected);
+  if (can) {
+    can->stop();
+    const daemon::CanFeedStats& feed = can->stats();
+    const daemon::MotionAidCounts& counts = odometry.counts();
+    fmt::print("wheels: {} samples ({} not trusted; {} wheel slips held); {} scans with their prior, {} outside the "
+               "wheel log on constant velocity; the prior disagreed with the scan on {} scans (constant velocity used)\n",
+               feed.samples.load(), feed.untrusted.load(), feed.slip_episodes.load(), counts.wheel_priors,
+               counts.scans_without_wheels, wheel_rejected);
+    if (payload.imu.enabled)
+      fmt::print("accelerometer: {} readings; gravity's up held {} scans, {} without\n", feed.imu_samples.load(),
+                 counts.gravity_priors, counts.scans_without_gravity);
+  }
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
              "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
@@ -170,7 +182,7 @@ int bench_odometry(const BenchOptions& o) {
 
   std::optional<slam::Trajectory> truth;
   if (!o.truth.empty()) {
-    truth = slam::read_tum(o.truth);
+    truth = eval::read_tum(o.truth);
     print_drift("adit odometry", *truth, estimate);
   }
 
@@ -219,8 +231,10 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--baseline-out", o->baseline_out, "Write the baseline's trajectory (TUM) here");
   odometry->add_option("--baseline", o->baseline, "gicp (PCL Generalized-ICP, scan to scan) or none")
       ->check(CLI::IsMember({"gicp", "none"}));
-  odometry->add_option("--wheels", o->wheels_config,
-                       "Session config (as aditd reads it) whose CAN log and wheel_odometry section give a motion prior");
+  odometry->add_option("--config,--wheels", o->config_file,
+                       "Payload config as aditd reads it (e.g. the session.yaml of adit sim): the odometry runs in the "
+                       "body frame with its extrinsics and range limits, and with the wheels and accelerometer of its "
+                       "CAN bus when configured (--max-range then comes from lidar.max_range_m)");
   odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
   odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
   odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");

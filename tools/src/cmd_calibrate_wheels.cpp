@@ -13,7 +13,7 @@
 #include "adit/drivers/can/candump.hpp"
 #include "adit/drivers/can/dbc.hpp"
 #include "adit/drivers/can/decoder.hpp"
-#include "adit/slam/wheel_calibration.hpp"
+#include "adit/eval/wheel_calibration.hpp"
 #include "commands.hpp"
 
 namespace adit::tools {
@@ -36,7 +36,7 @@ struct Options {
   bool no_time_offset = false;
 };
 
-std::vector<slam::WheelSpeedSample> read_wheels(const Options& o) {
+std::vector<eval::WheelSpeedSample> read_wheels(const Options& o) {
   const can::Database db = can::load_dbc(o.dbc);
   const std::vector<std::string> wanted{o.left, o.right};
   can::SignalDecoder decoder(db.messages, wanted);
@@ -48,7 +48,7 @@ std::vector<slam::WheelSpeedSample> read_wheels(const Options& o) {
   const int right = decoder.slot(o.right);
   std::vector<double> v(decoder.slot_count());
   can::CandumpReader reader(o.log);
-  std::vector<slam::WheelSpeedSample> samples;
+  std::vector<eval::WheelSpeedSample> samples;
   can::Frame f;
   while (reader.next(f)) {
     if (!o.bus.empty() && f.interface_name() != o.bus) continue;
@@ -62,10 +62,10 @@ std::vector<slam::WheelSpeedSample> read_wheels(const Options& o) {
 }
 
 // CSV with a header naming t (or time), x (or east) and y (or north); '#' comments.
-std::vector<slam::PlanarPosition> read_reference(const std::string& file) {
+std::vector<eval::PlanarPosition> read_reference(const std::string& file) {
   std::ifstream in(file);
   if (!in) throw InputError(file, "--reference", "cannot open the reference trajectory");
-  std::vector<slam::PlanarPosition> out;
+  std::vector<eval::PlanarPosition> out;
   std::string line;
   std::size_t line_no = 0;
   int ct = -1, cx = -1, cy = -1;
@@ -103,17 +103,17 @@ std::vector<slam::PlanarPosition> read_reference(const std::string& file) {
 }
 
 int run(const Options& o) {
-  const std::vector<slam::WheelSpeedSample> wheels = read_wheels(o);
-  const std::vector<slam::PlanarPosition> reference = read_reference(o.reference);
-  slam::CalibrationOptions c;
+  const std::vector<eval::WheelSpeedSample> wheels = read_wheels(o);
+  const std::vector<eval::PlanarPosition> reference = read_reference(o.reference);
+  eval::CalibrationOptions c;
   c.nominal.track_width = o.track_width;
   c.window = o.window;
   c.max_time_offset = o.max_offset;
   c.separate_scales = !o.common_scale;
   c.fit_time_offset = !o.no_time_offset;
-  slam::CalibrationResult r;
+  eval::CalibrationResult r;
   try {
-    r = slam::calibrate_wheels(wheels, reference, c);
+    r = eval::calibrate_wheels(wheels, reference, c);
   } catch (const std::invalid_argument& e) {
     throw InputError(o.reference, "--reference", e.what());
   }

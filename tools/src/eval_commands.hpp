@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "adit/slam/stats.hpp"
+#include "adit/eval/stats.hpp"
 
 namespace adit::tools {
 
@@ -57,8 +57,8 @@ void run_eval_endpoint(const EndpointEvalOptions& options);
 void run_eval_targets(const TargetsEvalOptions& options);
 
 // Shared by the runners.
-nlohmann::json stats_json(const slam::Stats& stats);
-std::string stats_row(const std::string& name, const slam::Stats& stats);
+nlohmann::json stats_json(const eval::Stats& stats);
+std::string stats_row(const std::string& name, const eval::Stats& stats);
 std::string stats_header();
 
 }  // namespace adit::tools

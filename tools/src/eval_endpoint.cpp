@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
-#include "adit/slam/endpoint.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/endpoint.hpp"
+#include "adit/eval/trajectory_io.hpp"
 #include "eval_commands.hpp"
 
 namespace adit::tools {
@@ -39,14 +39,14 @@ Eigen::Vector3d parse_delta(const std::string& text) {
 
 void run_eval_endpoint(const EndpointEvalOptions& o) {
   const Eigen::Vector3d true_delta = parse_delta(o.true_delta);
-  const slam::TrajectoryFormat f =
-      o.format == "auto" ? slam::detect_trajectory_format(o.est) : *slam::parse_trajectory_format(o.format);
+  const eval::TrajectoryFormat f =
+      o.format == "auto" ? eval::detect_trajectory_format(o.est) : *eval::parse_trajectory_format(o.format);
   std::optional<std::filesystem::path> times;
   if (!o.times.empty()) times = o.times;
-  const slam::Trajectory traj = slam::read_trajectory(o.est, f, times);
+  const slam::Trajectory traj = eval::read_trajectory(o.est, f, times);
   if (traj.size() < 2) throw InputError(o.est, "", "needs at least 2 poses for a start and an end");
 
-  const slam::EndpointDrift d = slam::endpoint_drift(traj.poses, true_delta);
+  const eval::EndpointDrift d = eval::endpoint_drift(traj.poses, true_delta);
   const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
   if (o.json) {
     const nlohmann::json j{{"trajectory", o.est},

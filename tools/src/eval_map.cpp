@@ -1,6 +1,6 @@
 // adit eval map: how far the map's points lie from the true scene surfaces
-// (absolute point error, as surveyors judge a map). docs/EVALUATION.md, "Map
-// accuracy", defines the figures.
+// (absolute point error, as surveyors judge a map). docs/EVALUATION.md
+// defines the figures.
 
 #include <algorithm>
 #include <cmath>
@@ -14,9 +14,9 @@
 #include "adit/common/error.hpp"
 #include "adit/protocol/map_import.hpp"
 #include "adit/protocol/ply_mesh.hpp"
-#include "adit/slam/interpolate.hpp"
-#include "adit/slam/mesh_distance.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/interpolate.hpp"
+#include "adit/eval/mesh_distance.hpp"
+#include "adit/eval/trajectory_io.hpp"
 #include "eval_commands.hpp"
 
 namespace adit::tools {
@@ -24,20 +24,20 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-std::vector<slam::Triangle> scene_triangles(const std::string& file) {
+std::vector<eval::Triangle> scene_triangles(const std::string& file) {
   const protocol::PlyMesh mesh = protocol::read_ply_mesh(file);
   if (mesh.triangles.empty()) throw InputError(file, "element face", "the scene has no triangles");
   const auto vertex = [&](std::uint32_t i) {
     return Eigen::Vector3d(mesh.vertices[i][0], mesh.vertices[i][1], mesh.vertices[i][2]);
   };
-  std::vector<slam::Triangle> out;
+  std::vector<eval::Triangle> out;
   out.reserve(mesh.triangles.size());
   for (const auto& t : mesh.triangles) out.push_back({vertex(t[0]), vertex(t[1]), vertex(t[2])});
   return out;
 }
 
 slam::Trajectory timed_trajectory(const std::string& file) {
-  slam::Trajectory t = slam::read_trajectory(file, slam::detect_trajectory_format(file));
+  slam::Trajectory t = eval::read_trajectory(file, eval::detect_trajectory_format(file));
   if (t.empty() || !t.timed) throw InputError(file, "", "needs time-stamped poses");
   return t;
 }
@@ -57,7 +57,7 @@ Placement placement(const MapEvalOptions& o) {
   const slam::Trajectory ref = timed_trajectory(o.ref);
   const slam::Trajectory est = timed_trajectory(o.est);
   p.t0 = est.stamps.front();
-  const auto ref_t0 = slam::interpolate_pose(ref, p.t0);
+  const auto ref_t0 = eval::interpolate_pose(ref, p.t0);
   if (!ref_t0)
     throw InputError(o.ref, "",
                      fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
@@ -104,7 +104,7 @@ MapAccuracy summarize(std::vector<double>& d, double within) {
 }
 
 // The points in one contiguous slice per core; MeshDistance is read-only.
-std::vector<double> distances_in_parallel(const slam::MeshDistance& scene, std::span<const Eigen::Vector3d> points) {
+std::vector<double> distances_in_parallel(const eval::MeshDistance& scene, std::span<const Eigen::Vector3d> points) {
   const std::size_t slices = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1,
                                                      std::max<std::size_t>(1, points.size() / 100'000));
   std::vector<std::vector<double>> parts(slices);
@@ -133,7 +133,7 @@ void run_eval_map(const MapEvalOptions& o) {
   if (o.within > o.cap)
     throw InputError("", "--within",
                      fmt::format("{} m is beyond --cap {} m, where distances are not computed", o.within, o.cap));
-  const slam::MeshDistance scene(scene_triangles(o.scene), o.cap);
+  const eval::MeshDistance scene(scene_triangles(o.scene), o.cap);
   const Placement place = placement(o);
   // Only the placed positions are kept (a 5 M-point map's fields are 200 MB).
   const std::vector<Eigen::Vector3d> points = [&] {

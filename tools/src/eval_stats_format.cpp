@@ -6,7 +6,7 @@
 
 namespace adit::tools {
 
-nlohmann::json stats_json(const slam::Stats& s) {
+nlohmann::json stats_json(const eval::Stats& s) {
   return {{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
           {"std", s.std},     {"min", s.min},   {"max", s.max},   {"sse", s.sse}};
 }
@@ -16,7 +16,7 @@ std::string stats_header() {
                      "median", "std", "min", "max", "sse");
 }
 
-std::string stats_row(const std::string& name, const slam::Stats& s) {
+std::string stats_row(const std::string& name, const eval::Stats& s) {
   return fmt::format("{:<28} {:>6} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>10.6f} {:>12.6g}\n", name,
                      s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse);
 }

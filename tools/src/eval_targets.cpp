@@ -6,9 +6,9 @@
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
-#include "adit/slam/pose_error.hpp"
-#include "adit/slam/targets.hpp"
-#include "adit/slam/targets_io.hpp"
+#include "adit/eval/pose_error.hpp"
+#include "adit/eval/targets.hpp"
+#include "adit/eval/targets_io.hpp"
 #include "eval_commands.hpp"
 #include "svg_plot.hpp"
 
@@ -16,6 +16,7 @@ namespace adit::tools {
 namespace {
 
 using namespace adit::slam;
+using namespace adit::eval;
 
 std::vector<std::string> split_ids(const std::string& text) {
   std::vector<std::string> ids;

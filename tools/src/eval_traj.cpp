@@ -7,13 +7,14 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
-#include "adit/slam/align.hpp"
-#include "adit/slam/ape.hpp"
-#include "adit/slam/associate.hpp"
-#include "adit/slam/kitti_drift.hpp"
-#include "adit/slam/pose_error.hpp"
-#include "adit/slam/rpe.hpp"
-#include "adit/slam/trajectory_io.hpp"
+#include "adit/eval/align.hpp"
+#include "adit/eval/ape.hpp"
+#include "adit/eval/associate.hpp"
+#include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/pose_error.hpp"
+#include "adit/eval/rpe.hpp"
+#include "adit/eval/trajectory_io.hpp"
+#include "adit/slam/tum.hpp"
 #include "eval_commands.hpp"
 #include "svg_plot.hpp"
 
@@ -21,6 +22,7 @@ namespace adit::tools {
 namespace {
 
 using namespace adit::slam;
+using namespace adit::eval;
 
 struct Loaded {
   Trajectory trajectory;

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "adit/protocol/utime.hpp"
+#include "adit/common/clock.hpp"
 #include "adit/command_t.hpp"
 #include "adit/common/error.hpp"
 #include "adit/protocol/channels.hpp"
@@ -23,7 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using protocol::Channel;
 
-using protocol::now_utime;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -106,7 +105,7 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   impl_->last_send = start - std::chrono::seconds(1);
   while (!answer && seconds_since(start) < impl_->options.timeout_s) {
     if (seconds_since(impl_->last_send) >= 0.25) {
-      c.utime = now_utime();
+      c.utime = realtime_us();
       impl_->last_send = Clock::now();
       impl_->lcm.publish(impl_->channel(Channel::command), &c);
     }
@@ -203,7 +202,7 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
       const auto missing = tiles.missing(kMaxRequestEntries);
       request.request_id = impl_->new_request_id();
       my_requests.insert(request.request_id);
-      request.utime = now_utime();
+      request.utime = realtime_us();
       request.session_id = locked;
       request.want_index = !index_complete();
       request.tile_ids.clear();

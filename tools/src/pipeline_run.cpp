@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
 #include "process_memory.hpp"
 
@@ -71,16 +72,16 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.dropped_packets = s.dropped_packets.load();
   f.dropped_scans = s.dropped_scans.load();
   const daemon::PipelineTimings& t = pipeline.timings();
-  f.odometry_median_ms = daemon::quantile(t.odometry_ms, 0.5);
-  f.odometry_p99_ms = daemon::quantile(t.odometry_ms, 0.99);
-  f.latency_median_ms = daemon::quantile(t.latency_ms, 0.5);
-  f.latency_p99_ms = daemon::quantile(t.latency_ms, 0.99);
-  f.latency_max_ms = daemon::quantile(t.latency_ms, 1.0);
+  f.odometry_median_ms = quantile(t.odometry_ms, 0.5);
+  f.odometry_p99_ms = quantile(t.odometry_ms, 0.99);
+  f.latency_median_ms = quantile(t.latency_ms, 0.5);
+  f.latency_p99_ms = quantile(t.latency_ms, 0.99);
+  f.latency_max_ms = quantile(t.latency_ms, 1.0);
   if (t.latency_ms.size() == t.odometry_ms.size()) {  // one of each per scan, in order
     std::vector<double> beyond(t.latency_ms.size());
     for (std::size_t i = 0; i < beyond.size(); ++i) beyond[i] = t.latency_ms[i] - t.odometry_ms[i];
-    f.beyond_odometry_median_ms = daemon::quantile(beyond, 0.5);
-    f.beyond_odometry_p99_ms = daemon::quantile(beyond, 0.99);
+    f.beyond_odometry_median_ms = quantile(beyond, 0.5);
+    f.beyond_odometry_p99_ms = quantile(beyond, 0.99);
   }
   f.sensor_span_s = t.sensor_span_s;
   f.duration_s = t.duration_s;

@@ -11,11 +11,12 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <stdexcept>
 
 #include <fmt/format.h>
+
+#include "adit/common/clock.hpp"
 
 namespace adit::drivers::can {
 namespace {
@@ -29,10 +30,6 @@ void set_option(int fd, int level, int name, const void* value, socklen_t size, 
     close(fd);
     throw std::runtime_error(fmt::format("CAN interface '{}': cannot set {}: {}", interface, what, std::strerror(e)));
   }
-}
-
-std::int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace
@@ -217,7 +214,7 @@ ReadResult CanSocket::read(Frame& out, int timeout_ms) {
     ++stats_.malformed;
     return ReadResult::malformed;
   }
-  out.time_us = meta.has_timestamp ? meta.time_us : now_us();
+  out.time_us = meta.has_timestamp ? meta.time_us : realtime_us();
   out.interface = name_template_.interface;
   bus_.on_frame(out);
   ++(out.error ? stats_.error_frames : stats_.frames);

@@ -4,16 +4,12 @@
 // for input also beats, so "stalled" means stuck, not idle.
 
 #include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <string>
 
-namespace adit::daemon {
+#include "adit/common/clock.hpp"
 
-inline std::int64_t monotonic_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+namespace adit::daemon {
 
 struct Heartbeat {
   explicit Heartbeat(std::string thread_name) : name(std::move(thread_name)) {}

@@ -9,7 +9,7 @@
 #include <cstdint>
 
 #include "adit/sim/scene.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -27,7 +27,7 @@ struct DronePathOptions {
   static constexpr double kHover = 2.0;                      // s hovering before and after
 };
 
-Trajectory drone_path(const Scene& scene, const DronePathOptions& options);
+BodyTrack drone_path(const Scene& scene, const DronePathOptions& options);
 double drone_min_duration_s();
 
 }  // namespace adit::sim

@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 
 #include "adit/drivers/can/frame.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -36,9 +36,9 @@ struct ImuTruth {
 // Specific force in the body frame at trajectory sample i: the robot's
 // acceleration as a wheeled vehicle moves (along and across its heading,
 // plus the bumps' vertical), gravity added, in the body axes.
-Eigen::Vector3d specific_force_at(const Trajectory& body, std::size_t i);
+Eigen::Vector3d specific_force_at(const BodyTrack& body, std::size_t i);
 
 // Appends the accelerometer's frames to `frames` (time order).
-ImuTruth simulate_imu(const Trajectory& body, const ImuOptions& options, std::vector<drivers::can::Frame>& frames);
+ImuTruth simulate_imu(const BodyTrack& body, const ImuOptions& options, std::vector<drivers::can::Frame>& frames);
 
 }  // namespace adit::sim

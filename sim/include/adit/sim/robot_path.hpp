@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "adit/sim/scene.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -25,11 +25,12 @@ struct RobotPathOptions {
   static constexpr double kTurnRate = 0.6;  // rad/s on the spot
   static constexpr double kRamp = 1.0;      // s to reach cruise speed
   // s standing still before moving off, as a crew starts a survey: the
-  // accelerometer's gravity then needs no motion removed (slam/gravity.hpp).
+  // accelerometer's gravity then needs no motion removed (slam/gravity.hpp;
+  // docs/decisions/003-gravity-settle.md).
   static constexpr double kHoldStart = 1.0;
 };
 
-Trajectory robot_path(const Scene& scene, const RobotPathOptions& options);
+BodyTrack robot_path(const Scene& scene, const RobotPathOptions& options);
 
 // The shortest duration robot_path accepts for the scene's route (a turn and two ramps).
 double robot_min_duration_s();

@@ -13,7 +13,7 @@
 namespace adit::sim {
 
 struct RouteSchedule {
-  std::vector<double> arc;            // metres along the route, per Trajectory sample
+  std::vector<double> arc;            // metres along the route, per BodyTrack sample
   std::vector<double> turn_fraction;  // 0 outbound, 1 returning, in between while turning on the spot
 };
 

@@ -16,7 +16,7 @@
 
 #include "adit/sim/people.hpp"
 #include "adit/sim/scene.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -60,7 +60,7 @@ struct SimSummary {
 
 // The scene and the body trajectory run_simulation uses (deterministic), for checks.
 Scene simulated_scene(const SimOptions& options);
-Trajectory simulated_path(const Scene& scene, const SimOptions& options);
+BodyTrack simulated_path(const Scene& scene, const SimOptions& options);
 Eigen::Isometry3d simulated_extrinsics(const SimOptions& options);  // sensor in the body frame
 People simulated_people(const Scene& scene, const SimOptions& options);  // the scene must outlive them
 

@@ -25,7 +25,7 @@
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/sensor_effects.hpp"
 #include "adit/sim/targets.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -103,7 +103,7 @@ struct LidarSimStats {
   std::uint64_t returns = 0;
 };
 
-LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const Trajectory& body, const RayCaster& caster,
+LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTrack& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
                                       const People& people, const LidarSimOptions& options,
                                       drivers::PcapWriter& pcap);

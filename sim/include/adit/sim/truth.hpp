@@ -8,13 +8,13 @@
 
 #include <Eigen/Geometry>
 
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
 // Writes every trajectory sample of body × frame (frame = identity: the body,
 // the extrinsics: the sensor). Throws adit::InputError on I/O failure.
-void write_tum(const std::filesystem::path& file, const Trajectory& body, const Eigen::Isometry3d& frame,
+void write_tum(const std::filesystem::path& file, const BodyTrack& body, const Eigen::Isometry3d& frame,
                std::int64_t start_time_ns);
 
 }  // namespace adit::sim

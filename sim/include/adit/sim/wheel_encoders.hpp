@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "adit/drivers/can/frame.hpp"
-#include "adit/sim/trajectory.hpp"
+#include "adit/sim/body_track.hpp"
 
 namespace adit::sim {
 
@@ -40,7 +40,7 @@ struct WheelTruth {
 
 // Appends the wheels' frames to `frames` (time order; the session merges
 // them with the IMU's into can.log).
-WheelTruth simulate_wheel_encoders(const Trajectory& body, const WheelOptions& options,
+WheelTruth simulate_wheel_encoders(const BodyTrack& body, const WheelOptions& options,
                                    std::vector<drivers::can::Frame>& frames);
 // "time,left_rad,right_rad" per frame (time in seconds on the common clock).
 void write_wheel_truth(const std::filesystem::path& file, const WheelTruth& truth, std::int64_t start_time_ns);

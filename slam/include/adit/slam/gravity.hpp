@@ -1,6 +1,6 @@
 #pragma once
 // Gravity's direction from an accelerometer, the odometry's tilt reference
-// (OdometryConfig::gravity_sigma_rad). An accelerometer measures specific
+// (its σ is the config's imu.gravity_sigma_deg). An accelerometer measures specific
 // force f = a − g in its own axes: the body's kinematic acceleration a minus
 // gravity g = (0, 0, −9.81 m/s²) in a z-up world. Averaged over a sweep and
 // with the kinematic part removed, f̄ − ā = −g: a vector of 9.81 m/s² along

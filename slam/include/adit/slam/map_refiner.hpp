@@ -4,7 +4,7 @@
 // Zhang & Singh 2014, which re-registers the odometry's scans against a finer
 // map at a lower rate).
 //
-// Why (docs/ARCHITECTURE.md, "Refined poses"): with wheels, the odometry's
+// Why (docs/decisions/013-map-refinement.md): with wheels, the odometry's
 // registration weighs each point as σ 1 m (RegistrationConfig::point_sigma_m)
 // so that a self-similar drift cannot overrule the wheels, and its local map
 // holds the scans at 0.25 m. Along a mine drive the wheels then set the

@@ -38,7 +38,8 @@ struct OdometryConfig {
   // its scans keep 0.75 m; a 64-beam scan (3 850 points at 0.75 m on
   // hdl64-urban-22) is brought to about this many, which bounds the plane
   // searches, most of the time per scan. KISS-ICP scales its voxel with the
-  // maximum range instead (Vizzo et al. 2023, §III-B).
+  // maximum range instead (Vizzo et al. 2023, §III-B). Why 2 500:
+  // docs/decisions/011-adaptive-registration-voxel.md.
   std::size_t target_registration_points = 2500;
   float max_registration_voxel_m = 2.0F;
   std::size_t map_capacity_voxels = std::size_t{1} << 17;
@@ -46,12 +47,9 @@ struct OdometryConfig {
   // keeps its first VoxelHashMap::kMaxPointsPerVoxel points, the rings of the
   // few scans that first saw it, and point-to-plane then prefers those scans'
   // attitude). KISS-ICP ≥ 1.0 refuses points closer than voxel / sqrt(20)
-  // (0.112 m here). Measured (docs/ODOMETRY.md, "The robot's roll and pitch
-  // lag the truth"): 0.08 m lowers the robot's pitch lag on the 12 s and 60 s
-  // mine drives (0.29° → 0.24°, 0.24° → 0.13°; not on 120 s) and lifts the
-  // mine maps by 3-6 points, with the featureless drift unchanged; 0.112 m did
-  // better on the 12 s drive but let a wheel spin through on a 120 s drive
-  // and cost the drift's map 16 points.
+  // (0.112 m here), which let a wheel spin through on a simulated drive and
+  // cost the featureless drift's map; why 0.08 m:
+  // docs/decisions/001-map-point-spacing.md.
   float map_point_spacing_m = 0.08F;
   // The local map drops voxels beyond max_range_m once the sensor has moved
   // this far since it last did, not after every scan: the pass reads the
@@ -89,15 +87,14 @@ struct OdometryConfig {
   double sweep_velocity_sigma_mps = 0.5;
   double sweep_velocity_sigma_radps = 0.5;
   // Gravity (ScanInput::gravity) holds roll and pitch: scan-to-map odometry
-  // carries its tilt on through its own map, and on simulated VLP-16 mine
-  // drives it ran away by 0.5–1° (docs/ODOMETRY.md, "Gravity"). The
+  // carries its tilt on through its own map
+  // (docs/decisions/008-accelerometer-gravity-prior.md). The
   // odometry frame's up is the mean of the measured ups over this long from
   // the first, each placed by its scan's pose and weighted by 1/σ²; then it
   // is fixed. It is meant for the second a crew holds still after starting:
   // once the gravity prior holds the poses to this up, later readings placed
   // by those poses only repeat it, so a longer mean cannot correct a frame
-  // taken while moving off (0.14° on a simulated drift that started at once;
-  // 1 s and 5 s gave the same maps).
+  // taken while moving off (docs/decisions/003-gravity-settle.md).
   double gravity_settle_s = 1.0;
   RegistrationConfig registration;
 };

@@ -44,16 +44,15 @@ struct RegistrationConfig {
   // Σ w·JᵀJ / σ², in the same units as the prior's. Far above the range noise
   // because residuals are not independent (shared map points, the rings'
   // sampling pattern, which biases a self-similar drift towards "no motion").
-  // Measured on a simulated 60 s mine survey with wheels: σ 0.05 let the
-  // biased scan overrule the wheels along the drift (APE 0.31 m), 1.0 gives
-  // 0.03 m; constrained directions still follow the scan.
+  // A small σ lets that biased scan overrule the wheels along a drift;
+  // constrained directions still follow the scan at 1 m
+  // (docs/decisions/010-scan-weight.md).
   double point_sigma_m = 1.0;
   // Normalised eigenvalue below which a direction is degenerate: 0.01 means
-  // fewer than ~1% of the residuals watch it. Measured with 10-point planes on
-  // simulated VLP-16 sessions (2 cm noise): a smooth 200 m drift's axis is
-  // flagged on 89% of its scans (0.003: 9%), the rough mine loop on 15% of
-  // its scans with wheels, where the remapping keeps the wheels' estimate
-  // and the accuracy is unchanged (APE 0.030 m).
+  // fewer than ~1% of the residuals watch it. With 10-point planes it flags a
+  // smooth drift's axis and leaves a rough mine mostly observed, where the
+  // remapping keeps the wheels' estimate
+  // (docs/decisions/009-planes-from-nearest-points.md).
   double degeneracy_threshold = 0.01;
   int min_plane_correspondences = 100;  // fewer: every direction counts as degenerate
 };

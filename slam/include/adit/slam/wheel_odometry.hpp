@@ -36,7 +36,8 @@
 // into the next reading. This is the wheel-acceleration test of traction
 // control (a wheel cannot accelerate beyond what friction allows, about µ·g),
 // e.g. Gustafsson, "Slip-based tire-road friction estimation", Automatica
-// 33(6), 1997, which estimates slip from wheel speeds against the vehicle's.
+// 33(6), 1997, which estimates slip from wheel speeds against the vehicle's
+// (docs/decisions/005-wheel-slip-held.md).
 
 #include <array>
 #include <cstdint>

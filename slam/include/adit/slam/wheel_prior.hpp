@@ -5,7 +5,7 @@
 // the turn. The wheels say nothing about height, roll and pitch, so those are
 // loose. (Error model after Siegwart et al., "Introduction to Autonomous
 // Mobile Robots", §5.2.4: variance proportional to the travel; the constants
-// were measured on simulated sessions, docs/ODOMETRY.md.)
+// are in wheel_prior.cpp and listed in docs/ODOMETRY.md.)
 
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/pose2.hpp"

@@ -1,0 +1,102 @@
+#pragma once
+// The pipeline's mapping stage: registered scans in, the session's map out.
+//
+// In:   each valid scan's body-frame points, times and intensities with its
+//       odometry pose (MapSlot).
+// Out:  the tiled voxel map and keyframes (read after join()); changed tiles
+//       to the tile sink at most once per map.publish_period_s; the map's
+//       poses as TUM; tiles the sensor has left, crowded tiles and old
+//       keyframes' scans to the session folder (bounded memory).
+// A scan is mapped one scan late: deskewed with the corrected motion over its
+// own sweep, pose_k⁻¹·pose_k+1 (odometry could only deskew with its
+// prediction), optionally refined against the map (slam/map_refiner.hpp),
+// then added. Thread "mapping": the map grows by nature and tile files are
+// written here, so it may allocate and do file I/O; it never blocks another
+// stage (live, its hand-off drops the oldest scan; a replay waits).
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/handoff.hpp"
+#include "adit/daemon/pipeline_items.hpp"
+#include "adit/daemon/pipeline_stats.hpp"
+#include "adit/daemon/stage_thread.hpp"
+#include "adit/daemon/tile_spill.hpp"
+#include "adit/slam/deskew.hpp"
+#include "adit/slam/keyframes.hpp"
+#include "adit/slam/lie.hpp"
+#include "adit/slam/map_refiner.hpp"
+#include "adit/slam/tiled_map.hpp"
+#include "adit/slam/tum.hpp"
+#include "adit/slam/voxel_downsample.hpp"
+
+namespace adit::daemon {
+
+class MappingStage {
+ public:
+  // `odometry`: the range limits and the longest gap after which a pose says
+  // nothing of the sweep before it; `max_points`: the most points per scan.
+  MappingStage(const config::Config& config, const slam::OdometryConfig& odometry, Handoff<MapSlot>& scans,
+               std::size_t max_points, PipelineSinks::TileSink sink, PipelineStats& stats,
+               const std::atomic<bool>& stop);
+
+  // Before start(): the map's poses as TUM (throws adit::InputError naming
+  // the file); where evicted tiles and old keyframes' scans go (empty = RAM).
+  void write_map_trajectory_to(const std::filesystem::path& file);
+  void spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir);
+  void start();
+  void join() { thread_.join(); }
+
+  StageThread& thread() { return thread_; }
+  const Handoff<MapSlot>& input() const { return scans_; }
+  // Complete after join().
+  const slam::TiledVoxelMap& map() const { return map_; }
+  const TileSpill* tile_spill() const { return spill_ ? &*spill_ : nullptr; }
+  const std::vector<slam::Keyframe>& keyframes() const { return keyframes_; }
+
+ private:
+  void loop();
+  void map_scan(const MapSlot& slot, const slam::Vector6d& velocity);
+  void spill_keyframes();
+  void compact_tiles(const std::vector<slam::TileCoord>& coords);
+  void restore_tiles(const std::vector<slam::TileCoord>& coords);
+  void evict_tiles(const std::vector<slam::TileCoord>& coords);
+  void flush_tiles();
+  void tile_file_error(const std::string& problem);
+
+  const config::MapSection config_;
+  const float min_range_m_;
+  const float max_range_m_;
+  const double max_scan_gap_s_;
+  Handoff<MapSlot>& scans_;
+  PipelineSinks::TileSink sink_;
+  PipelineStats& stats_;
+  StageThread thread_;
+  slam::TiledVoxelMap map_;
+  slam::TileEviction eviction_;
+  std::optional<TileSpill> spill_;        // with a tiles folder and map.evict_after_keyframes
+  std::filesystem::path keyframes_dir_;   // empty = keyframe scans stay in RAM
+  std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
+  std::uint64_t keyframe_bytes_ = 0;
+  slam::KeyframeSelector keyframe_selector_;
+  std::vector<slam::Keyframe> keyframes_;
+  slam::VoxelDownsampler keyframe_downsampler_;
+  slam::Deskewer deskewer_;
+  std::optional<slam::MapRefiner> refiner_;  // with map.refine
+  slam::TumWriter map_trajectory_;
+  // Per-scan buffers, reserved for the largest scan.
+  std::vector<Eigen::Vector3f> points_;
+  std::vector<float> times_;
+  std::vector<float> intensities_;
+  std::vector<Eigen::Vector3f> deskewed_;
+  std::vector<Eigen::Vector3f> keyframe_points_;
+  MapSlot pending_;  // the scan waiting for the next pose
+  bool have_pending_ = false;
+  slam::Vector6d velocity_ = slam::Vector6d::Zero();
+};
+
+}  // namespace adit::daemon

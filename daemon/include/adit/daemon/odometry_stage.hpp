@@ -1,0 +1,61 @@
+#pragma once
+// The pipeline's odometry stage: scans in, poses out.
+//
+// In:   ScanSlot from the LiDAR source (sensor frame), and the CAN feed's
+//       wheel and accelerometer samples when configured.
+// Out:  every scan's result (PoseSlot) to the output stage; each valid scan's
+//       body-frame points, times and intensities with its pose (MapSlot) to
+//       the mapping stage when mapping is on.
+// Thread "odometry" runs ScanOdometry (scan_odometry.hpp) per scan: no
+// allocation, lock or log per scan. Live, a full map hand-off drops the
+// oldest scan (counted); a replay waits. Poses are never dropped.
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/handoff.hpp"
+#include "adit/daemon/pipeline_items.hpp"
+#include "adit/daemon/pipeline_stats.hpp"
+#include "adit/daemon/scan_odometry.hpp"
+#include "adit/daemon/stage_thread.hpp"
+
+namespace adit::daemon {
+
+class OdometryStage {
+ public:
+  // `max_points`: the most points a scan can hold (the map hand-off reserves
+  // it); `overflow`: the map hand-off's policy (the source's).
+  OdometryStage(const config::Config& config, const slam::OdometryConfig& odometry, Handoff<ScanSlot>& scans,
+                CanFeed* can, bool mapping, std::size_t max_points, Overflow overflow, PipelineStats& stats,
+                PipelineTimings& timings, const std::atomic<bool>& stop);
+
+  void start();
+  void join() { thread_.join(); }
+
+  Handoff<PoseSlot>& poses() { return poses_; }
+  Handoff<MapSlot>* map_scans() { return map_slots_ ? &*map_slots_ : nullptr; }
+  StageThread& thread() { return thread_; }
+  const Handoff<ScanSlot>& input() const { return scans_; }
+  // First and last scan stamps (after join()).
+  std::int64_t first_stamp_ns() const { return first_stamp_ns_; }
+  std::int64_t last_stamp_ns() const { return last_stamp_ns_; }
+
+ private:
+  void loop();
+  void hand_to_mapping(const drivers::LidarScan& scan, const slam::OdometryResult& result);
+
+  Handoff<ScanSlot>& scans_;
+  PipelineStats& stats_;
+  PipelineTimings& timings_;
+  StageThread thread_;
+  ScanOdometry odometry_;
+  Handoff<PoseSlot> poses_;
+  std::optional<Handoff<MapSlot>> map_slots_;
+  std::int64_t first_stamp_ns_ = 0;
+  std::int64_t last_stamp_ns_ = 0;
+};
+
+}  // namespace adit::daemon

@@ -1,0 +1,61 @@
+#pragma once
+// What the pipeline's stages hand each other through Handoff<T>
+// (handoff.hpp): preallocated items, filled by one thread and read by the
+// next, and the sinks through which results leave the pipeline.
+//
+//   LidarSource ─ScanSlot→ OdometryStage ─PoseSlot→ OutputStage → PipelineSinks::pose
+//                                         └─MapSlot→ MappingStage → PipelineSinks::tile
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/drivers/lidar/point.hpp"
+#include "adit/slam/odometry.hpp"
+#include "adit/slam/tiled_map.hpp"
+
+namespace adit::daemon {
+
+// Items per hand-off.
+inline constexpr std::size_t kScanSlots = 4;
+inline constexpr std::size_t kPoseSlots = 8;
+inline constexpr std::size_t kMapSlots = 4;
+
+// A whole scan in the sensor frame, as the drivers assembled it.
+struct ScanSlot {
+  drivers::LidarScan scan;
+  std::int64_t last_packet_mono_ns = 0;  // when its last packet was received (latency)
+};
+
+// The odometry's result for one scan.
+struct PoseSlot {
+  slam::OdometryResult result;
+  std::int64_t last_packet_mono_ns = 0;
+  std::int64_t pose_mono_ns = 0;  // when the odometry handed it on
+};
+
+// A registered scan for the mapping thread: body-frame points as measured
+// (not deskewed: mapping deskews with the corrected motion), with the pose.
+struct MapSlot {
+  std::int64_t stamp_ns = 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  bool valid = false;
+  std::vector<Eigen::Vector3f> points;
+  std::vector<float> times_s;
+  std::vector<float> intensities;
+};
+
+// Where results leave the pipeline. Each runs on one pipeline thread and must
+// be quick and not throw; empty = not wanted.
+struct PipelineSinks {
+  using PoseSink = std::function<void(const slam::OdometryResult&)>;
+  using TileSink = std::function<void(const slam::TileCoord&, std::span<const slam::MapSample>)>;
+  PoseSink pose;  // output thread, once per scan (valid or not)
+  TileSink tile;  // mapping thread: the whole current content of a tile that changed
+};
+
+}  // namespace adit::daemon

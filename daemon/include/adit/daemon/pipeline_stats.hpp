@@ -1,0 +1,70 @@
+#pragma once
+// What the pipeline counts and times, written by its stages' threads and read
+// by the session (status, summary.json) and the tools.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace adit::daemon {
+
+// Statistics, readable while running (atomics) and complete after join().
+struct PipelineStats {
+  std::atomic<std::uint64_t> datagrams{0};         // received from the source
+  std::atomic<std::uint64_t> foreign_datagrams{0}; // not on the data port
+  std::atomic<std::uint64_t> stale_datagrams{0};   // udp: in the socket before start(), discarded
+  std::atomic<std::uint64_t> dropped_packets{0};   // live: dropped because assembly fell behind
+  std::atomic<std::uint64_t> scans{0};
+  std::atomic<std::uint64_t> dropped_scans{0};     // live: dropped because odometry fell behind
+  std::atomic<std::uint64_t> incomplete_scans{0};
+  std::atomic<std::uint64_t> poses{0};
+  std::atomic<std::uint64_t> invalid_poses{0};
+  std::atomic<std::uint64_t> degenerate_poses{0};
+  std::atomic<std::uint64_t> bad_packets{0};
+  std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
+  std::atomic<std::int64_t> clock_offset_ns{0};          // host − sensor clock, per scan (drivers/lidar/sensor_clock.hpp)
+  std::atomic<std::uint64_t> recorded_datagrams{0};
+  std::atomic<std::uint64_t> mapped_scans{0};
+  std::atomic<std::uint64_t> dropped_map_scans{0};      // live: mapping fell behind
+  std::atomic<std::uint64_t> map_points{0};
+  std::atomic<std::uint64_t> map_tiles{0};
+  std::atomic<std::uint64_t> keyframes{0};
+  // What the mapping thread holds and sends away (eviction: tiles the sensor has left go to disk).
+  std::atomic<std::uint64_t> map_bytes{0};            // resident tiles' vectors and indices
+  std::atomic<std::uint64_t> keyframe_bytes{0};       // keyframes' downsampled scans
+  std::atomic<std::uint64_t> resident_tiles{0};
+  std::atomic<std::uint64_t> evicted_tiles{0};        // evictions (a tile evicted twice counts twice)
+  std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
+  std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
+  std::atomic<std::uint64_t> lost_candidates{0};      // voxels hit < min_hits times in evicted tiles
+  std::atomic<std::uint64_t> spilled_keyframes{0};    // keyframes whose scan went to keyframes_dir
+  std::atomic<std::uint64_t> tile_file_errors{0};     // a tile or keyframe that could not be written (kept) or read (skipped)
+  std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back
+  std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
+  std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
+  std::atomic<std::uint64_t> gravity_priors{0};        // scans registered with the accelerometer's up
+  std::atomic<std::uint64_t> scans_without_gravity{0}; // IMU configured, but no readings or not gravity-sized
+};
+
+// A stage's queue and its thread's CPU time, for the status message.
+struct StageLoad {
+  std::string name;
+  double cpu_s = 0.0;         // CPU time of the stage's thread so far
+  std::size_t queue_depth = 0;  // items waiting for the stage
+  std::size_t queue_capacity = 0;
+};
+
+// Scans whose figures PipelineTimings keeps (29 h at 10 Hz).
+inline constexpr std::size_t kTimingCapacity = std::size_t{1} << 20;
+
+// Per-scan figures gathered by the odometry and output threads (read after join()).
+struct PipelineTimings {
+  std::vector<double> odometry_ms;   // Odometry::process per scan
+  std::vector<double> latency_ms;    // last packet of a scan received → its pose handed on
+  double duration_s = 0.0;           // wall time from start to the source's end and the queues drained
+  double sensor_span_s = 0.0;        // first to last scan stamp
+};
+
+}  // namespace adit::daemon

@@ -1,0 +1,78 @@
+#pragma once
+// One LiDAR scan to one pose, as aditd's odometry stage runs it and as
+// `adit bench odometry` measures it: the scan's points from the sensor frame
+// to the body frame (lidar.extrinsics) with their firing times in seconds,
+// the wheels' motion prior and the accelerometer's gravity from the CAN feed
+// when one is configured (slam/motion_history.hpp, slam/gravity.hpp), then
+// slam::Odometry. Thread-free: it runs on its caller's thread and waits only
+// for a replayed CAN log to catch up with the scan. No allocation per scan
+// after construction.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/can_feed.hpp"
+#include "adit/drivers/lidar/point.hpp"
+#include "adit/slam/motion_history.hpp"
+#include "adit/slam/odometry.hpp"
+
+namespace adit::daemon {
+
+// The odometry aditd runs for `config`: `base` (slam defaults, or a
+// benchmark's settings) with the range limits of the lidar section and room
+// for `max_points` per scan.
+slam::OdometryConfig odometry_config_of(const config::Config& config, slam::OdometryConfig base, std::size_t max_points);
+
+// How often the motion sensors helped (only counted when configured).
+struct MotionAidCounts {
+  std::uint64_t wheel_priors = 0;           // scans registered with the wheels' prior
+  std::uint64_t scans_without_wheels = 0;   // wheels configured, but no samples around the scan
+  std::uint64_t gravity_priors = 0;         // scans registered with the accelerometer's up
+  std::uint64_t scans_without_gravity = 0;  // IMU configured, but no readings or not gravity-sized
+};
+
+class ScanOdometry {
+ public:
+  // `can`: the CAN feed (wheels, accelerometer), or null. `idle` is called
+  // while a replayed CAN log lags the scan: it beats the caller's heartbeat
+  // and returns false to stop waiting.
+  ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
+               std::function<bool()> idle);
+
+  const slam::OdometryResult& process(const drivers::LidarScan& scan);
+
+  // The last scan in the body frame, with each point's time after the scan's start (s).
+  std::span<const Eigen::Vector3f> body_points() const { return body_points_; }
+  std::span<const float> body_times() const { return body_times_; }
+  double registration_ms() const { return registration_ms_; }  // slam::Odometry::process, last scan
+  const MotionAidCounts& counts() const { return counts_; }
+
+ private:
+  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns, float sweep_s);
+  std::optional<slam::UpMeasurement> up_for(std::int64_t stamp_ns, float sweep_s);
+
+  static constexpr double kSpeedHalfWindow_s = 0.05;  // the wheels' speed: central differences over ±50 ms
+
+  slam::Odometry odometry_;
+  Eigen::Isometry3f extrinsic_;
+  CanFeed* can_;
+  bool imu_;
+  double gravity_sigma_rad_;
+  std::function<bool()> idle_;
+  slam::WheelHistory wheel_history_{8192};  // 80 s at 100 Hz
+  slam::ImuHistory imu_history_{4096};      // 40 s at 100 Hz
+  double previous_stamp_s_ = 0.0;
+  std::vector<Eigen::Vector3f> body_points_;
+  std::vector<float> body_times_;
+  slam::OdometryResult result_;
+  double registration_ms_ = 0.0;
+  MotionAidCounts counts_;
+};
+
+}  // namespace adit::daemon

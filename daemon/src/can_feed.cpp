@@ -1,0 +1,260 @@
+#include "adit/daemon/can_feed.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/drivers/can/candump.hpp"
+#include "adit/drivers/can/decoder.hpp"
+#include "adit/drivers/can/signal.hpp"
+#include "adit/drivers/can/socketcan.hpp"
+#include "adit/slam/wheel_odometry.hpp"
+
+namespace adit::daemon {
+namespace can = drivers::can;
+
+std::vector<can::MessageSpec> can_messages_of(const config::Config& c) {
+  if (!c.can.preset.empty())
+    throw InputError("", "can.preset", "aditd reads wheel signals from can.dbc or can.signals; presets are for adit can-decode");
+  std::vector<can::MessageSpec> messages;
+  if (!c.can.dbc.empty()) messages = can::load_dbc(c.can.dbc).messages;
+  for (const config::CanSignal& s : c.can.signals) {
+    can::SignalSpec spec;
+    spec.name = s.name;
+    spec.start_bit = static_cast<unsigned>(s.start_bit);
+    spec.length = static_cast<unsigned>(s.length);
+    spec.byte_order = s.byte_order == config::ByteOrder::motorola ? can::ByteOrder::motorola : can::ByteOrder::intel;
+    spec.is_signed = s.value_type == config::ValueType::signed_int;
+    spec.type = s.value_type == config::ValueType::ieee_float
+                    ? (s.length == 64 ? can::ValueType::float64 : can::ValueType::float32)
+                    : can::ValueType::integer;
+    spec.factor = s.factor;
+    spec.offset = s.offset;
+    spec.unit = s.unit;
+    can::add_inline_signal(messages, s.id, s.extended, spec);
+  }
+  return messages;
+}
+
+struct CanFeed::Impl {
+  config::Config config;
+  can::SignalDecoder decoder;
+  std::size_t left = 0;
+  std::size_t right = 0;
+  slam::WheelOdometry odometry;
+  std::optional<can::CandumpReader> log;
+  std::optional<can::CanSocket> socket;
+  std::optional<can::CandumpWriter> recorder;
+  std::vector<double> values;
+  std::array<std::size_t, 3> accel{};  // decoder slots of the accelerometer's x, y, z (config.imu.enabled)
+  Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
+
+  static slam::WheelGeometry geometry_of(const config::WheelOdometrySection& w) {
+    slam::WheelGeometry g;
+    g.left_radius = w.left_radius_m;
+    g.right_radius = w.right_radius_m;
+    g.track_width = w.track_width_m;
+    g.skid_factor = w.model == config::DriveModel::skid_steer ? 1.5 : 1.0;
+    g.counts_per_revolution = w.counts_per_revolution;
+    g.counter_bits = static_cast<unsigned>(w.counter_bits);
+    return g;
+  }
+
+  static slam::WheelLimits limits_of(const config::WheelOdometrySection& w) {
+    slam::WheelLimits l;
+    l.max_acceleration = w.max_acceleration_mps2;
+    l.max_slip_duration = w.max_slip_s;
+    return l;
+  }
+
+  // The signals the feed decodes, with the config key that names each.
+  static std::vector<std::pair<std::string, std::string>> wanted_signals(const config::Config& c) {
+    std::vector<std::pair<std::string, std::string>> wanted{{c.wheel_odometry.left_signal, "wheel_odometry.left_signal"},
+                                                            {c.wheel_odometry.right_signal, "wheel_odometry.right_signal"}};
+    if (c.imu.enabled) {
+      wanted.emplace_back(c.imu.accel_x_signal, "imu.accel_x_signal");
+      wanted.emplace_back(c.imu.accel_y_signal, "imu.accel_y_signal");
+      wanted.emplace_back(c.imu.accel_z_signal, "imu.accel_z_signal");
+    }
+    return wanted;
+  }
+
+  // The decoder of the wheel (and accelerometer) signals; an unknown signal is named by its config key.
+  static can::SignalDecoder make_decoder(const config::Config& c) {
+    const auto wanted = wanted_signals(c);
+    std::vector<std::string> names;
+    for (const auto& [name, key] : wanted) names.push_back(name);
+    try {
+      return can::SignalDecoder(can_messages_of(c), names, c.wheel_odometry.quantity != config::WheelQuantity::counts);
+    } catch (const InputError& e) {
+      for (const auto& [name, key] : wanted)
+        if (e.key() == name) throw InputError(e.where(), key, e.reason());
+      throw;
+    }
+  }
+
+  explicit Impl(const config::Config& c)
+      : config(c),
+        decoder(make_decoder(c)),
+        odometry(geometry_of(c.wheel_odometry), {}, limits_of(c.wheel_odometry)) {
+    const int l = decoder.slot(c.wheel_odometry.left_signal);
+    const int r = decoder.slot(c.wheel_odometry.right_signal);
+    if (l < 0) throw InputError("", "wheel_odometry.left_signal", "no such signal in can.dbc / can.signals");
+    if (r < 0) throw InputError("", "wheel_odometry.right_signal", "no such signal in can.dbc / can.signals");
+    left = static_cast<std::size_t>(l);
+    right = static_cast<std::size_t>(r);
+    if (c.imu.enabled) {
+      const auto wanted = wanted_signals(c);
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        const auto& [name, key] = wanted[2 + axis];
+        const int slot = decoder.slot(name);
+        if (slot < 0) throw InputError("", key, "no such signal in can.dbc / can.signals");
+        accel[axis] = static_cast<std::size_t>(slot);
+      }
+      const auto rad = [](double deg) { return deg * std::numbers::pi / 180.0; };
+      imu_to_body = (Eigen::AngleAxisd(rad(c.imu.rpy_deg[2]), Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[1]), Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[0]), Eigen::Vector3d::UnitX()))
+                        .toRotationMatrix();
+    }
+    values.resize(decoder.slot_count());
+    if (c.can.source == config::CanSource::candump) {
+      log.emplace(c.can.log);
+    } else {
+      can::SocketOptions options;
+      options.interface = c.can.interface;
+      try {
+        socket.emplace(can::CanSocket::open(options));
+      } catch (const std::runtime_error& e) {
+        throw InputError(c.can.interface, "can.interface", e.what());
+      }
+    }
+  }
+};
+
+CanFeed::CanFeed(const config::Config& config)
+    : impl_(std::make_unique<Impl>(config)),
+      replay_(config.can.source == config::CanSource::candump),
+      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return CanSample{}; }) {}
+
+CanFeed::~CanFeed() { stop(); }
+
+void CanFeed::start(const std::filesystem::path& record_file) {
+  if (!record_file.empty()) impl_->recorder.emplace(record_file);
+  thread_ = std::thread([this] { run(); });
+}
+
+void CanFeed::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  if (impl_->recorder) {
+    try {
+      impl_->recorder->flush();
+    } catch (const std::exception& e) {
+      log::error("CAN recording: {}", e.what());
+    }
+  }
+}
+
+void CanFeed::drain_into(slam::WheelHistory& history, double until_t, slam::ImuHistory* imu,
+                         const std::function<bool()>& idle) {
+  // A replay stops once both streams reach until_t, or a second past it
+  // (an accelerometer that fell silent must not drain the whole log).
+  const auto covered = [&] {
+    if (history.latest() < until_t) return false;
+    return imu == nullptr || !impl_->config.imu.enabled || imu->latest() >= until_t || drained_t_ >= until_t + 1.0;
+  };
+  const bool wait = replay_ && idle;
+  while (!(replay_ && covered())) {
+    CanSample* s = wait ? samples_.take_or_wait(idle) : samples_.take();
+    if (s == nullptr) return;
+    if (const auto* wheel = std::get_if<slam::WheelSample>(s)) {
+      history.push(*wheel);
+      drained_t_ = wheel->t;
+    } else if (const auto* reading = std::get_if<slam::ImuSample>(s)) {
+      if (imu != nullptr) imu->push(*reading);
+      drained_t_ = reading->t;
+    }
+    samples_.release(s);
+  }
+}
+
+bool CanFeed::hand_over(const CanSample& sample) {
+  CanSample* out = nullptr;
+  while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {
+    beat_.beat();  // replay: the odometry thread has not caught up
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  if (out == nullptr) return false;
+  *out = sample;
+  samples_.publish(out);
+  return true;
+}
+
+void CanFeed::run() {
+  Impl& i = *impl_;
+  const config::WheelOdometrySection& w = i.config.wheel_odometry;
+  double value_left = NAN;
+  double value_right = NAN;
+  can::Frame frame;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    beat_.beat();
+    if (i.log) {
+      if (!i.log->next(frame)) break;  // the replayed log has ended
+    } else if (i.socket->read(frame, 100) != can::ReadResult::frame) {
+      continue;
+    }
+    stats_.frames.fetch_add(1, std::memory_order_relaxed);
+    stats_.last_frame_us.store(frame.time_us, std::memory_order_relaxed);
+    if (i.recorder) {
+      i.recorder->write(frame);
+      stats_.recorded.fetch_add(1, std::memory_order_relaxed);
+    }
+    const can::DecodeResult r = i.decoder.decode(frame, i.values);
+    if (r.status != can::DecodeStatus::decoded) continue;
+    const auto written = [&](std::size_t slot) {
+      return slot >= r.first && slot < r.first + r.count && !std::isnan(i.values[slot]);
+    };
+    // An accelerometer frame carries all three axes.
+    if (i.config.imu.enabled && written(i.accel[0]) && written(i.accel[1]) && written(i.accel[2])) {
+      const Eigen::Vector3d f(i.values[i.accel[0]], i.values[i.accel[1]], i.values[i.accel[2]]);
+      if (!hand_over(slam::ImuSample{1e-6 * static_cast<double>(frame.time_us) - i.config.imu.time_offset_s, i.imu_to_body * f}))
+        break;
+      stats_.imu_samples.fetch_add(1, std::memory_order_relaxed);
+    }
+    // Left and right may come in separate frames: a sample is taken when both
+    // have a value newer than the last sample.
+    if (written(i.left)) value_left = i.values[i.left];
+    if (written(i.right)) value_right = i.values[i.right];
+    if (std::isnan(value_left) || std::isnan(value_right)) continue;
+    const double t = 1e-6 * static_cast<double>(frame.time_us) - w.time_offset_s;
+    slam::WheelStep step = slam::WheelStep::integrated;
+    switch (w.quantity) {
+      case config::WheelQuantity::counts:
+        step = i.odometry.add_counts(t, static_cast<std::uint64_t>(static_cast<std::int64_t>(value_left)),
+                                     static_cast<std::uint64_t>(static_cast<std::int64_t>(value_right)));
+        break;
+      case config::WheelQuantity::angular_speed: step = i.odometry.add_wheel_rates(t, value_left, value_right); break;
+      case config::WheelQuantity::speed: step = i.odometry.add_speeds(t, value_left, value_right); break;
+    }
+    value_left = value_right = NAN;
+    if (step != slam::WheelStep::integrated && step != slam::WheelStep::first)
+      stats_.untrusted.fetch_add(1, std::memory_order_relaxed);
+    stats_.slip_episodes.store(i.odometry.stats().slip_episodes, std::memory_order_relaxed);
+    if (step == slam::WheelStep::time_backwards) continue;
+    if (!hand_over(slam::WheelSample{t, i.odometry.pose(), i.odometry.distance()})) break;
+    stats_.samples.fetch_add(1, std::memory_order_relaxed);
+  }
+  stats_.dropped.store(samples_.dropped());
+  samples_.close();
+  finished_.store(true, std::memory_order_release);
+  beat_.finished.store(true);
+}
+
+}  // namespace adit::daemon

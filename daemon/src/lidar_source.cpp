@@ -1,0 +1,244 @@
+// The LiDAR source stage. In: UDP datagrams, a pcap or a scan directory.
+// Out: whole scans (sensor frame) to the odometry stage; raw pcap recording.
+// Threads receiver and assembly; no allocation, lock or log per packet; a
+// replay waits for room, live drops the oldest (counted). (lidar_source.hpp)
+#include "adit/daemon/lidar_source.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <span>
+
+#include "adit/common/clock.hpp"
+#include "adit/common/error.hpp"
+#include "adit/common/log.hpp"
+#include "adit/drivers/lidar/decode_stream.hpp"
+#include "adit/drivers/lidar/registry.hpp"
+#include "adit/drivers/lidar/scan_directory.hpp"
+#include "adit/drivers/pcap_replay.hpp"
+#include "adit/drivers/pcap_writer.hpp"
+#include "adit/drivers/udp.hpp"
+
+namespace adit::daemon {
+namespace {
+
+constexpr std::size_t kMaxDatagram = 65'536;
+constexpr std::size_t kPacketSlots = 512;  // ~0.4 s of the busiest sensor (Ouster, 1280 packets/s)
+
+struct Packet {
+  std::int64_t host_time_ns = 0;      // capture or kernel time (the sensor clock's reference)
+  std::uint32_t src_ip = 0;           // for the raw recording
+  std::uint16_t src_port = 0;
+  std::int64_t received_mono_ns = 0;  // when the receiver handed it on (latency)
+  std::uint32_t size = 0;
+  std::array<std::uint8_t, kMaxDatagram> data{};
+};
+
+}  // namespace
+
+struct LidarSource::Impl {
+  Impl(const config::Config& c, double speed, Overflow overflow, PipelineStats& s, const std::atomic<bool>& stop_flag,
+       const std::atomic<bool>& end_flag)
+      : config(c),
+        stats(s),
+        stop(stop_flag),
+        end(end_flag),
+        packets(kPacketSlots, overflow, [] { return Packet{}; }),
+        receiver("receiver", c.threads.receiver, stop_flag),
+        assembly("assembly", c.threads.receiver, stop_flag) {
+    if (c.lidar.source == config::LidarSource::scan_dir) {
+      scan_directory.emplace(c.lidar.scan_dir);
+      return;
+    }
+    if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);
+    const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
+    if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
+    try {
+      decoder = family->make_decoder(c.lidar.model, c.lidar.calibration);
+    } catch (const InputError& e) {
+      // The family speaks of its own inputs; name the configuration key.
+      throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
+    }
+    data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
+    if (c.lidar.source == config::LidarSource::udp) {
+      drivers::UdpReceiverConfig udp_config;
+      udp_config.bind_address = c.lidar.address;
+      udp_config.port = data_port;
+      udp_config.interface = c.lidar.interface;
+      udp_config.multicast_group = c.lidar.multicast_group;
+      udp_config.receive_buffer_bytes = c.lidar.receive_buffer_bytes;
+      udp.emplace(udp_config);
+    }
+    // The packet period is learnt from the first packet by the family; 0 = by sequence only.
+    assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
+    stream.emplace(*decoder, *assembler, [this](drivers::LidarScan& scan) { hand_on(scan); });
+  }
+
+  bool reading() const { return !stop.load(std::memory_order_relaxed) && !end.load(std::memory_order_relaxed); }
+
+  // Assembly thread (receiver thread for a scan directory): a finished scan
+  // goes to odometry, swapped, not copied.
+  void hand_on(drivers::LidarScan& scan) {
+    stats.scans.fetch_add(1, std::memory_order_relaxed);
+    if (stream) {
+      if (const auto clock = stream->clock().estimate())
+        stats.clock_offset_ns.store(clock->offset_ns, std::memory_order_relaxed);
+    }
+    if (!scan.stats.complete) stats.incomplete_scans.fetch_add(1, std::memory_order_relaxed);
+    ScanSlot* slot = scans->acquire_or_wait([this] { return assembly.idle(); });
+    if (slot == nullptr) return;
+    std::swap(slot->scan, scan);
+    slot->last_packet_mono_ns = current_packet_mono_ns;
+    scans->publish(slot);
+  }
+
+  // Receiver thread: one datagram into the packet pool (and the recording).
+  void push(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip, std::uint16_t src_port) {
+    Packet* packet = packets.acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
+    if (packet == nullptr) return;
+    packet->host_time_ns = time_ns;
+    packet->src_ip = src_ip;
+    packet->src_port = src_port;
+    packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
+    std::memcpy(packet->data.data(), payload.data(), packet->size);
+    packet->received_mono_ns = monotonic_ns();
+    stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+    if (recorder) {
+      // Buffered file output on the receiver: a copy and no allocation per packet.
+      const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, data_port};
+      if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload))
+        stats.recorded_datagrams.fetch_add(1, std::memory_order_relaxed);
+    }
+    packets.publish(packet);
+  }
+
+  void receiver_loop() {
+    if (scan_directory) return scan_directory_loop();
+    if (pcap) {
+      drivers::UdpDatagram d;
+      while (reading() && pcap->next(d)) {
+        receiver.beat.beat();
+        stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+        if (d.dst_port != data_port) {
+          stats.foreign_datagrams.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
+        push(d.payload, d.capture_time_ns, d.src_ip, d.src_port);
+      }
+    } else {
+      // A pipeline built ahead of its session (Sessions keeps one ready) finds
+      // old packets in the socket's buffer: they belong to no session.
+      for (auto batch = udp->receive(0); !batch.empty(); batch = udp->receive(0))
+        stats.stale_datagrams.fetch_add(batch.size(), std::memory_order_relaxed);
+      while (reading()) {
+        receiver.beat.beat();
+        for (const drivers::ReceivedDatagram& d : udp->receive(100)) {
+          stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+          push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port);
+        }
+      }
+    }
+    if (recorder) {
+      try {
+        recorder->flush();
+      } catch (const InputError& e) {
+        log::error("{}: {}", e.where(), e.reason());
+      }
+    }
+    packets.close();
+  }
+
+  void scan_directory_loop() {
+    drivers::LidarScan scan;
+    scan.points.reserve(scan_dir_points);
+    while (reading() && scan_directory->next(scan)) {
+      receiver.beat.beat();
+      current_packet_mono_ns = monotonic_ns();
+      hand_on(scan);
+    }
+    scans->close();
+  }
+
+  void assembly_loop() {
+    if (scan_directory) return;
+    // A stop drops what is queued; an ended source is drained.
+    while (!stop.load(std::memory_order_relaxed)) {
+      Packet* packet = packets.take_or_wait([this] { return assembly.idle(); });
+      if (packet == nullptr) break;
+      assembly.beat.beat();
+      current_packet_mono_ns = packet->received_mono_ns;
+      stream->push(std::span<const std::uint8_t>(packet->data.data(), packet->size), packet->host_time_ns);
+      packets.release(packet);
+    }
+    if (!stop.load()) stream->finish();
+    stats.bad_packets.store(stream->bad_packets());
+    stats.dropped_packets.store(packets.dropped());
+    scans->close();
+  }
+
+  config::Config config;
+  PipelineStats& stats;
+  const std::atomic<bool>& stop;
+  const std::atomic<bool>& end;
+  std::size_t scan_dir_points = 0;
+  std::unique_ptr<drivers::LidarDecoder> decoder;
+  std::uint16_t data_port = 0;
+  std::optional<drivers::PacedPcapReader> pcap;
+  std::optional<drivers::UdpReceiver> udp;
+  std::optional<drivers::ScanDirectorySource> scan_directory;
+  std::optional<drivers::ScanAssembler> assembler;
+  std::optional<drivers::DecodeStream> stream;
+  std::optional<drivers::PcapWriter> recorder;
+  Handoff<Packet> packets;
+  Handoff<ScanSlot>* scans = nullptr;      // the source's output, set before the threads start
+  std::int64_t current_packet_mono_ns = 0;  // assembly thread only
+  StageThread receiver;
+  StageThread assembly;
+};
+
+namespace {
+Overflow overflow_of(const config::Config& c) {
+  return c.lidar.source == config::LidarSource::udp ? Overflow::drop_oldest : Overflow::wait;
+}
+}  // namespace
+
+LidarSource::LidarSource(const config::Config& config, double replay_speed, std::size_t scan_dir_points,
+                         PipelineStats& stats, const std::atomic<bool>& stop)
+    : impl_(std::make_unique<Impl>(config, replay_speed >= 0.0 ? replay_speed : config.lidar.replay_speed,
+                                   overflow_of(config), stats, stop, end_)),
+      overflow_(overflow_of(config)),
+      max_points_(impl_->assembler ? impl_->assembler->config().max_points_per_scan : scan_dir_points),
+      scans_(kScanSlots, overflow_, [points = max_points_] {
+        ScanSlot slot;
+        slot.scan.points.reserve(points);
+        return slot;
+      }) {
+  impl_->scan_dir_points = scan_dir_points;
+  impl_->scans = &scans_;
+}
+
+LidarSource::~LidarSource() { join(); }
+
+void LidarSource::record_to(const std::filesystem::path& file) {
+  if (file.empty()) return;
+  if (!impl_->udp && !impl_->pcap)
+    throw InputError(file.string(), "session.record_lidar", "only packet sources can be recorded");
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  impl_->recorder.emplace(file);
+}
+
+void LidarSource::start() {
+  impl_->assembly.start([this] { impl_->assembly_loop(); });
+  impl_->receiver.start([this] { impl_->receiver_loop(); });
+}
+
+void LidarSource::join() {
+  impl_->receiver.join();
+  impl_->assembly.join();
+}
+
+std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &impl_->assembly}; }
+std::size_t LidarSource::packets_waiting() const { return impl_->packets.depth(); }
+std::size_t LidarSource::packet_capacity() const { return impl_->packets.capacity(); }
+
+}  // namespace adit::daemon

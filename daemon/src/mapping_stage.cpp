@@ -1,0 +1,272 @@
+// The mapping stage. In: valid scans with their odometry poses. Out: the
+// tiled map and keyframes, changed tiles to the tile sink, the map's poses,
+// tiles and keyframe scans on disk. Thread mapping; the one stage that
+// allocates (the map grows) and writes files; never blocks another stage.
+// (mapping_stage.hpp)
+#include "adit/daemon/mapping_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <malloc.h>
+
+#include <fmt/format.h>
+
+#include "adit/common/clock.hpp"
+#include "adit/common/log.hpp"
+#include "adit/protocol/map_export.hpp"
+
+namespace adit::daemon {
+namespace {
+
+constexpr std::size_t kKeyframeScansInRam = 100;  // the newest keyframes keep their scans in RAM (~5 MB)
+
+slam::TiledMapConfig map_config_of(const config::MapSection& m) {
+  return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m), static_cast<std::uint8_t>(m.min_hits)};
+}
+
+// No point of a scan lies farther than max_range_m from the body (map_scan
+// filters them), deskewing moves points by at most a sweep's motion, and the
+// sensor's offset from the body is small: the margin covers both.
+slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
+  return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
+          static_cast<std::size_t>(m.compact_tile_voxels)};
+}
+
+}  // namespace
+
+MappingStage::MappingStage(const config::Config& config, const slam::OdometryConfig& odometry, Handoff<MapSlot>& scans,
+                           std::size_t max_points, PipelineSinks::TileSink sink, PipelineStats& stats,
+                           const std::atomic<bool>& stop)
+    : config_(config.map),
+      min_range_m_(odometry.min_range_m),
+      max_range_m_(std::min(odometry.max_range_m, static_cast<float>(config.map.max_range_m))),
+      max_scan_gap_s_(odometry.max_scan_gap_s),
+      scans_(scans),
+      sink_(std::move(sink)),
+      stats_(stats),
+      thread_("mapping", config.threads.mapping, stop),
+      map_(map_config_of(config.map)),
+      eviction_(eviction_config_of(config.map)),
+      keyframe_selector_({config.map.keyframe_distance_m, config.map.keyframe_angle_deg}),
+      keyframe_downsampler_(max_points) {
+  if (config.map.refine) {
+    slam::MapRefinerConfig refine;
+    refine.max_scan_points = max_points;
+    refiner_.emplace(refine);
+  }
+  for (std::vector<Eigen::Vector3f>* v : {&points_, &deskewed_, &keyframe_points_, &pending_.points}) v->reserve(max_points);
+  for (std::vector<float>* v : {&times_, &intensities_, &pending_.times_s, &pending_.intensities}) v->reserve(max_points);
+}
+
+void MappingStage::write_map_trajectory_to(const std::filesystem::path& file) {
+  if (!file.empty()) map_trajectory_ = slam::TumWriter(file);
+}
+
+void MappingStage::spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir) {
+  if (config_.evict_after_keyframes == 0) return;
+  if (!tiles_dir.empty()) spill_.emplace(tiles_dir, stored_tile_params(config_.tile_size_m));
+  keyframes_dir_ = keyframes_dir;
+}
+
+void MappingStage::start() {
+  thread_.start([this] { loop(); });
+}
+
+void MappingStage::loop() {
+  const auto period_ns = static_cast<std::int64_t>(config_.publish_period_s * 1e9);
+  std::int64_t last_flush_ns = monotonic_ns();
+  while (!thread_.stopping()) {
+    if (monotonic_ns() - last_flush_ns >= period_ns) {
+      flush_tiles();
+      last_flush_ns = monotonic_ns();
+    }
+    // Waits for a scan until the next flush is due.
+    MapSlot* slot =
+        scans_.take_or_wait([&] { return thread_.idle() && monotonic_ns() - last_flush_ns < period_ns; });
+    if (slot == nullptr) {
+      if (scans_.drained()) break;
+      continue;
+    }
+    thread_.beat.beat();
+    if (have_pending_) {
+      const double dt = 1e-9 * static_cast<double>(slot->stamp_ns - pending_.stamp_ns);
+      // After a gap the next pose says nothing of this sweep: keep the last motion.
+      if (dt > 0.0 && dt <= max_scan_gap_s_) velocity_ = slam::log_se3(pending_.pose.inverse() * slot->pose) / dt;
+      map_scan(pending_, velocity_);
+    }
+    // The slot's buffers and the pending ones have the same capacity: swap, no copy.
+    std::swap(pending_, *slot);
+    have_pending_ = true;
+    scans_.release(slot);
+  }
+  if (have_pending_ && !thread_.stopping()) map_scan(pending_, velocity_);  // the last sweep: the last motion known
+  have_pending_ = false;
+  flush_tiles();
+  map_trajectory_.flush();
+  stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);
+  stats_.dropped_map_scans.store(scans_.dropped());
+}
+
+void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity) {
+  points_.clear();
+  times_.clear();
+  intensities_.clear();
+  const float min2 = min_range_m_ * min_range_m_;
+  const float max2 = max_range_m_ * max_range_m_;
+  const bool timed = slot.times_s.size() == slot.points.size();
+  for (std::size_t i = 0; i < slot.points.size(); ++i) {
+    const float r2 = slot.points[i].squaredNorm();
+    if (!std::isfinite(r2) || r2 < min2 || r2 > max2) continue;
+    points_.push_back(slot.points[i]);
+    times_.push_back(timed ? slot.times_s[i] : 0.0F);
+    intensities_.push_back(i < slot.intensities.size() ? slot.intensities[i] : 0.0F);
+  }
+  deskewed_.resize(points_.size());
+  deskewer_.deskew(points_, times_, velocity, deskewed_);
+  // The map's pose of the scan: the odometry's, refined against the map of
+  // the scans before it (slam::MapRefiner says why).
+  const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_) : slot.pose;
+  map_trajectory_.write(slot.stamp_ns, map_pose);
+  const bool keyframe = keyframe_selector_.take(map_pose);
+  if (keyframe) {
+    keyframe_downsampler_.downsample(deskewed_, static_cast<float>(config_.keyframe_voxel_m), keyframe_points_);
+    keyframes_.push_back({slot.stamp_ns, map_pose, keyframe_points_});
+    keyframe_bytes_ += sizeof(slam::Keyframe) + keyframes_.back().points.capacity() * sizeof(Eigen::Vector3f);
+    stats_.keyframes.store(keyframes_.size(), std::memory_order_relaxed);
+    stats_.keyframe_bytes.store(keyframe_bytes_, std::memory_order_relaxed);
+  }
+  const Eigen::Isometry3f pose = map_pose.cast<float>();
+  for (Eigen::Vector3f& p : deskewed_) p = pose * p;
+  if (spill_) restore_tiles(map_.evicted_hit_by(deskewed_));
+  map_.add(deskewed_, intensities_, 1e-9 * static_cast<double>(slot.stamp_ns));
+  if (spill_ && keyframe) {
+    const std::vector<slam::TileCoord> cold = eviction_.cold_tiles(map_, map_pose.translation().cast<float>());
+    const std::vector<slam::TileCoord> crowded = eviction_.crowded_tiles(map_);
+    evict_tiles(cold);
+    compact_tiles(crowded);
+#ifdef __GLIBC__
+    // The freed tiles lie amid the mapping thread's arena, which glibc gives
+    // back to the kernel only from its top: return the free pages now.
+    if (!cold.empty() || !crowded.empty()) malloc_trim(0);
+#endif
+  }
+  if (!keyframes_dir_.empty() && keyframe) spill_keyframes();
+  stats_.mapped_scans.fetch_add(1, std::memory_order_relaxed);
+  stats_.map_points.store(map_.size(), std::memory_order_relaxed);
+  stats_.map_tiles.store(map_.tile_count(), std::memory_order_relaxed);
+  stats_.resident_tiles.store(map_.resident_tile_count(), std::memory_order_relaxed);
+  stats_.dropped_in_evicted.store(map_.dropped_in_evicted(), std::memory_order_relaxed);
+  if (keyframe) stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+}
+
+// The first file error is logged; every one is counted. What could not be
+// written stays in RAM; what could not be read is skipped.
+void MappingStage::tile_file_error(const std::string& problem) {
+  if (stats_.tile_file_errors.fetch_add(1, std::memory_order_relaxed) == 0) log::error("mapping: {}", problem);
+}
+
+// The scans of all but the newest kKeyframeScansInRam keyframes go to the
+// session folder; their poses stay. Loop closure will read them back. A
+// 30-minute drive keeps ~1800 keyframes of ~50 kB each; a radius rule would
+// not bound them on a route that keeps coming back to the same drifts.
+void MappingStage::spill_keyframes() {
+  for (; keyframes_in_ram_from_ + kKeyframeScansInRam < keyframes_.size(); ++keyframes_in_ram_from_) {
+    slam::Keyframe& k = keyframes_[keyframes_in_ram_from_];
+    std::vector<protocol::MapPoint> points;
+    points.reserve(k.points.size());
+    for (const Eigen::Vector3f& p : k.points) points.push_back({p.x(), p.y(), p.z(), 0.0F, 0.0});
+    try {
+      std::filesystem::create_directories(keyframes_dir_);
+      protocol::write_map(keyframes_dir_ / fmt::format("{}.ply", k.stamp_ns), protocol::MapFormat::ply, points);
+    } catch (const std::exception& e) {  // kept in RAM then
+      tile_file_error(e.what());
+      continue;
+    }
+    keyframe_bytes_ -= k.points.capacity() * sizeof(Eigen::Vector3f);
+    std::vector<Eigen::Vector3f>().swap(k.points);
+    stats_.spilled_keyframes.fetch_add(1, std::memory_order_relaxed);
+  }
+  stats_.keyframe_bytes.store(keyframe_bytes_, std::memory_order_relaxed);
+}
+
+// The whole tiles these functions read back or write (compact, evict,
+// restore, flush) live in a buffer local to each call, freed on return: a
+// buffer kept as a member held the capacity of the largest tile of the
+// session (24 B a point), resident between uses, and grew with the map.
+//
+// A tile holding too many voxels in RAM is written out, evicted and restored
+// at once: its points go to its file and only a bit per voxel stays
+// (unconfirmed voxels are lost, as on eviction).
+void MappingStage::compact_tiles(const std::vector<slam::TileCoord>& coords) {
+  std::vector<slam::MapSample> tile_buffer;
+  for (const slam::TileCoord& coord : coords) {
+    std::string problem = spill_->whole_tile(map_, coord, tile_buffer);
+    if (problem.empty()) problem = spill_->write(coord, tile_buffer);
+    if (!problem.empty()) {
+      tile_file_error(problem);
+      continue;
+    }
+    if (map_.evict(coord).changed && sink_) sink_(coord, tile_buffer);
+    map_.restore(coord, tile_buffer);
+    stats_.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
+  }
+  stats_.lost_candidates.store(map_.lost_candidates(), std::memory_order_relaxed);
+}
+
+// The sensor has come back to tiles it had left; they are read back, so the
+// scan continues them instead of starting copies. A tile that cannot be read
+// stays evicted (its file intact) and add() skips the points that fall into it.
+void MappingStage::restore_tiles(const std::vector<slam::TileCoord>& coords) {
+  std::vector<slam::MapSample> tile_buffer;
+  for (const slam::TileCoord& coord : coords) {
+    if (const std::string problem = spill_->read(coord, tile_buffer); !problem.empty()) {
+      tile_file_error(problem);
+      continue;
+    }
+    map_.restore(coord, tile_buffer);
+    stats_.restored_tiles.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+// Tiles the sensor has left go to the session's tiles/ folder and leave RAM.
+// A tile whose last change was not published yet goes to the sink first. A
+// restored tile's file holds its stored part: it is rewritten with the new
+// points appended, or left as it is when nothing is new.
+void MappingStage::evict_tiles(const std::vector<slam::TileCoord>& coords) {
+  std::vector<slam::MapSample> tile_buffer;
+  for (const slam::TileCoord& coord : coords) {
+    const bool restored = map_.stored_points(coord) > 0;
+    if (!restored || !map_.tile(coord).empty()) {
+      std::string problem = spill_->whole_tile(map_, coord, tile_buffer);
+      if (problem.empty()) problem = spill_->write(coord, tile_buffer);
+      if (!problem.empty()) {
+        tile_file_error(problem);
+        continue;
+      }
+    }
+    if (map_.evict(coord).changed && sink_ && spill_->whole_tile(map_, coord, tile_buffer).empty())
+      sink_(coord, tile_buffer);
+    stats_.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
+  }
+  stats_.lost_candidates.store(map_.lost_candidates(), std::memory_order_relaxed);
+}
+
+// A restored tile's whole content is its stored part (read back) and what is
+// new: decoding it costs a few ms per changed tile and period.
+void MappingStage::flush_tiles() {
+  const std::vector<slam::TileCoord> changed = map_.take_changed();
+  if (!sink_) return;
+  std::vector<slam::MapSample> tile_buffer;
+  for (const slam::TileCoord& coord : changed) {
+    if (!spill_ || map_.stored_points(coord) == 0) {
+      sink_(coord, map_.tile(coord));
+    } else if (const std::string problem = spill_->whole_tile(map_, coord, tile_buffer); problem.empty()) {
+      sink_(coord, tile_buffer);
+    } else {
+      tile_file_error(problem);
+    }
+  }
+}
+
+}  // namespace adit::daemon

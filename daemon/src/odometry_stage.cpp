@@ -1,0 +1,82 @@
+// The odometry stage. In: scans from the LiDAR source, the CAN feed's
+// samples. Out: every pose to the output stage, valid scans with their poses
+// to the mapping stage. Thread odometry; no allocation, lock or log per scan;
+// poses are never dropped. (odometry_stage.hpp)
+#include "adit/daemon/odometry_stage.hpp"
+
+#include "adit/common/clock.hpp"
+
+namespace adit::daemon {
+
+OdometryStage::OdometryStage(const config::Config& config, const slam::OdometryConfig& odometry,
+                             Handoff<ScanSlot>& scans, CanFeed* can, bool mapping, std::size_t max_points,
+                             Overflow overflow, PipelineStats& stats, PipelineTimings& timings,
+                             const std::atomic<bool>& stop)
+    : scans_(scans),
+      stats_(stats),
+      timings_(timings),
+      thread_("odometry", config.threads.odometry, stop),
+      odometry_(config, odometry, can, [this] { return thread_.idle(); }),
+      poses_(kPoseSlots, Overflow::wait, [] { return PoseSlot{}; }) {
+  if (mapping) {
+    map_slots_.emplace(kMapSlots, overflow, [max_points] {
+      MapSlot slot;
+      slot.points.reserve(max_points);
+      slot.times_s.reserve(max_points);
+      slot.intensities.reserve(max_points);
+      return slot;
+    });
+  }
+  timings_.odometry_ms.reserve(kTimingCapacity);
+}
+
+void OdometryStage::start() {
+  thread_.start([this] { loop(); });
+}
+
+void OdometryStage::loop() {
+  const auto idle = [this] { return thread_.idle(); };
+  // A stop drops what is queued; the source's end is drained.
+  while (!thread_.stopping()) {
+    ScanSlot* slot = scans_.take_or_wait(idle);
+    if (slot == nullptr) break;
+    thread_.beat.beat();
+    const slam::OdometryResult& result = odometry_.process(slot->scan);
+    const MotionAidCounts& counts = odometry_.counts();
+    stats_.wheel_priors.store(counts.wheel_priors, std::memory_order_relaxed);
+    stats_.scans_without_wheels.store(counts.scans_without_wheels, std::memory_order_relaxed);
+    stats_.gravity_priors.store(counts.gravity_priors, std::memory_order_relaxed);
+    stats_.scans_without_gravity.store(counts.scans_without_gravity, std::memory_order_relaxed);
+    if (timings_.odometry_ms.size() < kTimingCapacity) timings_.odometry_ms.push_back(odometry_.registration_ms());
+    if (first_stamp_ns_ == 0) first_stamp_ns_ = slot->scan.start_time_ns;
+    last_stamp_ns_ = slot->scan.start_time_ns;
+
+    if (PoseSlot* out = poses_.acquire_or_wait(idle)) {
+      out->result = result;
+      out->last_packet_mono_ns = slot->last_packet_mono_ns;
+      out->pose_mono_ns = monotonic_ns();
+      poses_.publish(out);
+    }
+    if (map_slots_ && result.valid) hand_to_mapping(slot->scan, result);
+    scans_.release(slot);
+  }
+  stats_.dropped_scans.store(scans_.dropped());
+  poses_.close();
+  if (map_slots_) map_slots_->close();
+}
+
+// Copies (no allocation: the slot's buffers are reserved).
+void OdometryStage::hand_to_mapping(const drivers::LidarScan& scan, const slam::OdometryResult& result) {
+  MapSlot* m = map_slots_->acquire_or_wait([this] { return thread_.idle(); });
+  if (m == nullptr) return;
+  m->stamp_ns = result.stamp_ns;
+  m->pose = result.pose;
+  m->valid = result.valid;
+  m->points.assign(odometry_.body_points().begin(), odometry_.body_points().end());
+  m->times_s.assign(odometry_.body_times().begin(), odometry_.body_times().end());
+  m->intensities.clear();
+  for (const drivers::LidarPoint& p : scan.points) m->intensities.push_back(p.intensity);
+  map_slots_->publish(m);
+}
+
+}  // namespace adit::daemon

@@ -1,0 +1,97 @@
+// The odometry step aditd's odometry stage and `adit bench odometry` share:
+// the scan in the body frame with its firing times, and the wheels' prior
+// and gravity's up taken from the CAN feed for every scan they cover.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/scan_odometry.hpp"
+#include "can_logs.hpp"
+
+namespace adit::daemon {
+namespace {
+
+drivers::LidarPoint point(float x, float y, float z, std::uint32_t time_offset_ns) {
+  drivers::LidarPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.time_offset_ns = time_offset_ns;
+  return p;
+}
+
+// A 10 m × 6 m × 3 m room around the sensor, swept over 0.1 s.
+drivers::LidarScan room_scan(std::int64_t start_ns) {
+  drivers::LidarScan scan;
+  scan.start_time_ns = start_ns;
+  for (int i = 0; i < 2000; ++i) {
+    const double a = 2.0 * M_PI * i / 2000.0;
+    const double c = std::cos(a);
+    const double s = std::sin(a);
+    const double r = std::min(5.0 / std::max(std::abs(c), 1e-6), 3.0 / std::max(std::abs(s), 1e-6));
+    const auto t = static_cast<std::uint32_t>(1e8 * i / 2000.0);
+    const float z = static_cast<float>((i % 5) * 0.5 - 1.0);
+    scan.points.push_back(point(static_cast<float>(r * c), static_cast<float>(r * s), z, t));
+  }
+  scan.stats.complete = true;
+  return scan;
+}
+
+TEST(ScanOdometry, PutsTheScanInTheBodyFrameWithItsFiringTimes) {
+  config::Config c;
+  c.lidar.extrinsics.xyz_m = {0.2, 0.0, 0.5};
+  c.lidar.extrinsics.rpy_deg = {0.0, 0.0, 90.0};  // the sensor's x is the body's y
+  ScanOdometry odometry(c, odometry_config_of(c, {}, 16), nullptr, [] { return true; });
+  drivers::LidarScan scan;
+  scan.start_time_ns = 1'000'000'000;
+  scan.points = {point(1.0F, 0.0F, 0.0F, 0), point(0.0F, 2.0F, 0.0F, 50'000'000)};
+  odometry.process(scan);
+  ASSERT_EQ(odometry.body_points().size(), 2U);
+  EXPECT_TRUE(odometry.body_points()[0].isApprox(Eigen::Vector3f(0.2F, 1.0F, 0.5F), 1e-6F));
+  EXPECT_TRUE(odometry.body_points()[1].isApprox(Eigen::Vector3f(-1.8F, 0.0F, 0.5F), 1e-6F));
+  EXPECT_FLOAT_EQ(odometry.body_times()[1], 0.05F);
+  EXPECT_EQ(odometry.counts().wheel_priors + odometry.counts().gravity_priors, 0U) << "no CAN bus configured";
+}
+
+// The odometry step on a replayed CAN log; the log is removed at the end.
+struct OnReplayedCan {
+  explicit OnReplayedCan(const config::Config& config)
+      : log(config.can.log), can(config), odometry(config, odometry_config_of(config, {}, 2000), &can, [] { return true; }) {
+    can.start({});
+  }
+  ~OnReplayedCan() { std::filesystem::remove(log); }
+  // Scans every 0.1 s from `first_ns`; then the feed stops.
+  const MotionAidCounts& run(std::int64_t first_ns, int scans) {
+    for (int k = 0; k < scans; ++k) odometry.process(room_scan(first_ns + k * 100'000'000LL));
+    can.stop();
+    return odometry.counts();
+  }
+  std::filesystem::path log;
+  CanFeed can;
+  ScanOdometry odometry;
+};
+
+TEST(ScanOdometry, TakesTheWheelsPriorAndGravityFromAReplayedCanLog) {
+  config::Config c = test::wheel_config(test::straight_drive_log(3.0, "scan-odometry", true));
+  test::add_accelerometer(c);
+  OnReplayedCan replay(c);
+  const MotionAidCounts& counts = replay.run(1'000'500'000'000, 10);
+  // The first scan has no previous one to take the wheels' motion from; every
+  // scan has the accelerometer's readings over its sweep.
+  EXPECT_EQ(counts.wheel_priors, 9U);
+  EXPECT_EQ(counts.scans_without_wheels, 0U);
+  EXPECT_EQ(counts.gravity_priors, 10U);
+  EXPECT_EQ(counts.scans_without_gravity, 0U);
+}
+
+TEST(ScanOdometry, CountsScansTheCanLogDoesNotCover) {
+  OnReplayedCan replay(test::wheel_config(test::straight_drive_log(1.0, "scan-odometry-short")));
+  // The log covers 1000-1001 s; these scans lie after it.
+  const MotionAidCounts& counts = replay.run(1'005'000'000'000, 3);
+  EXPECT_EQ(counts.wheel_priors, 0U);
+  EXPECT_EQ(counts.scans_without_wheels, 2U);
+}
+
+}  // namespace
+}  // namespace adit::daemon
