@@ -5,42 +5,24 @@
 #
 # One drive is not enough to judge a change: its figure moves by 10-40 points
 # with a tenth of a degree of tilt, and a change that helps one seed can cost
-# another as much (docs/ODOMETRY.md, session 7). Judge on the set.
+# another as much (docs/decisions/014-judge-map-on-twelve-drives.md). Judge on the set.
 #
 # Usage: scripts/bench-map.sh [DRIVE ...]
 #   DRIVE = scene:platform:seconds:seed, e.g. mine:robot:60:3 (adit sim's options);
-#   without arguments, the set of docs/ODOMETRY.md (12 drives, about 3 minutes on 2 cores).
+#   without arguments, the twelve drives of docs/decisions/014-judge-map-on-twelve-drives.md (about 3 minutes on 2 cores).
 # Sessions are made once under build/sessions/bench-map/; each run's files go to build/bench-map/.
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds those folders (default: build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=$(realpath "${ADIT_BUILD_DIR:-build}")
-
-drives=("$@")
-if [ ${#drives[@]} -eq 0 ]; then
-  drives=(mine:robot:12:7 mine:robot:60:1 mine:robot:60:2 mine:robot:60:3 mine:robot:60:4 mine:robot:60:5
-          mine:robot:60:6 mine:robot:60:7 mine:robot:120:11 drift:robot:150:1 drift:robot:90:2 drift:robot:90:3)
-fi
-
-sessions=$build/sessions/bench-map
-runs=$build/bench-map
-mkdir -p "$sessions" "$runs"
+source scripts/sim-sessions.sh
+use_drives bench-map "$@"
 sum=0
 worst=100
 count=0
 printf '%-24s %10s %10s\n' drive points within-5cm
 for drive in "${drives[@]}"; do
-  IFS=: read -r scene platform seconds seed <<< "$drive"
-  if [ -z "$seed" ]; then
-    echo "bench-map: $drive: expected scene:platform:seconds:seed" >&2
-    exit 2
-  fi
-  name="$scene-$platform-$seconds-s$seed"
-  session="$sessions/$name"
-  if [ ! -f "$session/lidar.pcap" ]; then
-    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor VLP-16 --duration "$seconds" --seed "$seed" \
-      --out "$session" > "$runs/$name-sim.log" 2>&1 || { echo "bench-map: $drive: adit sim failed ($runs/$name-sim.log)" >&2; exit 1; }
-  fi
+  session=$(sim_session "$drive" "$runs") || exit $?
+  name=$(basename "$session")
   work="$runs/$name"
   rm -rf "$work"
   mkdir -p "$work"

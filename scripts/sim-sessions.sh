@@ -1,0 +1,39 @@
+# Sourced by the benchmark scripts from the project's root: the build tree,
+# the set of simulated drives they judge a change on, and the session of
+# each, simulated once and reused.
+#   DRIVE = scene:platform:seconds:seed, e.g. mine:robot:60:3 (adit sim's options)
+# ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds the sessions (default: build).
+build=$(realpath "${ADIT_BUILD_DIR:-build}")
+
+# The twelve drives of docs/decisions/014-judge-map-on-twelve-drives.md.
+default_drives=(mine:robot:12:7 mine:robot:60:1 mine:robot:60:2 mine:robot:60:3 mine:robot:60:4 mine:robot:60:5
+                mine:robot:60:6 mine:robot:60:7 mine:robot:120:11 drift:robot:150:1 drift:robot:90:2 drift:robot:90:3)
+
+# use_drives RUNS_NAME [DRIVE ...]: sets `drives` to the drives given, or the
+# twelve, and `runs` to the folder $build/RUNS_NAME for the runs' files.
+use_drives() {
+  runs=$build/$1
+  mkdir -p "$runs"
+  shift
+  drives=("$@")
+  [ ${#drives[@]} -gt 0 ] || drives=("${default_drives[@]}")
+}
+
+# sim_session DRIVE LOG_DIR: prints the session folder, simulating it first
+# when it is not there yet (the log goes to LOG_DIR/NAME-sim.log).
+sim_session() {
+  local scene platform seconds seed name session
+  IFS=: read -r scene platform seconds seed <<< "$1"
+  if [ -z "$seed" ]; then
+    echo "$1: expected scene:platform:seconds:seed" >&2
+    return 2
+  fi
+  name="$scene-$platform-$seconds-s$seed"
+  session="$build/sessions/bench-map/$name"
+  if [ ! -f "$session/lidar.pcap" ]; then
+    mkdir -p "$2"
+    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor VLP-16 --duration "$seconds" --seed "$seed" \
+      --out "$session" > "$2/$name-sim.log" 2>&1 || { echo "$1: adit sim failed ($2/$name-sim.log)" >&2; return 1; }
+  fi
+  echo "$session"
+}
