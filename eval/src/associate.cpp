@@ -8,9 +8,9 @@ namespace {
 // For each stamp of `sparse` (shifted), the nearest stamp of `dense`: two
 // pointers, both lists sorted. When two sparse stamps pick the same dense one
 // the closer keeps it. Returns (index in sparse, index in dense).
-std::vector<slam::IndexPair> nearest(std::span<const double> sparse, std::span<const double> dense, double sparse_shift,
+std::vector<IndexPair> nearest(std::span<const double> sparse, std::span<const double> dense, double sparse_shift,
                                double max_difference) {
-  std::vector<slam::IndexPair> out;
+  std::vector<IndexPair> out;
   if (dense.empty()) return out;
   out.reserve(sparse.size());
   const auto gap = [&](std::size_t i, std::size_t j) { return std::abs(dense[j] - (sparse[i] + sparse_shift)); };
@@ -29,10 +29,10 @@ std::vector<slam::IndexPair> nearest(std::span<const double> sparse, std::span<c
 
 }  // namespace
 
-std::vector<slam::IndexPair> associate(std::span<const double> ref_stamps, std::span<const double> est_stamps,
+std::vector<IndexPair> associate(std::span<const double> ref_stamps, std::span<const double> est_stamps,
                                  double max_difference, double offset) {
   if (ref_stamps.size() >= est_stamps.size()) {
-    std::vector<slam::IndexPair> pairs = nearest(est_stamps, ref_stamps, offset, max_difference);
+    std::vector<IndexPair> pairs = nearest(est_stamps, ref_stamps, offset, max_difference);
     for (auto& [a, b] : pairs) std::swap(a, b);
     return pairs;
   }

@@ -1,5 +1,7 @@
 #include "adit/eval/endpoint.hpp"
 
+#include "adit/eval/path.hpp"
+
 namespace adit::eval {
 
 EndpointDrift endpoint_drift(std::span<const slam::Pose> poses, const Eigen::Vector3d& true_delta) {
@@ -9,7 +11,7 @@ EndpointDrift endpoint_drift(std::span<const slam::Pose> poses, const Eigen::Vec
   out.estimated_delta = poses.back().translation() - poses.front().translation();
   out.error = true_delta - out.estimated_delta;
   out.drift = out.error.norm();
-  out.length = slam::path_length(poses);
+  out.length = path_length(poses);
   out.rate = out.length > 0.0 ? out.drift / out.length : 0.0;
   return out;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "adit/eval/path.hpp"
 #include "adit/eval/pose_error.hpp"
 
 namespace adit::eval {
@@ -18,7 +19,7 @@ double devkit_rotation_error(const Eigen::Matrix3d& r) {
 
 std::optional<KittiDrift> kitti_drift(std::span<const slam::Pose> ref, std::span<const slam::Pose> est) {
   const std::size_t n = std::min(ref.size(), est.size());
-  const std::vector<double> dist = slam::path_distances(ref.first(n));
+  const std::vector<double> dist = path_distances(ref.first(n));
   KittiDrift out;
   for (std::size_t k = 0; k < kKittiLengths.size(); ++k) out.by_length[k].length = kKittiLengths[k];
 

@@ -10,8 +10,8 @@ namespace {
 
 // For every i, the j > i whose values[j] - values[i] is closest to delta,
 // kept when within tolerance. `values` is non-decreasing (path or time).
-std::vector<slam::IndexPair> all_pairs_by_value(std::span<const double> values, double delta, double tolerance) {
-  std::vector<slam::IndexPair> pairs;
+std::vector<IndexPair> all_pairs_by_value(std::span<const double> values, double delta, double tolerance) {
+  std::vector<IndexPair> pairs;
   pairs.reserve(values.size());
   for (std::size_t i = 0; i + 1 < values.size(); ++i) {
     const double target = values[i] + delta;
@@ -36,8 +36,8 @@ std::vector<slam::IndexPair> all_pairs_by_value(std::span<const double> values, 
   return pairs;
 }
 
-std::vector<slam::IndexPair> chain(const std::vector<std::size_t>& ids) {
-  std::vector<slam::IndexPair> pairs;
+std::vector<IndexPair> chain(const std::vector<std::size_t>& ids) {
+  std::vector<IndexPair> pairs;
   for (std::size_t k = 1; k < ids.size(); ++k) pairs.emplace_back(ids[k - 1], ids[k]);
   return pairs;
 }
@@ -60,11 +60,11 @@ std::string_view delta_unit_name(DeltaUnit unit) {
   return "?";
 }
 
-std::vector<slam::IndexPair> rpe_pairs(std::span<const double> distances, std::span<const double> stamps,
+std::vector<IndexPair> rpe_pairs(std::span<const double> distances, std::span<const double> stamps,
                                  const RpeSettings& settings) {
   const double delta = settings.delta;
   const std::size_t n = distances.size();
-  std::vector<slam::IndexPair> pairs;
+  std::vector<IndexPair> pairs;
   if (!(delta > 0.0) || n < 2) return pairs;
 
   if (settings.unit == DeltaUnit::frames) {
@@ -92,8 +92,8 @@ std::vector<slam::IndexPair> rpe_pairs(std::span<const double> distances, std::s
   return chain(ids);
 }
 
-std::vector<slam::IndexPair> rpe_pairs_all_naive(std::span<const double> values, double delta, double tolerance) {
-  std::vector<slam::IndexPair> pairs;
+std::vector<IndexPair> rpe_pairs_all_naive(std::span<const double> values, double delta, double tolerance) {
+  std::vector<IndexPair> pairs;
   for (std::size_t i = 0; i + 1 < values.size(); ++i) {
     std::size_t best = values.size();
     double best_residual = 0.0;
@@ -110,7 +110,7 @@ std::vector<slam::IndexPair> rpe_pairs_all_naive(std::span<const double> values,
 }
 
 PoseErrors relative_pose_errors(std::span<const slam::Pose> ref, std::span<const slam::Pose> est,
-                                std::span<const slam::IndexPair> pairs) {
+                                std::span<const IndexPair> pairs) {
   PoseErrors out;
   out.translation.reserve(pairs.size());
   out.rotation_deg.reserve(pairs.size());

@@ -12,6 +12,7 @@
 #include "adit/eval/ape.hpp"
 #include "adit/eval/associate.hpp"
 #include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/path.hpp"
 #include "adit/eval/rpe.hpp"
 #include "adit/eval/stats.hpp"
 #include "adit/eval/trajectory_io.hpp"

@@ -9,7 +9,6 @@ namespace adit::eval {
 namespace {
 using slam::Pose;
 using slam::Trajectory;
-using slam::IndexPair;
 
 TEST(Associate, HundredHertzAgainstThirtyHertz) {
   std::vector<double> ref, est;

@@ -72,14 +72,14 @@ TEST_F(Kitti00, ApeTranslationAfterSe3AlignmentMatchesReference) {
 
 TEST_F(Kitti00, RpeTranslation10mConsecutiveMatchesReference) {
   const RpeSettings settings{10.0, DeltaUnit::metres, false};
-  const auto pairs = rpe_pairs(slam::path_distances(est.poses), est.stamps, settings);
+  const auto pairs = rpe_pairs(path_distances(est.poses), est.stamps, settings);
   const PoseErrors errors = relative_pose_errors(ref.poses, est.poses, pairs);
   expect_stats_match(compute_stats(errors.translation), reference_stats(dir, "RPE, translation"));
 }
 
 TEST_F(Kitti00, RpeRotation100mConsecutiveMatchesReference) {
   const RpeSettings settings{100.0, DeltaUnit::metres, false};
-  const auto pairs = rpe_pairs(slam::path_distances(est.poses), est.stamps, settings);
+  const auto pairs = rpe_pairs(path_distances(est.poses), est.stamps, settings);
   const PoseErrors errors = relative_pose_errors(ref.poses, est.poses, pairs);
   expect_stats_match(compute_stats(errors.rotation_deg), reference_stats(dir, "RPE, rotation angle"));
 }

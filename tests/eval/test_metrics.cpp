@@ -17,7 +17,6 @@ namespace adit::eval {
 namespace {
 using slam::Pose;
 using slam::Trajectory;
-using slam::IndexPair;
 
 Pose at(double x, double y, double z, double yaw = 0.0) {
   Pose p = Pose::Identity();

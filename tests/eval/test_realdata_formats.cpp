@@ -14,7 +14,6 @@ namespace adit::eval {
 namespace {
 using slam::Pose;
 using slam::Trajectory;
-using slam::IndexPair;
 
 TEST(AssociateRealData, TumFr1XyzGroundTruthAt100HzAgainstEstimateAt30Hz) {
   ADIT_REQUIRE_SHARED_DATA(dir, "trajectories/tum-fr1-xyz");

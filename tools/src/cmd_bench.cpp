@@ -20,6 +20,7 @@
 #include "adit/eval/ape.hpp"
 #include "adit/eval/associate.hpp"
 #include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/path.hpp"
 #include "adit/eval/stats.hpp"
 #include "adit/eval/trajectory_io.hpp"
 #include "adit/slam/odometry.hpp"
@@ -82,7 +83,7 @@ void print_drift(const std::string& label, const slam::Trajectory& truth, const 
                kitti->translation_percent, kitti->rotation_deg_per_100m, kitti->segments);
     return;
   }
-  const double length = slam::path_length(a.ref);
+  const double length = eval::path_length(a.ref);
   const Eigen::Isometry3d ref_delta = a.ref.front().inverse() * a.ref.back();
   const Eigen::Isometry3d est_delta = a.est.front().inverse() * a.est.back();
   const double error = (ref_delta.inverse() * est_delta).translation().norm();

@@ -11,6 +11,7 @@
 #include "adit/eval/ape.hpp"
 #include "adit/eval/associate.hpp"
 #include "adit/eval/kitti_drift.hpp"
+#include "adit/eval/path.hpp"
 #include "adit/eval/pose_error.hpp"
 #include "adit/eval/rpe.hpp"
 #include "adit/eval/trajectory_io.hpp"

@@ -4,6 +4,7 @@
 #include <span>
 #include <vector>
 
+#include "adit/eval/path.hpp"
 #include "adit/slam/trajectory.hpp"
 
 namespace adit::eval {
@@ -12,7 +13,7 @@ namespace adit::eval {
 // Every stamp of the sparser trajectory is matched to its nearest stamp in the
 // denser one, so each pose is used at most once and pairs are increasing in
 // both indices. Both stamp lists must be non-decreasing. O(n + m).
-std::vector<slam::IndexPair> associate(std::span<const double> ref_stamps, std::span<const double> est_stamps,
+std::vector<IndexPair> associate(std::span<const double> ref_stamps, std::span<const double> est_stamps,
                                  double max_difference, double offset = 0.0);
 
 // The associated poses of both trajectories, in pair order.
@@ -20,7 +21,7 @@ struct Associated {
   std::vector<double> stamps;  // the reference's
   std::vector<slam::Pose> ref;
   std::vector<slam::Pose> est;
-  std::vector<slam::IndexPair> pairs;  // indices into the original trajectories
+  std::vector<IndexPair> pairs;  // indices into the original trajectories
 };
 
 // Timed trajectories are matched by associate(); untimed ones (KITTI without

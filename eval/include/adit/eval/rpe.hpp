@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "adit/eval/path.hpp"
 #include "adit/eval/pose_error.hpp"
 #include "adit/slam/trajectory.hpp"
 
@@ -41,13 +42,13 @@ struct RpeSettings {
 //   seconds  0, then each first pose at least delta seconds after the previous
 // All pairs: (i, j) with j the pose whose path length / time from i is
 // closest to delta (binary search on the prefix sums).
-std::vector<slam::IndexPair> rpe_pairs(std::span<const double> distances, std::span<const double> stamps,
+std::vector<IndexPair> rpe_pairs(std::span<const double> distances, std::span<const double> stamps,
                                  const RpeSettings& settings);
 
 // The same all-pairs result by a linear scan from every pose: O(n^2), the
 // baseline the benchmark compares against.
-std::vector<slam::IndexPair> rpe_pairs_all_naive(std::span<const double> values, double delta, double tolerance);
+std::vector<IndexPair> rpe_pairs_all_naive(std::span<const double> values, double delta, double tolerance);
 
-PoseErrors relative_pose_errors(std::span<const slam::Pose> ref, std::span<const slam::Pose> est, std::span<const slam::IndexPair> pairs);
+PoseErrors relative_pose_errors(std::span<const slam::Pose> ref, std::span<const slam::Pose> est, std::span<const IndexPair> pairs);
 
 }  // namespace adit::eval

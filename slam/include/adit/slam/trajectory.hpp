@@ -3,8 +3,6 @@
 // Evaluation, odometry output and file readers all share this value type.
 
 #include <cstddef>
-#include <span>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -30,14 +28,5 @@ struct Trajectory {
     poses.push_back(pose);
   }
 };
-
-// Indices of two poses: (i, j) in one trajectory, or matched across two.
-using IndexPair = std::pair<std::size_t, std::size_t>;
-
-// Cumulative path length: out[0] = 0, out[i] = sum_{k<i} |p_{k+1} - p_k|.
-std::vector<double> path_distances(std::span<const Pose> poses);
-
-// Total length of the path through the positions.
-double path_length(std::span<const Pose> poses);
 
 }  // namespace adit::slam
