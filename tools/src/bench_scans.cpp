@@ -1,5 +1,7 @@
 #include "bench_scans.hpp"
 
+#include <algorithm>
+
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/registry.hpp"
@@ -25,10 +27,13 @@ BenchScan to_bench_scan(const drivers::LidarScan& scan, bool timed) {
 std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
   std::vector<BenchScan> scans;
   const auto full = [&] { return input.max_scans > 0 && scans.size() >= input.max_scans; };
+  std::size_t seen = 0;
+  const auto kept = [&] { return seen++ % std::max<std::size_t>(input.every, 1) == 0; };
   if (!input.scans_dir.empty()) {
     drivers::ScanDirectorySource source(input.scans_dir);
     drivers::LidarScan scan;
-    while (!full() && source.next(scan)) scans.push_back(to_bench_scan(scan, false));
+    while (!full() && source.next(scan))
+      if (kept()) scans.push_back(to_bench_scan(scan, false));
     return scans;
   }
   const drivers::LidarFamily* family = drivers::lidar_family_of_model(input.model);
@@ -36,7 +41,7 @@ std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
   const auto decoder = family->make_decoder(input.model, input.calibration);
   drivers::ScanAssembler assembler(drivers::assembler_config_for(*decoder, 0, 0.0F));
   drivers::DecodeStream stream(*decoder, assembler, [&](drivers::LidarScan& scan) {
-    if (!full() && scan.stats.complete) scans.push_back(to_bench_scan(scan, true));
+    if (!full() && scan.stats.complete && kept()) scans.push_back(to_bench_scan(scan, true));
   });
   drivers::PcapReader reader(input.pcap);
   drivers::UdpDatagram d;

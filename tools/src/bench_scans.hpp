@@ -26,6 +26,7 @@ struct BenchInput {
   std::string model;
   std::string calibration;
   std::size_t max_scans = 0;  // 0 = all
+  std::size_t every = 1;      // keep one scan in this many (the first, then every Nth): larger steps between scans
 };
 
 std::vector<BenchScan> load_bench_scans(const BenchInput& input);

@@ -227,6 +227,8 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--model", o->input.model, "LiDAR model of the capture (VLP-16, PandarXT32, ...)");
   odometry->add_option("--calibration", o->input.calibration, "Calibration or metadata file of the capture");
   odometry->add_option("--max-scans", o->input.max_scans, "Use at most this many scans (0 = all)");
+  odometry->add_option("--every", o->input.every, "Keep one scan in this many (larger steps between scans)")
+      ->check(CLI::PositiveNumber);
   odometry->add_option("--truth", o->truth, "Ground-truth trajectory (TUM) for drift");
   odometry->add_option("--out", o->out, "Write adit's trajectory (TUM) here");
   odometry->add_option("--baseline-out", o->baseline_out, "Write the baseline's trajectory (TUM) here");
