@@ -195,15 +195,21 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // clearly more of the scan wins (as a slipped wheel is overruled above;
   // docs/decisions/012-start-search.md).
   if (!wheel && !velocity_known_ && dt > 0.0) {
-    static constexpr std::array<std::array<double, 2>, 8> kStartOffsets{
-        {{0.5, 0.0}, {-0.5, 0.0}, {1.0, 0.0}, {-1.0, 0.0}, {0.0, 0.5}, {0.0, -0.5}, {0.0, 1.0}, {0.0, -1.0}}};
-    for (const auto& offset : kStartOffsets) {
-      PosePrior start = constant_velocity;
-      start.mean = constant_velocity.mean * Eigen::Translation3d(offset[0], offset[1], 0.0);
-      SweepMotion moving = sweep;
-      moving.velocity.head<3>() += Eigen::Vector3d(offset[0], offset[1], 0.0) / dt;
-      const RegistrationResult alternative = register_from(start, moving);
-      if (explains_clearly_more(alternative)) result.registration = alternative;
+    // Offsets every start_search_step_m up to the distance max_start_speed_mps
+    // covers in dt, nearest first, along each of the four directions.
+    const double reach = config_.max_start_speed_mps * dt;
+    const auto steps = static_cast<int>(std::floor(reach / config_.start_search_step_m + 1e-9));
+    for (int k = 1; k <= steps; ++k) {
+      const double d = k * config_.start_search_step_m;
+      for (const Eigen::Vector2d& offset : {Eigen::Vector2d(d, 0.0), Eigen::Vector2d(-d, 0.0), Eigen::Vector2d(0.0, d),
+                                            Eigen::Vector2d(0.0, -d)}) {
+        PosePrior start = constant_velocity;
+        start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);
+        SweepMotion moving = sweep;
+        moving.velocity.head<2>() += offset / dt;
+        const RegistrationResult alternative = register_from(start, moving);
+        if (explains_clearly_more(alternative)) result.registration = alternative;
+      }
     }
   }
   velocity_known_ = true;

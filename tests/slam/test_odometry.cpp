@@ -131,6 +131,25 @@ TEST(Odometry, ASensorAlreadyMovingAtTheStartIsTrackedFromTheFirstScans) {
   }
 }
 
+// The same car seen one scan in three or four (0.3 or 0.4 s apart, 2.1 or
+// 2.8 m per scan, a decimated or dropping stream): the start search reaches
+// as far as max_start_speed_mps covers between the two scans.
+TEST(Odometry, ASensorAlreadyMovingIsFoundWhenItsScansArriveFarApart) {
+  const auto room = test::room(300000, 31, 14.0F, 5.0F, 2.5F);
+  for (const int every : {3, 4}) {
+    OdometryConfig config;
+    config.max_range_m = 30.0F;
+    Odometry odometry(config);
+    for (int k = 0; k < 7; ++k) {
+      const double x = 0.7 * every * k;
+      const auto scan = observe(room, planar_pose(-9.0 + x, 0.0, 0.0), 20000, 900 + static_cast<unsigned>(k));
+      const OdometryResult r = odometry.process({static_cast<std::int64_t>(k) * every * 100'000'000, scan, {}});
+      ASSERT_TRUE(r.valid) << "one scan in " << every << ", scan " << k;
+      EXPECT_NEAR(r.pose.translation().x(), x, 0.05) << "one scan in " << every << ", scan " << k;
+    }
+  }
+}
+
 // A spinning sensor sees each azimuth at one instant of its sweep: here a
 // sweep of 0.1 s turns once, and a point's time follows its azimuth.
 std::vector<Eigen::Vector3f> spin_observe(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& start,

@@ -62,6 +62,11 @@ struct OdometryConfig {
   std::size_t min_registration_points = 100;
   double initial_threshold_m = 2.0;
   double min_motion_m = 0.1;
+  // Without a known velocity the registration also starts from offsets along
+  // the body's x and y, every start_search_step_m up to what
+  // max_start_speed_mps covers between the two scans (decision 012).
+  double max_start_speed_mps = 10.0;
+  double start_search_step_m = 0.5;
   double max_scan_gap_s = 1.0;           // a longer gap forgets the velocity
   // The constant-velocity prediction's standard deviation per scan, used as a
   // weak prior so that degenerate directions stay anchored to the prediction.
