@@ -40,6 +40,12 @@ TEST(CanFeed, AReplayedLogLongerThanTheHistoryStillCoversEveryScan) {
     if (prior && std::abs(prior->delta.translation().x() - (t - previous)) < 1e-6) ++covered;
     previous = t;
   }
+  // The log runs 0.1 s past the last scan: let the feed read it to its end
+  // before stopping it (stop() ends the thread wherever it is).
+  for (int i = 0; i < 5000 && !feed.finished(); ++i) {
+    feed.drain_into(history, 1e9);
+    std::this_thread::sleep_for(1ms);
+  }
   feed.stop();
   EXPECT_EQ(covered, scans);
   EXPECT_EQ(feed.stats().samples.load(), 20001U);  // one per frame, the first (the baseline) included
