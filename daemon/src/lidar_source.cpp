@@ -39,8 +39,7 @@ struct Packet {
 struct LidarSource::Impl {
   Impl(const config::Config& c, double speed, Overflow overflow, PipelineStats& s, const std::atomic<bool>& stop_flag,
        const std::atomic<bool>& end_flag)
-      : config(c),
-        stats(s),
+      : stats(s),
         stop(stop_flag),
         end(end_flag),
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
@@ -176,7 +175,6 @@ struct LidarSource::Impl {
     scans->close();
   }
 
-  config::Config config;
   PipelineStats& stats;
   const std::atomic<bool>& stop;
   const std::atomic<bool>& end;

@@ -12,14 +12,9 @@
 // do. After start-up no stage before mapping allocates per packet or per scan
 // (the map grows by nature).
 
-#include <atomic>
-#include <functional>
-#include <span>
-#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "adit/config/config.hpp"
