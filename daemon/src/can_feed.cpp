@@ -186,11 +186,11 @@ void CanFeed::drain_into(slam::WheelHistory& history, double until_t, slam::ImuH
 }
 
 bool CanFeed::hand_over(const CanSample& sample) {
-  CanSample* out = nullptr;
-  while ((out = samples_.acquire()) == nullptr && !stop_.load(std::memory_order_relaxed)) {
-    beat_.beat();  // replay: the odometry thread has not caught up
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
+  // A replay waits here while the odometry thread has not caught up.
+  CanSample* out = samples_.acquire_or_wait([this] {
+    beat_.beat();
+    return !stop_.load(std::memory_order_relaxed);
+  });
   if (out == nullptr) return false;
   *out = sample;
   samples_.publish(out);
@@ -253,7 +253,6 @@ void CanFeed::run() {
   }
   stats_.dropped.store(samples_.dropped());
   samples_.close();
-  finished_.store(true, std::memory_order_release);
   beat_.finished.store(true);
 }
 

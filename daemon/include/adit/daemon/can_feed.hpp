@@ -71,7 +71,7 @@ class CanFeed {
   void drain_into(slam::WheelHistory& history, double until_t, slam::ImuHistory* imu = nullptr,
                   const std::function<bool()>& idle = {});
   // A replayed log has been read to its end and every sample handed over.
-  bool finished() const { return finished_.load(std::memory_order_acquire); }
+  bool finished() const { return samples_.closed(); }
   bool replay() const { return replay_; }
   const CanFeedStats& stats() const { return stats_; }
   const Heartbeat& heartbeat() const { return beat_; }
@@ -88,7 +88,6 @@ class CanFeed {
   CanFeedStats stats_;
   Heartbeat beat_{"can"};
   std::atomic<bool> stop_{false};
-  std::atomic<bool> finished_{false};
   std::thread thread_;
 };
 

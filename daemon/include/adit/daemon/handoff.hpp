@@ -71,6 +71,7 @@ class Handoff {
   }
   // Producer: nothing more will be published.
   void close() { closed_.store(true, std::memory_order_release); }
+  bool closed() const { return closed_.load(std::memory_order_acquire); }
 
   // Consumer: the oldest filled item, or nullptr.
   T* take() {
@@ -94,7 +95,7 @@ class Handoff {
   void release(T* item) { free_.try_push(index_of(item)); }
 
   // The producer has closed and every item it published was taken.
-  bool drained() const { return closed_.load(std::memory_order_acquire) && filled_.size() == 0; }
+  bool drained() const { return closed() && filled_.size() == 0; }
 
   std::uint64_t published() const { return published_.load(std::memory_order_relaxed); }
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
