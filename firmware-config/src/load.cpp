@@ -56,15 +56,32 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
   }
 
   if (c.imu.enabled) {
-    // The accelerometer is read by the CAN thread that integrates the wheels.
-    if (!c.can.enabled) fail("imu.enabled", "imu.enabled", "needs can.enabled: true (the accelerometer is read from CAN)");
-    if (!c.wheel_odometry.enabled)
-      fail("imu.enabled", "imu.enabled", "needs wheel_odometry.enabled: true (the wheels give the acceleration to remove)");
-    const std::pair<const char*, const std::string*> axes[] = {
-        {"imu.accel_x_signal", &c.imu.accel_x_signal}, {"imu.accel_y_signal", &c.imu.accel_y_signal},
-        {"imu.accel_z_signal", &c.imu.accel_z_signal}};
-    for (const auto& [key, name] : axes)
-      if (name->empty()) fail(key, "imu.enabled", "required when the IMU is enabled");
+    const bool gyro = !c.imu.gyro_x_signal.empty() || !c.imu.gyro_y_signal.empty() || !c.imu.gyro_z_signal.empty();
+    if (c.imu.source == ImuSource::ouster) {
+      if (!c.lidar.model.starts_with("OS"))
+        fail("imu.source", "lidar.model", "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's)");
+      if (gyro || !c.imu.accel_x_signal.empty() || !c.imu.accel_y_signal.empty() || !c.imu.accel_z_signal.empty())
+        fail("imu.source", "imu.source", "ouster reads the LiDAR's IMU packets: give no CAN signals");
+    } else {
+      // The IMU is read by the CAN thread that integrates the wheels.
+      if (!c.can.enabled) fail("imu.enabled", "imu.enabled", "needs can.enabled: true (the IMU is read from CAN)");
+      // Without a gyroscope, the wheels give the acceleration to remove from the specific force.
+      if (!gyro && !c.wheel_odometry.enabled)
+        fail("imu.enabled", "imu.enabled",
+             "an accelerometer alone needs wheel_odometry.enabled: true (the wheels give the acceleration to remove)");
+      const std::pair<const char*, const std::string*> axes[] = {
+          {"imu.accel_x_signal", &c.imu.accel_x_signal}, {"imu.accel_y_signal", &c.imu.accel_y_signal},
+          {"imu.accel_z_signal", &c.imu.accel_z_signal}};
+      for (const auto& [key, name] : axes)
+        if (name->empty()) fail(key, "imu.enabled", "required when the IMU is enabled");
+      if (gyro) {
+        const std::pair<const char*, const std::string*> gyro_axes[] = {
+            {"imu.gyro_x_signal", &c.imu.gyro_x_signal}, {"imu.gyro_y_signal", &c.imu.gyro_y_signal},
+            {"imu.gyro_z_signal", &c.imu.gyro_z_signal}};
+        for (const auto& [key, name] : gyro_axes)
+          if (name->empty()) fail(key, "imu.gyro_x_signal", "give all three gyroscope signals or none");
+      }
+    }
   }
 
   if (c.map.tile_size_m / c.map.voxel_m > 1600.0)

@@ -155,7 +155,7 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
 
   const InputError imu = parse_error(std::string(kMinimal) + "imu:\n  enabled: true\n");
   EXPECT_EQ(imu.key(), "imu.enabled");
-  EXPECT_EQ(imu.reason(), "needs can.enabled: true (the accelerometer is read from CAN)");
+  EXPECT_EQ(imu.reason(), "needs can.enabled: true (the IMU is read from CAN)");
   const std::string can_and_wheels = std::string(kMinimal) +
                                      "can:\n  enabled: true\n  source: candump\n  log: can.log\n"
                                      "wheel_odometry:\n  enabled: true\n  left_signal: l\n  right_signal: r\n";
@@ -164,6 +164,19 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(axis.key(), "imu.accel_z_signal");
   EXPECT_EQ(axis.reason(), "required when the IMU is enabled");
   EXPECT_EQ(parse_error(can_and_wheels + "imu:\n  gravity_sigma_deg: 0\n").key(), "imu.gravity_sigma_deg");
+  const std::string accel = "imu:\n  enabled: true\n  accel_x_signal: ax\n  accel_y_signal: ay\n  accel_z_signal: az\n";
+  const InputError gyro = parse_error(can_and_wheels + accel + "  gyro_x_signal: gx\n  gyro_z_signal: gz\n");
+  EXPECT_EQ(gyro.key(), "imu.gyro_y_signal");
+  EXPECT_EQ(gyro.reason(), "give all three gyroscope signals or none");
+  // An accelerometer alone needs the wheels' acceleration; with a gyroscope it does not.
+  const std::string can_only = std::string(kMinimal) + "can:\n  enabled: true\n  source: candump\n  log: can.log\n";
+  EXPECT_EQ(parse_error(can_only + accel).reason(),
+            "an accelerometer alone needs wheel_odometry.enabled: true (the wheels give the acceleration to remove)");
+  const Config inertial = parse(can_only + accel + "  gyro_x_signal: gx\n  gyro_y_signal: gy\n  gyro_z_signal: gz\n");
+  EXPECT_EQ(inertial.imu.gyro_z_signal, "gz");
+  const InputError ouster = parse_error(std::string(kMinimal) + "imu:\n  enabled: true\n  source: ouster\n");
+  EXPECT_EQ(ouster.key(), "imu.source");
+  EXPECT_EQ(ouster.reason(), "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's)");
 
   const InputError fifo = parse_error(std::string(kMinimal) + "threads:\n  odometry:\n    policy: fifo\n");
   EXPECT_EQ(fifo.key(), "threads.odometry.priority");

@@ -104,17 +104,34 @@ struct WheelOdometrySection {
   double max_slip_s = 1.0;
 };
 
-// An accelerometer on the CAN bus: gravity's direction for the odometry's
-// roll and pitch (slam/gravity.hpp). Three signals in m/s² (after the
-// signal's factor), the IMU's axes given in the body frame.
+// The IMU: an accelerometer, and a gyroscope where the unit has one. From
+// the CAN bus (three signals each, in m/s² and rad/s after the signals'
+// factors) or from the Ouster's own IMU packets (UDP port 7503 beside the
+// LiDAR's, the axes from the metadata's imu_to_sensor). An accelerometer
+// alone gives gravity's direction for roll and pitch (slam/gravity.hpp, with
+// the wheels' acceleration removed); with a gyroscope the odometry is
+// LiDAR-inertial. The noise model is the datasheet's (Allan deviation)
+// figures; the defaults are a MEMS unit's (ADIS16448, as in the EuRoC
+// datasets' calibration).
+enum class ImuSource { can, ouster };
+
 struct ImuSection {
   bool enabled = false;
-  std::string accel_x_signal;            // required when enabled: DBC "MESSAGE.SIGNAL" or inline name
+  ImuSource source = ImuSource::can;
+  std::string accel_x_signal;            // CAN: required when enabled: DBC "MESSAGE.SIGNAL" or inline name
   std::string accel_y_signal;
   std::string accel_z_signal;
-  std::array<double, 3> rpy_deg{0.0, 0.0, 0.0};  // the IMU's axes in the body frame (roll, pitch, yaw)
+  std::string gyro_x_signal;             // CAN: all three or none (an accelerometer alone)
+  std::string gyro_y_signal;
+  std::string gyro_z_signal;
+  std::array<double, 3> rpy_deg{0.0, 0.0, 0.0};     // the IMU's axes in the body frame (roll, pitch, yaw)
+  std::array<double, 3> position_m{0.0, 0.0, 0.0};  // the IMU's origin in the body frame (lever arm)
   double time_offset_s = 0.0;            // IMU clock minus LiDAR clock
   double gravity_sigma_deg = 0.2;        // the odometry's trust in the measured up, per scan
+  double gyro_noise_density = 1.7e-4;    // rad/s/√Hz
+  double accel_noise_density = 2.0e-3;   // m/s²/√Hz
+  double gyro_bias_walk = 1.9e-5;        // rad/s²/√Hz
+  double accel_bias_walk = 3.0e-3;       // m/s³/√Hz
 };
 
 // A GPIO line: by offset on the chip, or by its name (one of them).

@@ -57,6 +57,8 @@ inline constexpr std::array<std::pair<std::string_view, ByteOrder>, 2> kByteOrde
     {"intel", ByteOrder::intel}, {"motorola", ByteOrder::motorola}}};
 inline constexpr std::array<std::pair<std::string_view, ValueType>, 3> kValueTypes{{
     {"unsigned", ValueType::unsigned_int}, {"signed", ValueType::signed_int}, {"ieee_float", ValueType::ieee_float}}};
+inline constexpr std::array<std::pair<std::string_view, ImuSource>, 2> kImuSources{{
+    {"can", ImuSource::can}, {"ouster", ImuSource::ouster}}};
 inline constexpr std::array<std::pair<std::string_view, DriveModel>, 2> kDriveModels{{
     {"differential", DriveModel::differential}, {"skid_steer", DriveModel::skid_steer}}};
 inline constexpr std::array<std::pair<std::string_view, WheelQuantity>, 3> kWheelQuantities{{
@@ -149,12 +151,21 @@ void describe(V& v, WheelOdometrySection& s) {
 template <typename V>
 void describe(V& v, ImuSection& s) {
   v.optional("enabled", s.enabled);
+  v.optional("source", s.source, Names<ImuSource>{kImuSources});
   v.optional("accel_x_signal", s.accel_x_signal);
   v.optional("accel_y_signal", s.accel_y_signal);
   v.optional("accel_z_signal", s.accel_z_signal);
+  v.optional("gyro_x_signal", s.gyro_x_signal);
+  v.optional("gyro_y_signal", s.gyro_y_signal);
+  v.optional("gyro_z_signal", s.gyro_z_signal);
   v.optional("rpy_deg", s.rpy_deg, Range<double>{-360.0, 360.0});
+  v.optional("position_m", s.position_m, Range<double>{-10.0, 10.0});
   v.optional("time_offset_s", s.time_offset_s, Range<double>{-10.0, 10.0});
   v.optional("gravity_sigma_deg", s.gravity_sigma_deg, Range<double>{0.01, 10.0});
+  v.optional("gyro_noise_density", s.gyro_noise_density, Range<double>{1e-6, 1.0});
+  v.optional("accel_noise_density", s.accel_noise_density, Range<double>{1e-6, 10.0});
+  v.optional("gyro_bias_walk", s.gyro_bias_walk, Range<double>{0.0, 1.0});
+  v.optional("accel_bias_walk", s.accel_bias_walk, Range<double>{0.0, 10.0});
 }
 
 template <typename V>
