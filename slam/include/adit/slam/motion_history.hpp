@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "adit/slam/imu_sample.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/pose2.hpp"
 
@@ -22,16 +23,6 @@ struct WheelSample {
   double t = 0.0;         // s, on the LiDAR clock (wheel_odometry.time_offset_s removed)
   Pose2 pose;             // integrated body pose
   double distance = 0.0;  // m travelled so far
-};
-
-// One IMU reading in the body frame (the mounting applied): the
-// accelerometer's specific force, m/s², and, from a unit with a gyroscope,
-// the angular rate, rad/s.
-struct ImuSample {
-  double t = 0.0;  // s, on the LiDAR clock (imu.time_offset_s removed)
-  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_rate = Eigen::Vector3d::Zero();
-  bool has_gyro = false;  // an accelerometer alone leaves angular_rate zero
 };
 
 // Samples of one kind (with a time `t`): fixed capacity, the oldest dropped,
