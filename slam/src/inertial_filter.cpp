@@ -1,0 +1,184 @@
+#include "adit/slam/inertial_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace adit::slam {
+namespace {
+
+// Error-state blocks (see the header).
+constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12, kG = 15;
+
+struct Reading {
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+};
+
+// The samples at `tau`: linear between the two around it, the nearest held
+// beyond the ends. `j` walks forward with tau (samples[j].t <= tau).
+Reading reading_at(std::span<const ImuSample> samples, std::size_t& j, double tau) {
+  while (j + 1 < samples.size() && samples[j + 1].t <= tau) ++j;
+  const ImuSample& a = samples[j];
+  if (tau <= a.t || j + 1 == samples.size()) return {a.angular_rate, a.specific_force};
+  const ImuSample& b = samples[j + 1];
+  const double s = (tau - a.t) / (b.t - a.t);
+  return {a.angular_rate + s * (b.angular_rate - a.angular_rate), a.specific_force + s * (b.specific_force - a.specific_force)};
+}
+
+// Whether the samples reach [t0, t1] with no gap over max_gap.
+bool covers(std::span<const ImuSample> samples, double t0, double t1, double max_gap) {
+  if (samples.empty() || samples.front().t > t0 + max_gap || samples.back().t < t1 - max_gap) return false;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    if (samples[i].t <= t0 || samples[i - 1].t >= t1) continue;
+    if (!(samples[i].t > samples[i - 1].t) || samples[i].t - samples[i - 1].t > max_gap) return false;
+  }
+  return true;
+}
+
+// Calls step(a, b, dt) for each piece of [t0, t1] between sample times.
+template <typename Step>
+void for_each_piece(std::span<const ImuSample> samples, double t0, double t1, Step&& step) {
+  std::size_t j = 0;
+  double tau = t0;
+  Reading a = reading_at(samples, j, tau);
+  while (tau < t1) {
+    double next = t1;
+    for (std::size_t k = j; k < samples.size(); ++k)
+      if (samples[k].t > tau) {
+        next = std::min(next, samples[k].t);
+        break;
+      }
+    const Reading b = reading_at(samples, j, next);
+    step(a, b, next - tau);
+    a = b;
+    tau = next;
+  }
+}
+
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle < 1e-12) return Eigen::Matrix3d::Identity() + skew(w);
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+// Specific force at the body origin from the IMU's at `r`: a point at r on
+// a rotating body accelerates by α×r + ω×(ω×r) more than the origin.
+Eigen::Vector3d at_origin(const Eigen::Vector3d& force, const Eigen::Vector3d& omega, const Eigen::Vector3d& alpha,
+                          const Eigen::Vector3d& r) {
+  return force - omega.cross(omega.cross(r)) - alpha.cross(r);
+}
+
+// One midpoint step of the nominal state; returns the bias-corrected mean
+// rate and specific force (at the body origin) used, for the covariance.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> integrate(InertialState& s, const Reading& a, const Reading& b, double dt,
+                                                      const Eigen::Vector3d& r) {
+  const Eigen::Vector3d wa = a.gyro - s.gyro_bias, wb = b.gyro - s.gyro_bias;
+  const Eigen::Vector3d alpha = dt > 0.0 ? Eigen::Vector3d((wb - wa) / dt) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d fa = at_origin(a.force, wa, alpha, r) - s.accel_bias;
+  const Eigen::Vector3d fb = at_origin(b.force, wb, alpha, r) - s.accel_bias;
+  const Eigen::Vector3d w = 0.5 * (wa + wb);
+  const Eigen::Matrix3d Ra = s.pose.linear();
+  const Eigen::Matrix3d Rb = Ra * exp_so3(w * dt);
+  const Eigen::Vector3d acceleration = 0.5 * (Ra * fa + Rb * fb) + s.gravity;
+  s.pose.translation() += s.velocity * dt + 0.5 * acceleration * dt * dt;
+  s.velocity += acceleration * dt;
+  Eigen::Quaterniond q(Rb);  // keep R orthonormal over many steps
+  s.pose.linear() = q.normalized().toRotationMatrix();
+  s.t += dt;
+  return {w, 0.5 * (fa + fb)};
+}
+
+}  // namespace
+
+InertialFilter::InertialFilter(const InertialConfig& config) : config_(config) {}
+
+void InertialFilter::reset(const InertialState& state, const Matrix6d& pose_covariance) {
+  state_ = state;
+  covariance_.setZero();
+  covariance_.topLeftCorner<6, 6>() = pose_covariance;
+  const auto set = [&](int block, double sigma) { covariance_.block<3, 3>(block, block).diagonal().setConstant(sigma * sigma); };
+  set(kV, config_.initial_velocity_sigma_mps);
+  set(kBg, config_.initial_gyro_bias_sigma_radps);
+  set(kBa, config_.initial_accel_bias_sigma_mps2);
+  set(kG, config_.initial_gravity_sigma_mps2);
+}
+
+bool InertialFilter::propagate(std::span<const ImuSample> samples, double t_end) {
+  if (!covers(samples, state_.t, t_end, config_.max_sample_gap_s)) return false;
+  const ImuNoise& n = config_.noise;
+  for_each_piece(samples, state_.t, t_end, [&](const Reading& a, const Reading& b, double dt) {
+    const Eigen::Matrix3d R = state_.pose.linear();
+    const auto [w, f] = integrate(state_, a, b, dt, config_.imu_position);
+    // Error dynamics (Solà 2017, eq. 269 with local angular error), first order in dt:
+    // δθ' = exp(−ω dt)·δθ − dt·δb_g, δp' = δp + dt·δv,
+    // δv' = δv − dt·R[f]×·δθ − dt·R·δb_a + dt·δg.
+    Matrix18d F = Matrix18d::Identity();
+    F.block<3, 3>(kTheta, kTheta) = exp_so3(-w * dt);
+    F.block<3, 3>(kTheta, kBg) = -dt * Eigen::Matrix3d::Identity();
+    F.block<3, 3>(kP, kV) = dt * Eigen::Matrix3d::Identity();
+    F.block<3, 3>(kV, kTheta) = -dt * R * skew(f);
+    F.block<3, 3>(kV, kBa) = -dt * R;
+    F.block<3, 3>(kV, kG) = dt * Eigen::Matrix3d::Identity();
+    covariance_ = F * covariance_ * F.transpose();
+    // White noise integrated over dt: density² · dt (isotropic, so R·Q·Rᵀ = Q).
+    covariance_.block<3, 3>(kTheta, kTheta).diagonal().array() += n.gyro_noise_density * n.gyro_noise_density * dt;
+    covariance_.block<3, 3>(kV, kV).diagonal().array() += n.accel_noise_density * n.accel_noise_density * dt;
+    covariance_.block<3, 3>(kBg, kBg).diagonal().array() += n.gyro_bias_walk * n.gyro_bias_walk * dt;
+    covariance_.block<3, 3>(kBa, kBa).diagonal().array() += n.accel_bias_walk * n.accel_bias_walk * dt;
+  });
+  state_.t = t_end;  // the pieces' sum, without its rounding
+  return true;
+}
+
+bool InertialFilter::predict_motion(std::span<const ImuSample> samples, double t_end,
+                                    std::vector<TimedPose>& motion) const {
+  motion.clear();
+  if (!covers(samples, state_.t, t_end, config_.max_sample_gap_s)) return false;
+  InertialState s = state_;
+  const Eigen::Isometry3d start_inverse = state_.pose.inverse();
+  motion.push_back({0.0, Eigen::Isometry3d::Identity()});
+  for_each_piece(samples, state_.t, t_end, [&](const Reading& a, const Reading& b, double dt) {
+    integrate(s, a, b, dt, config_.imu_position);
+    motion.push_back({s.t - state_.t, start_inverse * s.pose});
+  });
+  return true;
+}
+
+PosePrior InertialFilter::pose_prior() const {
+  PosePrior prior;
+  prior.mean = state_.pose;
+  // Registration's ρ is the body-frame translation: ρ = Rᵀ·δp.
+  Matrix6d M = Matrix6d::Identity();
+  M.topLeftCorner<3, 3>() = state_.pose.linear().transpose();
+  const Matrix6d pose_covariance = M * covariance_.topLeftCorner<6, 6>() * M.transpose();
+  prior.information = pose_covariance.ldlt().solve(Matrix6d::Identity());
+  if (!prior.information.allFinite()) prior.information.setZero();
+  return prior;
+}
+
+void InertialFilter::update(const Eigen::Isometry3d& pose, const Matrix6d& body_covariance) {
+  // The measured pose's error in this filter's coordinates.
+  Vector6d delta;
+  delta.head<3>() = pose.translation() - state_.pose.translation();
+  const Eigen::AngleAxisd turn(state_.pose.linear().transpose() * pose.linear());
+  delta.tail<3>() = turn.angle() * turn.axis();
+  Matrix6d M = Matrix6d::Identity();  // δp = R·ρ
+  M.topLeftCorner<3, 3>() = pose.linear();
+  const Matrix6d posterior = M * body_covariance * M.transpose();
+
+  const Matrix6d prior = covariance_.topLeftCorner<6, 6>();
+  const Eigen::Matrix<double, 18, 6> cross = covariance_.leftCols<6>();
+  const Eigen::Matrix<double, 18, 6> gain = prior.ldlt().solve(cross.transpose()).transpose();
+  if (!gain.allFinite()) return;
+  const Eigen::Matrix<double, 18, 1> dx = gain * delta;
+  covariance_ -= gain * (prior - posterior) * gain.transpose();
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+
+  state_.pose = pose;
+  state_.velocity += dx.segment<3>(kV);
+  state_.gyro_bias += dx.segment<3>(kBg);
+  state_.accel_bias += dx.segment<3>(kBa);
+  state_.gravity += dx.segment<3>(kG);
+}
+
+}  // namespace adit::slam
