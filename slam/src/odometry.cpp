@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "start_search.hpp"
+
 namespace adit::slam {
 namespace {
 
@@ -38,7 +40,12 @@ Odometry::Odometry(const OdometryConfig& config)
       map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
       downsampler_(config.max_scan_points),
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m),
-      registration_voxel_m_(config.registration_voxel_m) {
+      registration_voxel_m_(config.registration_voxel_m),
+      inertial_(config.inertial),
+      inertial_registration_(config.registration) {
+  inertial_registration_.point_sigma_m = config.inertial_point_sigma_m;
+  // An IMU at 400 Hz over a 0.2 s sweep, with room.
+  sweep_motion_.reserve(256);
   for (auto* buffer : {&deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
   for (auto* buffer : {&frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
   source_deskewed_.resize(config.max_scan_points);
@@ -92,10 +99,21 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     result.sweep_velocity = velocity;
   };
 
+  float sweep_s = 0.0F;
+  for (const float t : frame_times_) sweep_s = std::max(sweep_s, t);
+  const bool inertial = inertial_started_ && started_ && predict_inertial(scan, static_cast<double>(sweep_s));
+
   if (source_.size() < config_.min_registration_points) {
-    deskew_frame(scan_velocity);
+    // Held on the prediction: the IMU's alone when there is one (dead reckoning).
+    if (inertial) {
+      deskewed_.resize(frame_.size());
+      deskewer_.deskew(frame_, frame_times_, sweep_motion_, deskewed_);
+      result.inertial = true;
+    } else {
+      deskew_frame(scan_velocity);
+    }
     reacquire_ = true;
-    pose_ = predicted;
+    pose_ = inertial ? inertial_.state().pose : predicted;
     start_to_mid_.setIdentity();
     mid_offset_s_ = 0.0;
     last_stamp_ns_ = scan.stamp_ns;
@@ -107,7 +125,16 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
 
   if (!started_ || map_.empty()) {
     if (scan.gravity) settle_up(*scan.gravity, scan.stamp_ns);
-    deskew_frame(scan_velocity);
+    // The map starts from this scan: with an IMU, deskewed by its rotation.
+    start_inertial(scan, Matrix6d::Zero());
+    if (inertial_started_ &&
+        inertial_.predict_motion(scan.imu, 1e-9 * static_cast<double>(scan.stamp_ns) + sweep_s, sweep_motion_)) {
+      deskewed_.resize(frame_.size());
+      deskewer_.deskew(frame_, frame_times_, sweep_motion_, deskewed_);
+      result.inertial = true;
+    } else {
+      deskew_frame(scan_velocity);
+    }
     transform_into(deskewed_, pose_, registered_);
     map_.add(registered_);
     started_ = true;
@@ -116,6 +143,11 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     result.covariance = Matrix6d::Zero();  // the origin of the odometry frame, by definition
     result.status = OdometryStatus::first_scan;
     result.valid = true;
+    return result;
+  }
+
+  if (inertial) {
+    register_inertial(scan, wheel, result);
     return result;
   }
 
@@ -195,22 +227,15 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // clearly more of the scan wins (as a slipped wheel is overruled above;
   // docs/decisions/012-start-search.md).
   if (!wheel && !velocity_known_ && dt > 0.0) {
-    // Offsets every start_search_step_m up to the distance max_start_speed_mps
-    // covers in dt, nearest first, along each of the four directions.
-    const double reach = config_.max_start_speed_mps * dt;
-    const auto steps = static_cast<int>(std::floor(reach / config_.start_search_step_m + 1e-9));
-    for (int k = 1; k <= steps; ++k) {
-      const double d = k * config_.start_search_step_m;
-      for (const Eigen::Vector2d& offset : {Eigen::Vector2d(d, 0.0), Eigen::Vector2d(-d, 0.0), Eigen::Vector2d(0.0, d),
-                                            Eigen::Vector2d(0.0, -d)}) {
-        PosePrior start = constant_velocity;
-        start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);
-        SweepMotion moving = sweep;
-        moving.velocity.head<2>() += offset / dt;
-        const RegistrationResult alternative = register_from(start, moving);
-        if (explains_clearly_more(alternative)) result.registration = alternative;
-      }
-    }
+    search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m, config_.wheel_rejection_margin,
+                 [&](const Eigen::Vector2d& offset) {
+                   PosePrior start = constant_velocity;
+                   start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);
+                   SweepMotion moving = sweep;
+                   moving.velocity.head<2>() += offset / dt;
+                   return register_from(start, moving);
+                 },
+                 result.registration);
   }
   velocity_known_ = true;
   last_correspondences_ = static_cast<double>(result.registration.correspondences);
@@ -245,18 +270,26 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   if (scan.gravity) settle_up(*scan.gravity, scan.stamp_ns);
 
   deskew_frame(result.registration.sweep_velocity);
+  add_deskewed_to_map();
+
+  result.pose = pose_;
+  result.covariance = result.registration.covariance;
+  result.valid = true;
+  result.status = result.registration.degenerate ? OdometryStatus::degenerate : OdometryStatus::ok;
+  // The IMU did not cover this scan (a dropout, or it just began): the
+  // filter starts again from the scan's pose.
+  const Eigen::Isometry3d to_body = pose_.inverse();
+  start_inertial(scan, adjoint(to_body) * result.covariance * adjoint(to_body).transpose());
+  return result;
+}
+
+void Odometry::add_deskewed_to_map() {
   transform_into(deskewed_, pose_, registered_);
   map_.add(registered_);
   if ((pose_.translation() - removed_far_at_).norm() >= config_.map_removal_step_m) {
     map_.remove_far(pose_.translation().cast<float>(), config_.max_range_m);
     removed_far_at_ = pose_.translation();
   }
-
-  result.pose = pose_;
-  result.covariance = result.registration.covariance;
-  result.valid = true;
-  result.status = result.registration.degenerate ? OdometryStatus::degenerate : OdometryStatus::ok;
-  return result;
 }
 
 void Odometry::settle_up(const UpMeasurement& gravity, std::int64_t stamp_ns) {

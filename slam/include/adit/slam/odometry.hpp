@@ -19,6 +19,8 @@
 #include "adit/slam/adaptive_threshold.hpp"
 #include "adit/slam/deskew.hpp"
 #include "adit/slam/gravity.hpp"
+#include "adit/slam/imu_sample.hpp"
+#include "adit/slam/inertial_filter.hpp"
 #include "adit/slam/registration.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -102,6 +104,14 @@ struct OdometryConfig {
   // taken while moving off (docs/decisions/003-gravity-settle.md).
   double gravity_settle_s = 1.0;
   RegistrationConfig registration;
+  // With a gyroscope (ScanInput::imu), LiDAR-inertial odometry: the IMU
+  // predicts and deskews, the scan corrects (inertial_filter.hpp).
+  InertialConfig inertial;
+  // σ of one point-to-plane residual against the IMU's prediction.
+  // LiDAR-only, registration.point_sigma_m is set loose (1 m) so that the
+  // wheels keep a drift's axis; an IMU is no such prior: FAST-LIO2 weighs
+  // its points at 0.001 m² (Xu et al. 2022, its released configuration).
+  double inertial_point_sigma_m = 0.0316;
 };
 
 // Body motion since the previous scan from wheel odometry, with its
@@ -118,6 +128,10 @@ struct ScanInput {
   // Gravity's up in the body frame over the sweep (slam::measured_up), or
   // nullopt without an IMU.
   std::optional<UpMeasurement> gravity = std::nullopt;
+  // IMU readings with the gyroscope's rate (body frame, ascending), from at
+  // or before the previous scan's stamp to past this sweep's end: the
+  // odometry is then LiDAR-inertial. Empty, or not covering that: LiDAR only.
+  std::span<const ImuSample> imu = {};
 };
 
 enum class OdometryStatus : std::uint8_t {
@@ -136,7 +150,8 @@ struct OdometryResult {
   Matrix6d covariance = Matrix6d::Identity();
   OdometryStatus status = OdometryStatus::ok;
   bool valid = false;       // the pose comes from registration
-  bool wheel_rejected = false;  // the wheel prior disagreed with the scan; constant velocity was used
+  bool wheel_rejected = false;  // the wheel prior disagreed with the scan (or the IMU); it was not used
+  bool inertial = false;        // the IMU predicted and deskewed this scan
   Vector6d sweep_velocity = Vector6d::Zero();  // body twist per second over the scan, as deskewed
   RegistrationResult registration;
   std::size_t input_points = 0;
@@ -156,6 +171,9 @@ class Odometry {
   OdometryResult process(const ScanInput& scan, const std::optional<MotionPrior>& wheel = std::nullopt);
 
   const VoxelHashMap& local_map() const { return map_; }
+  // The IMU filter's state (biases, gravity, velocity), meaningful once a
+  // result had `inertial` set.
+  const InertialFilter& inertial() const { return inertial_; }
   // The last scan, deskewed, downsampled at the map resolution, in the
   // odometry frame: what mapping accumulates. Valid until the next process().
   std::span<const Eigen::Vector3f> last_registered_points() const { return registered_; }
@@ -186,6 +204,22 @@ class Odometry {
   double last_correspondences_ = 0.0;
   float registration_voxel_m_;  // this scan's, adapted from the last (see OdometryConfig)
   Eigen::Vector3d removed_far_at_ = Eigen::Vector3d::Zero();  // sensor position at the last remove_far
+  // LiDAR-inertial odometry (odometry_inertial.cpp).
+  // Whether the scan's IMU readings can carry the filter over it: then the
+  // filter is propagated to the scan and its sweep's motion predicted.
+  bool predict_inertial(const ScanInput& scan, double sweep_s);
+  // Registers the scan from the IMU's prediction (and the wheels'), updates
+  // the filter and the map.
+  void register_inertial(const ScanInput& scan, const std::optional<MotionPrior>& wheel, OdometryResult& result);
+  // (Re)starts the filter at the current pose when the scan's IMU readings
+  // allow it: gravity from their mean specific force, the velocity as known.
+  void start_inertial(const ScanInput& scan, const Matrix6d& body_covariance);
+  InertialFilter inertial_;
+  bool inertial_started_ = false;
+  std::vector<TimedPose> sweep_motion_;  // the body over this sweep, from the scan start
+  RegistrationConfig inertial_registration_;
+  // Places deskewed_ at pose_ in the map, dropping what is out of range.
+  void add_deskewed_to_map();
   // Up in the odometry frame (see OdometryConfig::gravity_settle_s): the
   // weighted sum of the measured ups placed by their poses, until settled.
   void settle_up(const UpMeasurement& gravity, std::int64_t stamp_ns);
