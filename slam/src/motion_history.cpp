@@ -54,6 +54,18 @@ std::optional<Eigen::Vector3d> WheelHistory::acceleration(double t0, double t1, 
   return Eigen::Vector3d((v1 - v0) / dt, omega * 0.5 * (v0 + v1), 0.0);
 }
 
+void ImuHistory::copy_covering(double t0, double t1, std::vector<ImuSample>& out) const {
+  out.clear();
+  const TimedRing<ImuSample>& at = samples_;
+  if (at.size() == 0) return;
+  std::size_t i = at.size() - 1;  // the last reading at or before t0 (newest first: the wanted ones are recent)
+  while (i > 0 && at[i].t > t0) --i;
+  for (; i < at.size(); ++i) {
+    out.push_back(at[i]);
+    if (at[i].t >= t1) break;
+  }
+}
+
 std::optional<Eigen::Vector3d> ImuHistory::mean(double t0, double t1, std::size_t min_samples) const {
   // The time average over [t0, t1] of the readings joined by straight lines
   // (trapezoids; the ends interpolated): a plain mean of the readings inside

@@ -40,6 +40,23 @@ TEST(ImuHistory, AveragesTheReadingsJoinedByLinesOverAnyInterval) {
   EXPECT_TRUE(history.mean(0.1, 0.115, 1).has_value());
 }
 
+TEST(ImuHistory, CopiesTheReadingsThatCoverAnInterval) {
+  ImuHistory history(16);
+  for (int k = 0; k < 20; ++k) history.push({0.01 * k, Eigen::Vector3d::Zero()});  // 0.04 .. 0.19 kept
+  std::vector<ImuSample> out;
+  out.reserve(16);
+  history.copy_covering(0.085, 0.125, out);
+  ASSERT_EQ(out.size(), 6U);  // 0.08 .. 0.13
+  EXPECT_DOUBLE_EQ(out.front().t, 0.08);
+  EXPECT_DOUBLE_EQ(out.back().t, 0.13);
+  history.copy_covering(0.0, 0.05, out);
+  ASSERT_EQ(out.size(), 2U) << "from the oldest kept";
+  EXPECT_DOUBLE_EQ(out.front().t, 0.04);
+  history.copy_covering(0.18, 0.5, out);
+  ASSERT_EQ(out.size(), 2U) << "to the newest";
+  EXPECT_DOUBLE_EQ(out.back().t, 0.19);
+}
+
 TEST(WheelHistory, GivesTheBodysAccelerationAlongAndAcrossItsHeading) {
   // Speeding up along x at 0.5 m/s² from 1 m/s: a forward acceleration, nothing sideways.
   WheelHistory straight(512);

@@ -62,6 +62,10 @@ class ImuHistory {
   // The mean specific force over [t0, t1], the readings joined by straight
   // lines; nullopt unless readings lie on both sides and `min_samples` within.
   std::optional<Eigen::Vector3d> mean(double t0, double t1, std::size_t min_samples = 3) const;
+  // The readings from the last at or before t0 to the first at or after t1
+  // (what covers [t0, t1]) into `out`, oldest first (cleared; no allocation
+  // within its capacity): the odometry's ScanInput::imu.
+  void copy_covering(double t0, double t1, std::vector<ImuSample>& out) const;
 
  private:
   TimedRing<ImuSample> samples_;
