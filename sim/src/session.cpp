@@ -259,6 +259,7 @@ SimSummary run_simulation(const SimOptions& o) {
     }
     if (can_imu) {
       const std::vector<ImuSample> samples = simulate_imu(body, imu);
+      if (samples.empty()) throw InputError("adit sim", "--duration", "too short for one IMU sample");
       ImuFrameOptions f;
       f.start_time_ns = o.start_time_ns;
       append_imu_frames(samples, f, frames);
