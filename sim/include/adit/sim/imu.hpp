@@ -19,6 +19,7 @@
 // ouster_imu_packet.hpp into Ouster IMU packets.
 
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -42,8 +43,8 @@ struct ImuNoise {
   // to measure it to a few percent. Accelerometer 1 mg: what the robot's
   // accelerometer had (a part calibrated in the payload), 0.06° of tilt per
   // axis; the map's up comes from it (decision 008).
-  double gyro_turn_on_sigma = 0.2 * 3.14159265358979323846 / 180.0;  // rad/s
-  double accel_turn_on_sigma = 0.0098;                                 // m/s²
+  double gyro_turn_on_sigma = 0.2 * std::numbers::pi / 180.0;  // rad/s
+  double accel_turn_on_sigma = 0.0098;                         // m/s²
 
   static ImuNoise none() { return {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}; }
 };
