@@ -4,32 +4,26 @@
 #include <cmath>
 
 #include "adit/sim/hash_noise.hpp"
+#include "adit/sim/imu_kinematics.hpp"
 
 namespace adit::sim {
 namespace {
 
-constexpr std::uint64_t kBiasStream = 0x496D7542ULL;
-constexpr std::uint64_t kNoiseStream = 0x496D754EULL;
-constexpr double kGravity = 9.80665;
+// Streams of the counter-based draws: index 3·k + axis for sample k.
+constexpr std::uint64_t kAccelTurnOnStream = 0x496D7542ULL;  // the robot accelerometer's constant bias, as before
+constexpr std::uint64_t kAccelNoiseStream = 0x496D754EULL;
+constexpr std::uint64_t kAccelWalkStream = 0x496D7557ULL;
+constexpr std::uint64_t kGyroTurnOnStream = 0x47797242ULL;
+constexpr std::uint64_t kGyroNoiseStream = 0x4779724EULL;
+constexpr std::uint64_t kGyroWalkStream = 0x47797257ULL;
 
-drivers::can::Frame accel_frame(std::int64_t time_us, std::uint32_t id, const Eigen::Vector3d& f, double lsb) {
-  drivers::can::Frame frame;
-  frame.time_us = time_us;
-  frame.id = id;
-  frame.length = 6;
-  frame.set_interface_name("can0");
-  for (int axis = 0; axis < 3; ++axis) {
-    const long counts = std::clamp(std::lround(f(axis) / lsb), -32768L, 32767L);
-    const auto u = static_cast<std::uint16_t>(static_cast<std::int16_t>(counts));
-    frame.data[static_cast<std::size_t>(2 * axis)] = static_cast<std::uint8_t>(u & 0xFF);
-    frame.data[static_cast<std::size_t>(2 * axis + 1)] = static_cast<std::uint8_t>(u >> 8);
-  }
-  return frame;
+Eigen::Vector3d draw3(const NoiseStream& s, std::uint64_t k) {
+  return {s.gaussian(3 * k), s.gaussian(3 * k + 1), s.gaussian(3 * k + 2)};
 }
 
 }  // namespace
 
-Eigen::Vector3d specific_force_at(const BodyTrack& body, std::size_t i) {
+Eigen::Vector3d wheeled_acceleration(const BodyTrack& body, std::size_t i) {
   const auto& s = body.samples();
   const double dt = 1.0 / BodyTrack::kRate;
   const std::size_t last = s.size() - 1;
@@ -49,27 +43,48 @@ Eigen::Vector3d specific_force_at(const BodyTrack& body, std::size_t i) {
   forward.z() = 0.0;
   forward.normalize();
   const Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(forward);
-  const Eigen::Vector3d acceleration = dv * forward + s[i].speed_mps * s[i].yaw_rate_rps * left + az * Eigen::Vector3d::UnitZ();
-  return s[i].orientation.conjugate() * (acceleration + Eigen::Vector3d(0.0, 0.0, kGravity));
+  return dv * forward + s[i].speed_mps * s[i].yaw_rate_rps * left + az * Eigen::Vector3d::UnitZ();
 }
 
-ImuTruth simulate_imu(const BodyTrack& body, const ImuOptions& o, std::vector<drivers::can::Frame>& frames) {
-  ImuTruth truth;
-  for (int axis = 0; axis < 3; ++axis)
-    truth.bias(axis) = o.bias_sigma_mps2 * gaussian(o.seed, kBiasStream, static_cast<std::uint64_t>(axis));
-  const std::size_t samples = body.samples().size();
-  if (samples < 3) return truth;
-  const auto count = static_cast<std::uint64_t>(body.duration() * o.rate_hz);
+Eigen::Vector3d specific_force_at(const BodyTrack& body, std::size_t i) {
+  return body.samples()[i].orientation.conjugate() *
+         (wheeled_acceleration(body, i) + Eigen::Vector3d(0.0, 0.0, kStandardGravity));
+}
+
+std::vector<ImuSample> simulate_imu(const BodyTrack& body, const ImuOptions& o) {
+  std::vector<ImuSample> out;
+  if (body.samples().size() < 3 || !(o.rate_hz > 0.0)) return out;
+  const double period = 1.0 / o.rate_hz;
+  const ImuNoise& n = o.noise;
+  const NoiseStream accel_noise(o.seed, kAccelNoiseStream), accel_walk(o.seed, kAccelWalkStream);
+  const NoiseStream gyro_noise(o.seed, kGyroNoiseStream), gyro_walk(o.seed, kGyroWalkStream);
+  Eigen::Vector3d accel_bias = n.accel_turn_on_sigma * draw3(NoiseStream(o.seed, kAccelTurnOnStream), 0);
+  Eigen::Vector3d gyro_bias = n.gyro_turn_on_sigma * draw3(NoiseStream(o.seed, kGyroTurnOnStream), 0);
+  // Per sample: white noise σ = density·√rate; the bias walks by walk·√period.
+  const double accel_white = n.accel_noise_density * std::sqrt(o.rate_hz);
+  const double gyro_white = n.gyro_noise_density * std::sqrt(o.rate_hz);
+  const double accel_step = n.accel_bias_walk * std::sqrt(period);
+  const double gyro_step = n.gyro_bias_walk * std::sqrt(period);
+  const auto count = static_cast<std::uint64_t>(std::floor(body.duration() * o.rate_hz + 1e-9));
+  out.reserve(count + 1);
+  const Eigen::Matrix3d axes = o.mount.linear();
   for (std::uint64_t k = 0; k <= count; ++k) {
-    const double t = static_cast<double>(k) / o.rate_hz;
-    const auto i = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(t * BodyTrack::kRate)), 1, samples - 2);
-    Eigen::Vector3d f = specific_force_at(body, i) + truth.bias;
-    for (int axis = 0; axis < 3; ++axis)
-      f(axis) += o.noise_mps2 * gaussian(o.seed, kNoiseStream, 3 * k + static_cast<std::uint64_t>(axis));
-    const std::int64_t time_us = (o.start_time_ns + std::llround((t + o.time_offset_s) * 1e9)) / 1000;
-    frames.push_back(accel_frame(time_us + 300, o.id, f, o.lsb_mps2));  // after the wheels' two PDOs
+    if (k > 0) {
+      accel_bias += accel_step * draw3(accel_walk, k);
+      gyro_bias += gyro_step * draw3(gyro_walk, k);
+    }
+    ImuSample s;
+    s.t = static_cast<double>(k) * period;
+    s.stamp = s.t + o.time_offset_s;
+    const ImuKinematics truth = imu_kinematics(body, s.t, period, o.mount, o.motion);
+    const VibrationSample shake = rotor_vibration(o.vibration, o.seed, s.t);
+    s.gyro = truth.angular_rate + axes.transpose() * shake.gyro + gyro_bias + gyro_white * draw3(gyro_noise, k);
+    s.accel = truth.specific_force + axes.transpose() * shake.accel + accel_bias + accel_white * draw3(accel_noise, k);
+    s.gyro_bias = gyro_bias;
+    s.accel_bias = accel_bias;
+    out.push_back(s);
   }
-  return truth;
+  return out;
 }
 
 }  // namespace adit::sim

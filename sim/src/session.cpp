@@ -2,12 +2,18 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <limits>
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/drivers/pcap_writer.hpp"
+#include "adit/drivers/lidar/ouster_encoder.hpp"
 #include "adit/sim/ray_caster.hpp"
 #include "adit/sim/drone_path.hpp"
+#include "adit/sim/handheld_path.hpp"
+#include "adit/sim/imu_frames.hpp"
+#include "adit/sim/ouster_imu_packet.hpp"
 #include "adit/sim/robot_path.hpp"
 #include "adit/sim/session_config.hpp"
 #include "adit/sim/spinning_lidar.hpp"
@@ -24,14 +30,28 @@ void require(bool ok, const std::string& key, const std::string& reason) {
   if (!ok) throw InputError("adit sim", key, reason);
 }
 
-// Where the sensor sits: on the robot as in the VLP-16 robot template; on top of the drone.
+// Where the sensor sits: on the robot as in the VLP-16 robot template; on top
+// of the drone; 0.10 m above the walker's hand (about 1.5 m above the floor).
 Eigen::Isometry3d sensor_extrinsics(const std::string& platform) {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.translation() = platform == "drone" ? Eigen::Vector3d(0.0, 0.0, 0.12) : Eigen::Vector3d(0.20, 0.0, 0.45);
+  e.translation() = platform == "drone"      ? Eigen::Vector3d(0.0, 0.0, 0.12)
+                    : platform == "handheld" ? Eigen::Vector3d(0.0, 0.0, 0.10)
+                                             : Eigen::Vector3d(0.20, 0.0, 0.45);
   return e;
 }
 
 bool is_drone(const SimOptions& o) { return o.platform == "drone"; }
+bool is_handheld(const SimOptions& o) { return o.platform == "handheld"; }
+bool is_ouster(const SimOptions& o) { return o.sensor.starts_with("OS"); }
+
+double min_duration_s(const SimOptions& o) {
+  return is_drone(o) ? drone_min_duration_s() : is_handheld(o) ? handheld_min_duration_s() : robot_min_duration_s();
+}
+double max_speed_mps(const SimOptions& o) {
+  return is_drone(o)      ? DronePathOptions::kMaxSpeed
+         : is_handheld(o) ? HandheldPathOptions::kMaxSpeed
+                          : RobotPathOptions::kMaxSpeed;
+}
 
 }  // namespace
 
@@ -45,18 +65,64 @@ Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extr
 
 People simulated_people(const Scene& scene, const SimOptions& o) { return make_people(scene, o.people, o.seed); }
 
+double platform_speed_mps(const SimOptions& o) {
+  if (o.speed_mps > 0.0) return o.speed_mps;
+  return is_handheld(o) ? HandheldPathOptions{}.speed_mps : 1.0;
+}
+
+SimImuSource simulated_imu_source(const SimOptions& o) {
+  if (!o.imu) return SimImuSource::none;
+  // A robot's IMU is on its CAN bus beside the wheels, whatever the LiDAR;
+  // without wheels an Ouster's own IMU is the one to read.
+  return o.platform == "robot" || !is_ouster(o) ? SimImuSource::can : SimImuSource::ouster;
+}
+
+ImuOptions simulated_imu(const SimOptions& o, SimImuSource source) {
+  ImuOptions imu;
+  imu.noise = o.imu_noise;
+  imu.motion = o.platform == "robot" ? ImuMotion::wheeled : ImuMotion::smooth;
+  imu.vibration.enabled = o.vibration == "on" || (o.vibration == "auto" && is_drone(o));
+  if (source == SimImuSource::ouster) {
+    // Inside the sensor, where the metadata's imu_to_sensor_transform puts it (mm).
+    const drivers::OusterMetadata m = drivers::ouster_os1_64_nominal_metadata();
+    Eigen::Isometry3d imu_to_sensor = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) imu_to_sensor.linear()(r, k) = m.imu_to_sensor[static_cast<std::size_t>(4 * r + k)];
+      imu_to_sensor.translation()(r) = m.imu_to_sensor[static_cast<std::size_t>(4 * r + 3)] * 1e-3;
+    }
+    imu.mount = sensor_extrinsics(o.platform) * imu_to_sensor;
+    imu.rate_hz = o.imu_rate_hz > 0.0 ? o.imu_rate_hz : 100.0;
+    imu.time_offset_s = o.imu_time_offset_s;  // the LiDAR's and the IMU's stamps come from one clock
+    imu.seed = o.seed ^ 0x4F5374496D75ULL;    // another unit than a CAN IMU's in the same session
+  } else {
+    imu.mount.translation() = o.imu_position_m;
+    imu.rate_hz = o.imu_rate_hz > 0.0 ? o.imu_rate_hz : 200.0;
+    imu.time_offset_s = o.can_offset_s + o.imu_time_offset_s;
+    imu.seed = o.seed;
+  }
+  return imu;
+}
+
 BodyTrack simulated_path(const Scene& scene, const SimOptions& o) {
+  if (is_handheld(o)) {
+    HandheldPathOptions h;
+    h.duration_s = o.duration_s;
+    h.speed_mps = platform_speed_mps(o);
+    h.lateral_offset_m = o.lateral_offset_m;
+    h.seed = o.seed;
+    return handheld_path(scene, h);
+  }
   if (is_drone(o)) {
     DronePathOptions d;
     d.duration_s = o.duration_s;
-    d.speed_mps = o.speed_mps;
+    d.speed_mps = platform_speed_mps(o);
     d.lateral_offset_m = o.lateral_offset_m;
     d.seed = o.seed;
     return drone_path(scene, d);
   }
   RobotPathOptions r;
   r.duration_s = o.duration_s;
-  r.speed_mps = o.speed_mps;
+  r.speed_mps = platform_speed_mps(o);
   r.lateral_offset_m = o.lateral_offset_m;
   r.seed = o.seed;
   return robot_path(scene, r);
@@ -65,10 +131,10 @@ BodyTrack simulated_path(const Scene& scene, const SimOptions& o) {
 void validate(const SimOptions& o) {
   require(o.scene == "mine" || o.scene == "drift" || o.scene == "building", "--scene",
           "unknown scene '" + o.scene + "' (mine, drift, building)");
-  require(o.platform == "robot" || o.platform == "drone", "--platform",
-          "unknown platform '" + o.platform + "' (robot, drone)");
+  require(o.platform == "robot" || o.platform == "drone" || o.platform == "handheld", "--platform",
+          "unknown platform '" + o.platform + "' (robot, drone, handheld)");
   const SpinningSensor sensor = make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
-  const double shortest = is_drone(o) ? drone_min_duration_s() : robot_min_duration_s();
+  const double shortest = min_duration_s(o);
   require(std::isfinite(o.duration_s) && o.duration_s >= shortest && o.duration_s <= 7200.0, "--duration",
           "must be between " + std::to_string(shortest) + " and 7200 s for the " + o.platform);
   require(!o.out.empty(), "--out", "an output folder is required");
@@ -81,15 +147,33 @@ void validate(const SimOptions& o) {
   require(sensor.fixed_rpm == 0.0 || o.rpm == sensor.fixed_rpm, "--rpm",
           "the " + sensor.model + " turns at " + std::to_string(static_cast<int>(sensor.fixed_rpm)) +
               " rpm in its simulated lidar mode");
-  const double fastest = is_drone(o) ? DronePathOptions::kMaxSpeed : RobotPathOptions::kMaxSpeed;
-  require(std::isfinite(o.speed_mps) && o.speed_mps > 0.0 && o.speed_mps <= fastest, "--speed",
-          "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s");
+  const double fastest = max_speed_mps(o);
+  require(std::isfinite(o.speed_mps) && o.speed_mps >= 0.0 && o.speed_mps <= fastest, "--speed",
+          "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s (0: its own pace)");
   require(std::isfinite(o.lateral_offset_m), "--lateral-offset-m", "must be a number");
   require(std::isfinite(o.wheel_radius_error) && std::abs(o.wheel_radius_error) <= 0.1, "--wheel-radius-error",
           "must be within ±0.1 (±10 %)");
   require(std::isfinite(o.slips_per_minute) && o.slips_per_minute >= 0.0 && o.slips_per_minute <= 60.0,
           "--slips-per-minute", "must be in [0, 60]");
   require(std::isfinite(o.can_offset_s) && std::abs(o.can_offset_s) <= 10.0, "--can-offset-s", "must be within ±10 s");
+  require(o.imu_rate_hz == 0.0 || (o.imu_rate_hz >= 100.0 && o.imu_rate_hz <= 400.0), "--imu-rate-hz",
+          "must be 0 (the source's own rate) or within [100, 400] Hz");
+  const ImuNoise& n = o.imu_noise;
+  const std::pair<const char*, double> noise[] = {
+      {"--gyro-noise-density", n.gyro_noise_density}, {"--accel-noise-density", n.accel_noise_density},
+      {"--gyro-bias-walk", n.gyro_bias_walk},         {"--accel-bias-walk", n.accel_bias_walk},
+      {"--gyro-bias-sigma", n.gyro_turn_on_sigma},    {"--imu-bias-mps2", n.accel_turn_on_sigma}};
+  for (const auto& [key, value] : noise)
+    require(std::isfinite(value) && value >= 0.0 && value < 1.0, key, "must be in [0, 1) (SI units, see --help)");
+  require(o.imu_position_m.allFinite() && o.imu_position_m.norm() <= 5.0, "--imu-position-m",
+          "the IMU must sit within 5 m of the body origin");
+  require(!(simulated_imu_source(o) == SimImuSource::ouster && !o.imu_position_m.isZero()), "--imu-position-m",
+          "the " + o.sensor + "'s IMU sits where its metadata's imu_to_sensor_transform puts it; "
+          "--imu-position-m places a CAN IMU");
+  require(std::isfinite(o.imu_time_offset_s) && std::abs(o.imu_time_offset_s) <= 1.0, "--imu-time-offset-s",
+          "must be within ±1 s");
+  require(o.vibration == "auto" || o.vibration == "on" || o.vibration == "off", "--vibration",
+          "unknown value '" + o.vibration + "' (auto, on, off)");
   require(o.targets >= 0 && o.targets <= 50, "--targets", "must be in [0, 50]");
   require(o.people >= 0 && o.people <= 100, "--people", "must be in [0, 100]");
   require(o.threads >= 1 && o.threads <= 64, "--threads", "must be in [1, 64]");
@@ -131,9 +215,31 @@ SimSummary run_simulation(const SimOptions& o) {
   lidar.start_time_ns = o.start_time_ns;
   lidar.extrinsics = sensor_extrinsics(o.platform);
   lidar.threads = o.threads;
+  const SimImuSource imu_source = simulated_imu_source(o);
+  // An Ouster sends its IMU's packets beside the LiDAR's (to port 7503, from
+  // the same address), merged into the pcap in capture order.
+  const bool ouster_imu = o.imu && is_ouster(o);
+  const ImuOptions ouster_imu_options = simulated_imu(o, SimImuSource::ouster);
+  const std::vector<ImuSample> ouster_samples = ouster_imu ? simulate_imu(body, ouster_imu_options) : std::vector<ImuSample>{};
   drivers::PcapWriter pcap(o.out / "lidar.pcap");
+  std::size_t imu_written = 0;
+  const auto write_imu_packets = [&](std::int64_t until_ns) {
+    drivers::UdpEndpoints endpoints;
+    endpoints.src_port = endpoints.dst_port = drivers::ouster_os1_64_nominal_metadata().udp_port_imu;
+    constexpr std::int64_t kCaptureLatencyNs = 100'000;  // as the LiDAR packets' (LidarSimOptions)
+    for (; imu_written < ouster_samples.size(); ++imu_written) {
+      const ImuSample& sample = ouster_samples[imu_written];
+      const std::int64_t stamp_ns = o.start_time_ns + std::llround(sample.stamp * 1e9);
+      if (stamp_ns + kCaptureLatencyNs > until_ns) break;
+      pcap.write_udp(stamp_ns + kCaptureLatencyNs, endpoints,
+                     encode_ouster_imu_packet(sample, static_cast<std::uint64_t>(stamp_ns)));
+    }
+  };
   const People people = simulated_people(scene, o);
-  const LidarSimStats stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, people, lidar, pcap);
+  const LidarSimStats stats =
+      simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, people, lidar, pcap,
+                              ouster_imu ? std::function<void(std::int64_t)>(write_imu_packets) : nullptr);
+  write_imu_packets(std::numeric_limits<std::int64_t>::max());
   pcap.flush();
 
   WheelOptions wheels;
@@ -142,31 +248,42 @@ SimSummary run_simulation(const SimOptions& o) {
   wheels.time_offset_s = o.can_offset_s;
   wheels.start_time_ns = o.start_time_ns;
   wheels.seed = o.seed;
-  ImuOptions imu;
-  imu.bias_sigma_mps2 = o.imu_bias_sigma_mps2;
-  imu.time_offset_s = o.can_offset_s;
-  imu.start_time_ns = o.start_time_ns;
-  imu.seed = o.seed;
-  if (o.wheels && !is_drone(o)) {
+  const bool wheels_on = o.wheels && o.platform == "robot";
+  const bool can_imu = imu_source == SimImuSource::can;
+  const ImuOptions imu = simulated_imu(o, SimImuSource::can);
+  if (wheels_on || can_imu) {
     std::vector<drivers::can::Frame> frames;
-    const WheelTruth truth = simulate_wheel_encoders(body, wheels, frames);
-    write_wheel_truth(o.out / "truth_wheels.csv", truth, o.start_time_ns);
-    if (o.imu) {
-      const ImuTruth imu_truth = simulate_imu(body, imu, frames);
-      log::info("sim: accelerometer bias {:+.4f} {:+.4f} {:+.4f} m/s²", imu_truth.bias.x(), imu_truth.bias.y(),
-                imu_truth.bias.z());
+    if (wheels_on) {
+      const WheelTruth truth = simulate_wheel_encoders(body, wheels, frames);
+      write_wheel_truth(o.out / "truth_wheels.csv", truth, o.start_time_ns);
+    }
+    if (can_imu) {
+      const std::vector<ImuSample> samples = simulate_imu(body, imu);
+      if (samples.empty()) throw InputError("adit sim", "--duration", "too short for one IMU sample");
+      ImuFrameOptions f;
+      f.start_time_ns = o.start_time_ns;
+      append_imu_frames(samples, f, frames);
+      write_imu_truth(o.out / "truth_imu.csv", samples, o.start_time_ns, imu.time_offset_s);
+      log::info("sim: IMU turn-on bias gyro {:+.5f} {:+.5f} {:+.5f} rad/s, accelerometer {:+.4f} {:+.4f} {:+.4f} m/s²",
+                samples.front().gyro_bias.x(), samples.front().gyro_bias.y(), samples.front().gyro_bias.z(),
+                samples.front().accel_bias.x(), samples.front().accel_bias.y(), samples.front().accel_bias.z());
     }
     std::stable_sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.time_us < b.time_us; });
     drivers::can::CandumpWriter writer(o.out / "can.log");
     for (const drivers::can::Frame& f : frames) writer.write(f);
     writer.flush();
   }
+  if (ouster_imu)
+    write_imu_truth(o.out / (can_imu ? "truth_ouster_imu.csv" : "truth_imu.csv"), ouster_samples, o.start_time_ns,
+                    ouster_imu_options.time_offset_s);
   write_tum(o.out / "truth_body.tum", body, Eigen::Isometry3d::Identity(), o.start_time_ns);
   write_tum(o.out / "truth_sensor.tum", body, lidar.extrinsics, o.start_time_ns);
   write_ply(o.out / "scene.ply", scene.mesh);
   if (!scene.design.triangles.empty()) write_ply_points(o.out / "bim.ply", sample_surface(scene.design, 100.0, o.seed));
   write_targets_csv(o.out / "targets.csv", targets);
-  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels, imu, lidar.extrinsics);
+  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels,
+                       simulated_imu(o, imu_source == SimImuSource::none ? SimImuSource::can : imu_source), imu_source,
+                       lidar.extrinsics);
 
   SimSummary summary;
   summary.packets = stats.packets;

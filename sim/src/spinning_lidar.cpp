@@ -33,7 +33,8 @@ SpinningSensor make_spinning_sensor(std::string_view model) {
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTrack& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
                                       const People& people, const LidarSimOptions& o,
-                                      drivers::PcapWriter& pcap) {
+                                      drivers::PcapWriter& pcap,
+                                      const std::function<void(std::int64_t)>& before_packet) {
   std::vector<BeamTrig> beams;
   for (const Beam& b : sensor.beams) {
     beams.push_back({std::cos(b.elevation_rad), std::sin(b.elevation_rad), std::cos(b.azimuth_offset_rad),
@@ -154,7 +155,9 @@ LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTr
   const auto write = [&](const std::vector<SpinningPacket>& chunk, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
       sensor.encode(chunk[i], bytes);
-      pcap.write_udp(chunk[i].time_ns + last_firing + std::llround(o.capture_latency_s * 1e9), endpoints, bytes);
+      const std::int64_t capture_ns = chunk[i].time_ns + last_firing + std::llround(o.capture_latency_s * 1e9);
+      if (before_packet) before_packet(capture_ns);
+      pcap.write_udp(capture_ns, endpoints, bytes);
     }
     stats.packets += n;
   };

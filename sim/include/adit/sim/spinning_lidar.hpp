@@ -97,6 +97,9 @@ struct LidarSimOptions {
   int threads = 2;                  // outputs do not depend on it
 };
 
+// `before_packet`, when given, is called with each data packet's capture time
+// (Unix ns) just before the packet is written: the caller writes what it has
+// captured until then (the Ouster's IMU packets), so the pcap stays in time order.
 struct LidarSimStats {
   std::uint64_t packets = 0;
   std::uint64_t rays = 0;
@@ -106,6 +109,7 @@ struct LidarSimStats {
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTrack& body, const RayCaster& caster,
                                       const TriangleMesh& mesh, std::span<const Target> targets,
                                       const People& people, const LidarSimOptions& options,
-                                      drivers::PcapWriter& pcap);
+                                      drivers::PcapWriter& pcap,
+                                      const std::function<void(std::int64_t)>& before_packet = {});
 
 }  // namespace adit::sim
