@@ -8,8 +8,14 @@
 
 #include <bit>
 #include <cmath>
+#include <chrono>
 #include <cstring>
+#include <fstream>
+#include <sstream>
+#include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -17,6 +23,7 @@
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/lidar/ouster_packet.hpp"
 #include "adit/drivers/pcap_reader.hpp"
+#include "adit/drivers/udp.hpp"
 #include "shared_data.hpp"
 
 namespace adit::daemon {
@@ -144,6 +151,64 @@ TEST(OusterImuRealData, ReachesThePipelineOnTheLidarClock) {
     EXPECT_TRUE(std::isfinite(imu.clock_spread_s.load()));
     EXPECT_LT(std::abs(imu.clock_spread_s.load()), 0.05);
   }
+}
+
+TEST(OusterImuRealData, ArrivesLiveOnItsOwnPortBesideTheLidar) {
+  // The OS-1-128 capture sent over real UDP on loopback, the LiDAR's packets
+  // to lidar.port and the IMU's to the metadata's udp_port_imu (both moved
+  // off 7502/7503 so that tests running side by side do not meet).
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/ouster");
+  const Capture& c = kCaptures[0];
+  const auto lidar_port = static_cast<std::uint16_t>(20000 + 2 * (::getpid() % 10000));
+  const auto imu_port = static_cast<std::uint16_t>(lidar_port + 1);
+  std::ifstream in(dir / c.metadata);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string json = text.str();
+  const std::string key = "\"udp_port_imu\": 7503";
+  ASSERT_NE(json.find(key), std::string::npos);
+  json.replace(json.find(key), key.size(), fmt::format("\"udp_port_imu\": {}", imu_port));
+  const auto metadata = test::binary_dir() / fmt::format("ouster-imu-live-{}.json", ::getpid());
+  std::ofstream(metadata) << json;
+  const std::string yaml = fmt::format(
+      "payload:\n  id: test\n  state_dir: {}\nlidar:\n  model: {}\n  source: udp\n  address: 127.0.0.1\n"
+      "  port: {}\n  calibration: {}\nimu:\n  enabled: true\n  source: ouster\nthreads:\n  lock_memory: false\n",
+      (test::binary_dir() / "ouster-imu-live").string(), c.model, lidar_port, metadata.string());
+  PipelineOptions options;
+  options.mapping = false;
+  Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
+  pipeline.start();
+  drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
+  drivers::UdpSender to_imu("127.0.0.1", imu_port);
+  drivers::PcapReader reader(dir / c.pcap);
+  drivers::UdpDatagram d;
+  std::size_t imu_sent = 0;
+  std::size_t lidar_sent = 0;
+  while (reader.next(d)) {
+    if (d.dst_port == 7503) imu_sent += to_imu.send(d.payload) ? 1 : 0;
+    else lidar_sent += to_lidar.send(d.payload) ? 1 : 0;
+    std::this_thread::sleep_for(std::chrono::microseconds(300));  // about the capture's pace (0.3 s for 222 packets)
+  }
+  const double sent_s = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                       std::chrono::system_clock::now().time_since_epoch())
+                                                       .count());
+  const ImuStats& imu = pipeline.stats().imu;  // copied from the source per scan and at the end
+  for (int i = 0; i < 200 && pipeline.stats().datagrams.load() < imu_sent + lidar_sent; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  pipeline.end_source();
+  pipeline.join();
+  std::filesystem::remove(metadata);
+  fmt::print("live: {} LiDAR and {} IMU datagrams sent; {} IMU packets read, {} readings, {} before the LiDAR's clock\n",
+             lidar_sent, imu_sent, imu.packets.load(), imu.samples.load(), imu.count(ImuProblem::unclocked));
+  ASSERT_EQ(imu_sent, c.packets);
+  EXPECT_EQ(imu.packets.load(), imu_sent) << "loopback does not lose 30 datagrams";
+  EXPECT_EQ(imu.samples.load() + imu.count(ImuProblem::unclocked), imu.packets.load());
+  EXPECT_GE(imu.samples.load(), imu_sent - 2);
+  EXPECT_EQ(imu.count(ImuProblem::time_back), 0U);
+  // Live, stamped on the LiDAR clock mapped to the host's: the last reading
+  // within the sending's last 0.1 s (kernel receive times, min-delay filtered).
+  EXPECT_NEAR(imu.last_t.load(), sent_s, 0.1);
 }
 
 }  // namespace
