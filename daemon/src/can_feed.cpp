@@ -328,11 +328,12 @@ void CanFeed::run() {
         results[1] = i.pairing.add_gyro(t, w, saturated);
       }
       bool stopped = false;
-      for (const CanImuPairing::Result& r : results) {
-        if (r.gyro_dropped) i.monitor.report(ImuProblem::unpaired, n, 3);
-        if (r.accel_alone) i.monitor.report(ImuProblem::unpaired, n, 0);
-        if (!r.reading || !i.monitor.check(*r.reading, n, r.saturated_axes)) continue;
-        slam::ImuSample body = *r.reading;
+      // A lone frame is reported at the frame that shows it lone.
+      for (const CanImuPairing::Result& paired : results) {
+        if (paired.gyro_dropped) i.monitor.report(ImuProblem::unpaired, n, 3);
+        if (paired.accel_alone) i.monitor.report(ImuProblem::unpaired, n, 0);
+        if (!paired.reading || !i.monitor.check(*paired.reading, n, paired.saturated_axes)) continue;
+        slam::ImuSample body = *paired.reading;
         body.specific_force = i.imu_to_body * body.specific_force;
         body.angular_rate = i.imu_to_body * body.angular_rate;
         if (!hand_over(body)) {
