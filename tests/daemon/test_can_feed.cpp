@@ -128,7 +128,8 @@ TEST(CanFeed, AnImuAloneOnTheBusPairsItsGyroscopeWithItsAccelerometerInBodyAxes)
   CanFeed feed(c);
   ASSERT_FALSE(feed.has_wheels());
   ASSERT_TRUE(feed.has_imu());
-  feed.start({});
+  const std::filesystem::path recorded = log.string() + ".recorded";
+  feed.start(recorded);
   // A replay waits for the IMU alone (no wheels to wait for) and stops at until_t.
   const std::function<bool()> idle = [] { return true; };
   feed.catch_up(1001.0, idle);
@@ -142,6 +143,18 @@ TEST(CanFeed, AnImuAloneOnTheBusPairsItsGyroscopeWithItsAccelerometerInBodyAxes)
   EXPECT_NEAR(s.rate_hz.load(), 100.0, 0.5);
   EXPECT_EQ(describe_problems(s, "can"), "");
   EXPECT_DOUBLE_EQ(s.time_offset_s.load(), 0.004);
+  // The session's candump recording carries the IMU's frames, both kinds.
+  EXPECT_EQ(feed.stats().recorded.load(), 602U);
+  std::ifstream recording(recorded);
+  std::size_t accel_frames = 0;
+  std::size_t gyro_frames = 0;
+  for (std::string line; std::getline(recording, line);) {
+    accel_frames += line.find(" 190#") != std::string::npos ? 1 : 0;
+    gyro_frames += line.find(" 191#") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(accel_frames, 301U);
+  EXPECT_EQ(gyro_frames, 301U);
+  std::filesystem::remove(recorded);
   // The lever arm is carried, not applied.
   EXPECT_EQ(feed.mounting().position_m, Eigen::Vector3d(0.1, -0.2, 0.3));
   const slam::ImuHistory& h = feed.history();

@@ -23,6 +23,7 @@
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/lidar/ouster_packet.hpp"
 #include "adit/drivers/pcap_reader.hpp"
+#include "adit/drivers/pcap_replay.hpp"
 #include "adit/drivers/udp.hpp"
 #include "shared_data.hpp"
 
@@ -125,10 +126,28 @@ TEST(OusterImuRealData, ReachesThePipelineOnTheLidarClock) {
     const config::Config config = config::parse_config(yaml, "test.yaml", "/");
     PipelineOptions options;
     options.mapping = false;
+    options.record_file = state / "lidar.pcap";  // the session's raw recording
     Pipeline pipeline(config, options);
     pipeline.start();
     pipeline.join();
     const PipelineStats& s = pipeline.stats();
+    // The raw recording keeps the IMU's packets on their own port, byte for byte.
+    {
+      drivers::PcapReader original(dir / c.pcap);
+      drivers::PcapReader recorded(options.record_file);
+      std::vector<std::vector<std::uint8_t>> imu_in;
+      std::vector<std::vector<std::uint8_t>> imu_out;
+      drivers::UdpDatagram d;
+      while (original.next(d))
+        if (d.dst_port == 7503) imu_in.emplace_back(d.payload.begin(), d.payload.end());
+      std::size_t all = 0;
+      while (recorded.next(d)) {
+        ++all;
+        if (d.dst_port == 7503) imu_out.emplace_back(d.payload.begin(), d.payload.end());
+      }
+      EXPECT_EQ(all, s.recorded_datagrams.load());
+      EXPECT_EQ(imu_out, imu_in);
+    }
     const ImuStats& imu = s.imu;
     fmt::print("{}: {} IMU packets, {} readings ({} before the LiDAR's clock), {:.1f} Hz, clock spread {:.6f} s; {} scans\n",
                c.pcap, imu.packets.load(), imu.samples.load(), imu.count(ImuProblem::unclocked), imu.rate_hz.load(),
@@ -180,14 +199,15 @@ TEST(OusterImuRealData, ArrivesLiveOnItsOwnPortBesideTheLidar) {
   pipeline.start();
   drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
   drivers::UdpSender to_imu("127.0.0.1", imu_port);
-  drivers::PcapReader reader(dir / c.pcap);
+  // At the capture's own pace, as the sensor sends them: the LiDAR clock's
+  // estimate (and so the IMU's stamps) follows the host's as it would live.
+  drivers::PacedPcapReader reader(dir / c.pcap, 1.0);
   drivers::UdpDatagram d;
   std::size_t imu_sent = 0;
   std::size_t lidar_sent = 0;
   while (reader.next(d)) {
     if (d.dst_port == 7503) imu_sent += to_imu.send(d.payload) ? 1 : 0;
     else lidar_sent += to_lidar.send(d.payload) ? 1 : 0;
-    std::this_thread::sleep_for(std::chrono::microseconds(300));  // about the capture's pace (0.3 s for 222 packets)
   }
   const double sent_s = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                        std::chrono::system_clock::now().time_since_epoch())
