@@ -74,7 +74,7 @@ inline void add_accelerometer(config::Config& c) {
 // An IMU alone on the bus, as the simulator writes it for a drone (no
 // wheels): accelerometer frames on 0x190 (x, y, z as int16 LE, 0.001 m/s²)
 // and, 100 µs after each, gyroscope frames on 0x191 (int16 LE, 0.0002 rad/s),
-// 100 Hz from t = 1000 s. The readings wander by a few steps so that no axis
+// 100 Hz from t0 (1000 s). The readings wander by a few steps so that no axis
 // is stuck; `line` may rewrite or drop (empty) a reading's frames: it gets
 // the reading's index and its two frames.
 struct ImuFrames {
@@ -95,12 +95,12 @@ inline std::string int16_le(const std::array<int, 3>& v) {
 }
 
 template <typename Edit>
-std::filesystem::path imu_only_log(double seconds, const std::string& name, Edit&& edit) {
+std::filesystem::path imu_only_log(double seconds, const std::string& name, Edit&& edit, double t0 = 1000.0) {
   const std::filesystem::path file = binary_dir() / fmt::format("{}-{}.log", name, ::getpid());
   std::ofstream out(file);
   for (int i = 0; i <= static_cast<int>(seconds * 100); ++i) {
     ImuFrames f;
-    f.t = 1000.0 + 0.01 * i;
+    f.t = t0 + 0.01 * i;
     f.accel = {100 + i % 7, -200 - i % 3, 9800 + i % 5};  // (0.1, -0.2, 9.8) m/s²
     f.gyro = {50 + i % 3, -100 - i % 4, 2500 + i % 5};    // (0.01, -0.02, 0.5) rad/s
     edit(i, f);
