@@ -9,6 +9,8 @@
 #include <cstring>
 #include <span>
 
+#include <fmt/format.h>
+
 #include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
@@ -65,6 +67,8 @@ struct LidarSource::Impl {
     if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
       imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
       imu_port = imu->port();
+      if (imu_port == data_port)
+        throw InputError(c.lidar.calibration, "udp_port_imu", fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
     }
     if (c.lidar.source == config::LidarSource::udp) {
       drivers::UdpReceiverConfig udp_config;
