@@ -13,7 +13,7 @@ std::string_view to_string(ImuProblem problem) {
     case ImuProblem::time_back: return "time going back";
     case ImuProblem::undecodable: return "undecodable";
     case ImuProblem::unpaired: return "unpaired";
-    case ImuProblem::unclocked: return "before the LiDAR clock";
+    case ImuProblem::unclocked: return "off the LiDAR clock";
   }
   return "?";
 }

@@ -52,15 +52,22 @@ void OusterImu::push(std::span<const std::uint8_t> payload, std::int64_t host_ti
     monitor_.report(ImuProblem::undecodable, n);
     return;
   }
-  const auto system_ns = static_cast<std::int64_t>(raw.system_time_ns);
-  if (host_time_ns > 0 && system_ns > 0) packet_clock_.add(system_ns, host_time_ns);
   const std::optional<drivers::ClockEstimate> lidar = lidar_clock.estimate();
-  if (!lidar) {
+  // A stamp far from the LiDAR's newest sensor time cannot be put on its
+  // clock (nor added to it without overflowing): a corrupt packet.
+  const auto near_lidar = [&](std::uint64_t sensor_ns) {
+    return std::abs(static_cast<double>(sensor_ns) - static_cast<double>(lidar->at_sensor_ns)) <= kMaxFromLidarNs;
+  };
+  if (!lidar || !near_lidar(raw.accel_time_ns)) {
     monitor_.report(ImuProblem::unclocked, n);
     return;
   }
-  if (const std::optional<drivers::ClockEstimate> own = packet_clock_.estimate())
-    stats_.clock_spread_s.store(1e-9 * static_cast<double>(own->offset_ns - lidar->offset_ns), std::memory_order_relaxed);
+  if (host_time_ns > 0 && near_lidar(raw.system_time_ns)) {
+    packet_clock_.add(static_cast<std::int64_t>(raw.system_time_ns), host_time_ns);
+    if (const std::optional<drivers::ClockEstimate> own = packet_clock_.estimate())
+      stats_.clock_spread_s.store(1e-9 * (static_cast<double>(own->offset_ns) - static_cast<double>(lidar->offset_ns)),
+                                  std::memory_order_relaxed);
+  }
   slam::ImuSample r;
   r.t = 1e-9 * static_cast<double>(lidar_clock.to_host(static_cast<std::int64_t>(raw.accel_time_ns))) - time_offset_s_;
   r.specific_force = Eigen::Vector3d(raw.accel_mps2[0], raw.accel_mps2[1], raw.accel_mps2[2]);

@@ -39,7 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   imu.close();
   imu.catch_up(1e30, {});
   const daemon::ImuStats& s = imu.imu_stats();
-  if (s.samples.load() + s.count(daemon::ImuProblem::time_back) + s.count(daemon::ImuProblem::undecodable) !=
+  if (s.samples.load() + s.count(daemon::ImuProblem::time_back) + s.count(daemon::ImuProblem::undecodable) +
+          s.count(daemon::ImuProblem::unclocked) !=
       s.packets.load())
     std::abort();
   if (s.samples.load() > 0 && !std::isfinite(imu.history().latest())) std::abort();

@@ -22,7 +22,8 @@ enum class ImuProblem : std::uint8_t {
   undecodable,   // not an IMU packet or frame of the expected layout (dropped)
   unpaired,      // CAN: an accelerometer frame without its gyroscope frame (kept, has_gyro false), or a
                  // gyroscope frame without its accelerometer frame (dropped)
-  unclocked,     // Ouster: before the LiDAR clock's first estimate, so no stamp on the LiDAR clock (dropped)
+  unclocked,     // Ouster: before the LiDAR clock's first estimate, or stamped more than 10 s from the
+                 // LiDAR's newest packet: no stamp on the LiDAR clock (dropped)
 };
 inline constexpr std::size_t kImuProblemKinds = 7;
 

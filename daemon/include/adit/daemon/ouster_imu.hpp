@@ -12,8 +12,9 @@
 //       then lidar.extrinsics), stamped at accel_time_ns mapped to the host
 //       clock by the LiDAR stream's own sensor-clock estimate (the one its
 //       scans' start_time_ns come from, drivers/lidar/sensor_clock.hpp) minus
-//       imu.time_offset_s. Readings before that estimate exists are dropped
-//       (counted `unclocked`).
+//       imu.time_offset_s. Readings before that estimate exists, or stamped
+//       more than 10 s from the LiDAR's newest packet (a corrupt packet), are
+//       dropped (counted `unclocked`).
 // The hand-off drops the oldest reading when full, in replay too: the
 // assembly thread must never wait for the odometry here, which waits for
 // the assembly's scans (a LiDAR that stops while the IMU goes on would
@@ -46,6 +47,8 @@ class OusterImu final : public ImuSource {
   // `replay`: catch_up waits for the readings of a scan (pcap source).
   // Throws adit::InputError naming the metadata file when its IMU profile is not LEGACY.
   OusterImu(const config::Config& config, const drivers::OusterMetadata& metadata, bool replay);
+
+  static constexpr double kMaxFromLidarNs = 10e9;  // see `unclocked` above
 
   std::uint16_t port() const { return port_; }
 
