@@ -33,12 +33,14 @@ TEST(ImuNoAllocation, OusterImuPacketsToTheOdometryAllocateNothing) {
   config.imu.source = config::ImuSource::ouster;
   OusterImu imu(config, metadata, false);
   drivers::ClockOffsetEstimator clock;
-  clock.add(1'000'000'000, 1'700'000'000'000'000'000);
+  clock.add(1'000'000'000, 1'700'000'001'000'000'000);
   const auto before = test::allocations();
   for (int i = 0; i < 2000; ++i) {
     const std::uint64_t t = 1'000'000'000ULL + 10'000'000ULL * static_cast<std::uint64_t>(i);
     const auto packet = imu_packet(t, 1e-4F * static_cast<float>(i % 7));
-    imu.push(packet, 1'700'000'000'000'000'000 + static_cast<std::int64_t>(t), clock);
+    const std::int64_t host = 1'700'000'000'000'000'000 + static_cast<std::int64_t>(t);
+    clock.add(static_cast<std::int64_t>(t), host);  // the LiDAR's packets, going on beside the IMU's
+    imu.push(packet, host, clock);
     if (i % 10 == 0) imu.catch_up(1e30, {});
   }
   EXPECT_EQ(test::allocations() - before, 0U);
