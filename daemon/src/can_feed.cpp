@@ -8,12 +8,16 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/can_imu_pairing.hpp"
+#include "adit/daemon/imu_monitor.hpp"
 #include "adit/drivers/can/candump.hpp"
 #include "adit/drivers/can/decoder.hpp"
 #include "adit/drivers/can/signal.hpp"
 #include "adit/drivers/can/socketcan.hpp"
+#include "adit/drivers/can/units.hpp"
 #include "adit/slam/wheel_odometry.hpp"
 
 namespace adit::daemon {
@@ -42,6 +46,32 @@ std::vector<can::MessageSpec> can_messages_of(const config::Config& c) {
   return messages;
 }
 
+namespace {
+
+// The lowest and highest values a signal can carry (raw extremes × factor +
+// offset, in SI units when the decoder converts); none for IEEE floats or a
+// name not found. A reading at one of them is saturated.
+std::pair<double, double> encoding_limits(const std::vector<can::MessageSpec>& messages, const std::string& name,
+                                          bool convert) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const can::MessageSpec& m : messages) {
+    for (const can::SignalSpec& s : m.signals) {
+      if (s.name != name && m.name + "." + s.name != name) continue;
+      if (s.type != can::ValueType::integer || s.length == 0 || s.length > 63) return {-kInf, kInf};
+      const double span = std::ldexp(1.0, static_cast<int>(s.length));
+      const double raw_lo = s.is_signed ? -span / 2 : 0.0;
+      const double raw_hi = s.is_signed ? span / 2 - 1 : span - 1;
+      const double scale = convert ? can::si_conversion(s.unit).scale : 1.0;
+      const double a = (raw_lo * s.factor + s.offset) * scale;
+      const double b = (raw_hi * s.factor + s.offset) * scale;
+      return {std::min(a, b), std::max(a, b)};
+    }
+  }
+  return {-kInf, kInf};
+}
+
+}  // namespace
+
 struct CanFeed::Impl {
   config::Config config;
   can::SignalDecoder decoder;
@@ -52,8 +82,15 @@ struct CanFeed::Impl {
   std::optional<can::CanSocket> socket;
   std::optional<can::CandumpWriter> recorder;
   std::vector<double> values;
-  std::array<std::size_t, 3> accel{};  // decoder slots of the accelerometer's x, y, z (config.imu.enabled)
+  bool wheels = false;                 // wheel_odometry.enabled
+  bool imu = false;                    // imu.enabled, source can
+  bool gyro = false;                   // with the gyroscope's three signals
+  std::array<std::size_t, 3> accel{};  // decoder slots of the accelerometer's x, y, z
+  std::array<std::size_t, 3> rate{};   // and of the gyroscope's
+  std::array<std::pair<double, double>, 6> limits{};  // each axis's encoding limits (ax ay az gx gy gz)
   Eigen::Matrix3d imu_to_body = Eigen::Matrix3d::Identity();
+  CanImuPairing pairing{false};
+  ImuMonitor monitor;
 
   static slam::WheelGeometry geometry_of(const config::WheelOdometrySection& w) {
     slam::WheelGeometry g;
@@ -74,15 +111,31 @@ struct CanFeed::Impl {
   }
 
   // The signals the feed decodes, with the config key that names each.
+  // Wheels first (when enabled), then the accelerometer, then the gyroscope.
+  static bool imu_on_can(const config::Config& c) { return c.imu.enabled && c.imu.source == config::ImuSource::can; }
+  static bool gyro_on_can(const config::Config& c) { return imu_on_can(c) && !c.imu.gyro_x_signal.empty(); }
   static std::vector<std::pair<std::string, std::string>> wanted_signals(const config::Config& c) {
-    std::vector<std::pair<std::string, std::string>> wanted{{c.wheel_odometry.left_signal, "wheel_odometry.left_signal"},
-                                                            {c.wheel_odometry.right_signal, "wheel_odometry.right_signal"}};
-    if (c.imu.enabled) {
+    std::vector<std::pair<std::string, std::string>> wanted;
+    if (c.wheel_odometry.enabled) {
+      wanted.emplace_back(c.wheel_odometry.left_signal, "wheel_odometry.left_signal");
+      wanted.emplace_back(c.wheel_odometry.right_signal, "wheel_odometry.right_signal");
+    }
+    if (imu_on_can(c)) {
       wanted.emplace_back(c.imu.accel_x_signal, "imu.accel_x_signal");
       wanted.emplace_back(c.imu.accel_y_signal, "imu.accel_y_signal");
       wanted.emplace_back(c.imu.accel_z_signal, "imu.accel_z_signal");
     }
+    if (gyro_on_can(c)) {
+      wanted.emplace_back(c.imu.gyro_x_signal, "imu.gyro_x_signal");
+      wanted.emplace_back(c.imu.gyro_y_signal, "imu.gyro_y_signal");
+      wanted.emplace_back(c.imu.gyro_z_signal, "imu.gyro_z_signal");
+    }
     return wanted;
+  }
+
+  // Signal values in SI units, unless the wheels read raw counts.
+  static bool converts(const config::Config& c) {
+    return !c.wheel_odometry.enabled || c.wheel_odometry.quantity != config::WheelQuantity::counts;
   }
 
   // The decoder of the wheel (and accelerometer) signals; an unknown signal is named by its config key.
@@ -91,7 +144,7 @@ struct CanFeed::Impl {
     std::vector<std::string> names;
     for (const auto& [name, key] : wanted) names.push_back(name);
     try {
-      return can::SignalDecoder(can_messages_of(c), names, c.wheel_odometry.quantity != config::WheelQuantity::counts);
+      return can::SignalDecoder(can_messages_of(c), names, converts(c));
     } catch (const InputError& e) {
       for (const auto& [name, key] : wanted)
         if (e.key() == name) throw InputError(e.where(), key, e.reason());
@@ -99,23 +152,36 @@ struct CanFeed::Impl {
     }
   }
 
-  explicit Impl(const config::Config& c)
+  Impl(const config::Config& c, ImuStats& imu_stats)
       : config(c),
         decoder(make_decoder(c)),
-        odometry(geometry_of(c.wheel_odometry), {}, limits_of(c.wheel_odometry)) {
-    const int l = decoder.slot(c.wheel_odometry.left_signal);
-    const int r = decoder.slot(c.wheel_odometry.right_signal);
-    if (l < 0) throw InputError("", "wheel_odometry.left_signal", "no such signal in can.dbc / can.signals");
-    if (r < 0) throw InputError("", "wheel_odometry.right_signal", "no such signal in can.dbc / can.signals");
-    left = static_cast<std::size_t>(l);
-    right = static_cast<std::size_t>(r);
-    if (c.imu.enabled) {
-      const auto wanted = wanted_signals(c);
+        odometry(geometry_of(c.wheel_odometry), {}, limits_of(c.wheel_odometry)),
+        wheels(c.wheel_odometry.enabled),
+        imu(imu_on_can(c)),
+        gyro(gyro_on_can(c)),
+        pairing(gyro_on_can(c)),
+        monitor(imu_stats, ImuLimits{c.imu.accel_range_mps2, c.imu.gyro_range_radps}) {
+    const auto wanted = wanted_signals(c);
+    const auto slot_of = [&](std::size_t i) {
+      const auto& [name, key] = wanted[i];
+      const int slot = decoder.slot(name);
+      if (slot < 0) throw InputError("", key, "no such signal in can.dbc / can.signals");
+      return static_cast<std::size_t>(slot);
+    };
+    const std::size_t first_imu = wheels ? 2 : 0;
+    if (wheels) {
+      left = slot_of(0);
+      right = slot_of(1);
+    }
+    if (imu) {
+      const std::vector<can::MessageSpec> messages = can_messages_of(c);
       for (std::size_t axis = 0; axis < 3; ++axis) {
-        const auto& [name, key] = wanted[2 + axis];
-        const int slot = decoder.slot(name);
-        if (slot < 0) throw InputError("", key, "no such signal in can.dbc / can.signals");
-        accel[axis] = static_cast<std::size_t>(slot);
+        accel[axis] = slot_of(first_imu + axis);
+        limits[axis] = encoding_limits(messages, wanted[first_imu + axis].first, converts(c));
+        if (gyro) {
+          rate[axis] = slot_of(first_imu + 3 + axis);
+          limits[3 + axis] = encoding_limits(messages, wanted[first_imu + 3 + axis].first, converts(c));
+        }
       }
       const auto rad = [](double deg) { return deg * std::numbers::pi / 180.0; };
       imu_to_body = (Eigen::AngleAxisd(rad(c.imu.rpy_deg[2]), Eigen::Vector3d::UnitZ()) *
@@ -139,9 +205,15 @@ struct CanFeed::Impl {
 };
 
 CanFeed::CanFeed(const config::Config& config)
-    : impl_(std::make_unique<Impl>(config)),
+    : impl_(std::make_unique<Impl>(config, imu_stats_)),
       replay_(config.can.source == config::CanSource::candump),
-      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return CanSample{}; }) {}
+      wheels_(impl_->wheels),
+      imu_(impl_->imu),
+      samples_(1024, replay_ ? Overflow::wait : Overflow::drop_oldest, [] { return CanSample{}; }) {
+  mounting_.rotation = impl_->imu_to_body;
+  mounting_.position_m = Eigen::Vector3d(config.imu.position_m[0], config.imu.position_m[1], config.imu.position_m[2]);
+  imu_stats_.time_offset_s.store(config.imu.time_offset_s);
+}
 
 CanFeed::~CanFeed() { stop(); }
 
@@ -167,8 +239,8 @@ void CanFeed::drain_into(slam::WheelHistory& history, double until_t, slam::ImuH
   // A replay stops once both streams reach until_t, or a second past it
   // (an accelerometer that fell silent must not drain the whole log).
   const auto covered = [&] {
-    if (history.latest() < until_t) return false;
-    return imu == nullptr || !impl_->config.imu.enabled || imu->latest() >= until_t || drained_t_ >= until_t + 1.0;
+    if (wheels_ && history.latest() < until_t) return false;
+    return imu == nullptr || !imu_ || imu->latest() >= until_t || drained_t_ >= until_t + 1.0;
   };
   const bool wait = replay_ && idle;
   while (!(replay_ && covered())) {
@@ -183,6 +255,10 @@ void CanFeed::drain_into(slam::WheelHistory& history, double until_t, slam::ImuH
     }
     samples_.release(s);
   }
+}
+
+void CanFeed::catch_up(double until_t, const std::function<bool()>& idle) {
+  drain_into(wheel_history_, until_t, imu_ ? &imu_history_ : nullptr, idle);
 }
 
 bool CanFeed::hand_over(const CanSample& sample) {
@@ -221,13 +297,57 @@ void CanFeed::run() {
     const auto written = [&](std::size_t slot) {
       return slot >= r.first && slot < r.first + r.count && !std::isnan(i.values[slot]);
     };
-    // An accelerometer frame carries all three axes.
-    if (i.config.imu.enabled && written(i.accel[0]) && written(i.accel[1]) && written(i.accel[2])) {
-      const Eigen::Vector3d f(i.values[i.accel[0]], i.values[i.accel[1]], i.values[i.accel[2]]);
-      if (!hand_over(slam::ImuSample{1e-6 * static_cast<double>(frame.time_us) - i.config.imu.time_offset_s, i.imu_to_body * f}))
-        break;
-      stats_.imu_samples.fetch_add(1, std::memory_order_relaxed);
+    // An accelerometer frame carries all three axes, a gyroscope frame too
+    // (one frame may carry both).
+    if (i.imu) {
+      const std::uint64_t n = stats_.frames.load(std::memory_order_relaxed);
+      const double t = 1e-6 * static_cast<double>(frame.time_us) - i.config.imu.time_offset_s;
+      const auto read = [&](const std::array<std::size_t, 3>& slots, std::size_t first_axis, Eigen::Vector3d& v) {
+        unsigned saturated = 0;
+        for (std::size_t a = 0; a < 3; ++a) {
+          v[static_cast<Eigen::Index>(a)] = i.values[slots[a]];
+          const auto [lo, hi] = i.limits[first_axis + a];
+          if (v[static_cast<Eigen::Index>(a)] <= lo || v[static_cast<Eigen::Index>(a)] >= hi) saturated |= 1U << a;
+        }
+        return saturated;
+      };
+      const auto all_written = [&](const std::array<std::size_t, 3>& slots) {
+        return written(slots[0]) && written(slots[1]) && written(slots[2]);
+      };
+      CanImuPairing::Result results[2];
+      if (all_written(i.accel)) {
+        imu_stats_.packets.fetch_add(1, std::memory_order_relaxed);
+        Eigen::Vector3d f;
+        const unsigned saturated = read(i.accel, 0, f);
+        results[0] = i.pairing.add_accel(t, f, saturated);
+      }
+      if (i.gyro && all_written(i.rate)) {
+        imu_stats_.packets.fetch_add(1, std::memory_order_relaxed);
+        Eigen::Vector3d w;
+        const unsigned saturated = read(i.rate, 3, w);
+        results[1] = i.pairing.add_gyro(t, w, saturated);
+      }
+      bool stopped = false;
+      // A lone frame is reported at the frame that shows it lone.
+      for (const CanImuPairing::Result& paired : results) {
+        if (paired.gyro_dropped) i.monitor.report(ImuProblem::unpaired, n, 3);
+        if (paired.accel_alone) i.monitor.report(ImuProblem::unpaired, n, 0);
+        if (!paired.reading || !i.monitor.check(*paired.reading, n, paired.saturated_axes)) continue;
+        slam::ImuSample body = *paired.reading;
+        body.specific_force = i.imu_to_body * body.specific_force;
+        body.angular_rate = i.imu_to_body * body.angular_rate;
+        if (!hand_over(body)) {
+          stopped = true;
+          break;
+        }
+        stats_.imu_samples.fetch_add(1, std::memory_order_relaxed);
+        imu_stats_.samples.fetch_add(1, std::memory_order_relaxed);
+        if (body.has_gyro) imu_stats_.gyro_samples.fetch_add(1, std::memory_order_relaxed);
+        imu_stats_.last_seen_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+      }
+      if (stopped) break;
     }
+    if (!i.wheels) continue;
     // Left and right may come in separate frames: a sample is taken when both
     // have a value newer than the last sample.
     if (written(i.left)) value_left = i.values[i.left];
@@ -252,6 +372,7 @@ void CanFeed::run() {
     stats_.samples.fetch_add(1, std::memory_order_relaxed);
   }
   stats_.dropped.store(samples_.dropped());
+  imu_stats_.dropped.store(samples_.dropped());  // wheels and IMU share the hand-off
   samples_.close();
   beat_.finished.store(true);
 }

@@ -9,10 +9,14 @@
 #include <cstring>
 #include <span>
 
+#include <fmt/format.h>
+
 #include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/ouster_imu.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
+#include "adit/drivers/lidar/ouster_metadata.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_directory.hpp"
 #include "adit/drivers/pcap_replay.hpp"
@@ -31,6 +35,7 @@ struct Packet {
   std::uint16_t src_port = 0;
   std::int64_t received_mono_ns = 0;  // when the receiver handed it on (latency)
   std::uint32_t size = 0;
+  bool imu = false;                   // from the Ouster IMU port (imu.source ouster)
   std::array<std::uint8_t, kMaxDatagram> data{};
 };
 
@@ -59,6 +64,12 @@ struct LidarSource::Impl {
       throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
     }
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
+    if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
+      imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
+      imu_port = imu->port();
+      if (imu_port == data_port)
+        throw InputError(c.lidar.calibration, "udp_port_imu", fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
+    }
     if (c.lidar.source == config::LidarSource::udp) {
       drivers::UdpReceiverConfig udp_config;
       udp_config.bind_address = c.lidar.address;
@@ -67,6 +78,16 @@ struct LidarSource::Impl {
       udp_config.multicast_group = c.lidar.multicast_group;
       udp_config.receive_buffer_bytes = c.lidar.receive_buffer_bytes;
       udp.emplace(udp_config);
+      if (imu) {
+        // The IMU's packets (100 Hz, 48 bytes) on their own port, read by the
+        // same receiver thread into the same packet pool: the assembly thread
+        // then sees both in arrival order and stamps the IMU with the LiDAR
+        // stream's clock estimate without sharing it across threads (the
+        // pool is single-producer, so a second thread could not feed it).
+        udp_config.port = imu_port;
+        udp_config.receive_buffer_bytes = 1 << 20;
+        imu_udp.emplace(udp_config);
+      }
     }
     // The packet period is learnt from the first packet by the family; 0 = by sequence only.
     assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
@@ -79,6 +100,7 @@ struct LidarSource::Impl {
   // goes to odometry, swapped, not copied.
   void hand_on(drivers::LidarScan& scan) {
     stats.scans.fetch_add(1, std::memory_order_relaxed);
+    if (imu) imu->lidar_reached(1e-9 * static_cast<double>(scan.start_time_ns));
     if (stream) {
       if (const auto clock = stream->clock().estimate())
         stats.clock_offset_ns.store(clock->offset_ns, std::memory_order_relaxed);
@@ -92,9 +114,11 @@ struct LidarSource::Impl {
   }
 
   // Receiver thread: one datagram into the packet pool (and the recording).
-  void push(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip, std::uint16_t src_port) {
+  void push(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip, std::uint16_t src_port,
+            bool from_imu = false) {
     Packet* packet = packets.acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
     if (packet == nullptr) return;
+    packet->imu = from_imu;
     packet->host_time_ns = time_ns;
     packet->src_ip = src_ip;
     packet->src_port = src_port;
@@ -104,7 +128,7 @@ struct LidarSource::Impl {
     stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
     if (recorder) {
       // Buffered file output on the receiver: a copy and no allocation per packet.
-      const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, data_port};
+      const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, from_imu ? imu_port : data_port};
       if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload))
         stats.recorded_datagrams.fetch_add(1, std::memory_order_relaxed);
     }
@@ -118,6 +142,10 @@ struct LidarSource::Impl {
       while (reading() && pcap->next(d)) {
         receiver.beat.beat();
         stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+        if (imu && d.dst_port == imu_port) {
+          push(d.payload, d.capture_time_ns, d.src_ip, d.src_port, true);
+          continue;
+        }
         if (d.dst_port != data_port) {
           stats.foreign_datagrams.fetch_add(1, std::memory_order_relaxed);
           continue;
@@ -129,11 +157,22 @@ struct LidarSource::Impl {
       // old packets in the socket's buffer: they belong to no session.
       for (auto batch = udp->receive(0); !batch.empty(); batch = udp->receive(0))
         stats.stale_datagrams.fetch_add(batch.size(), std::memory_order_relaxed);
+      if (imu_udp)
+        for (auto batch = imu_udp->receive(0); !batch.empty(); batch = imu_udp->receive(0))
+          stats.stale_datagrams.fetch_add(batch.size(), std::memory_order_relaxed);
+      // With the IMU's socket beside it, the LiDAR's waits at most 5 ms, so
+      // the IMU is read within 5 ms even when the LiDAR falls silent.
+      const int wait_ms = imu_udp ? 5 : 100;
       while (reading()) {
         receiver.beat.beat();
-        for (const drivers::ReceivedDatagram& d : udp->receive(100)) {
+        for (const drivers::ReceivedDatagram& d : udp->receive(wait_ms)) {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
           push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port);
+        }
+        if (!imu_udp) continue;
+        for (const drivers::ReceivedDatagram& d : imu_udp->receive(0)) {
+          stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+          push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port, true);
         }
       }
     }
@@ -165,11 +204,17 @@ struct LidarSource::Impl {
       Packet* packet = packets.take_or_wait([this] { return assembly.idle(); });
       if (packet == nullptr) break;
       assembly.beat.beat();
-      current_packet_mono_ns = packet->received_mono_ns;
-      stream->push(std::span<const std::uint8_t>(packet->data.data(), packet->size), packet->host_time_ns);
+      const std::span<const std::uint8_t> payload(packet->data.data(), packet->size);
+      if (packet->imu) {
+        imu->push(payload, packet->host_time_ns, stream->clock());
+      } else {
+        current_packet_mono_ns = packet->received_mono_ns;
+        stream->push(payload, packet->host_time_ns);
+      }
       packets.release(packet);
     }
     if (!stop.load()) stream->finish();
+    if (imu) imu->close();
     stats.bad_packets.store(stream->bad_packets());
     stats.dropped_packets.store(packets.dropped());
     scans->close();
@@ -187,6 +232,9 @@ struct LidarSource::Impl {
   std::optional<drivers::ScanAssembler> assembler;
   std::optional<drivers::DecodeStream> stream;
   std::optional<drivers::PcapWriter> recorder;
+  std::optional<OusterImu> imu;           // imu.source ouster
+  std::uint16_t imu_port = 0;
+  std::optional<drivers::UdpReceiver> imu_udp;
   Handoff<Packet> packets;
   Handoff<ScanSlot>* scans = nullptr;      // the source's output, set before the threads start
   std::int64_t current_packet_mono_ns = 0;  // assembly thread only
@@ -238,5 +286,6 @@ void LidarSource::join() {
 std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &impl_->assembly}; }
 std::size_t LidarSource::packets_waiting() const { return impl_->packets.depth(); }
 std::size_t LidarSource::packet_capacity() const { return impl_->packets.capacity(); }
+OusterImu* LidarSource::imu() { return impl_->imu ? &*impl_->imu : nullptr; }
 
 }  // namespace adit::daemon

@@ -9,14 +9,14 @@
 namespace adit::daemon {
 
 OdometryStage::OdometryStage(const config::Config& config, const slam::OdometryConfig& odometry,
-                             Handoff<ScanSlot>& scans, CanFeed* can, bool mapping, std::size_t max_points,
-                             Overflow overflow, PipelineStats& stats, PipelineTimings& timings,
+                             Handoff<ScanSlot>& scans, CanFeed* can, ImuSource* imu, bool mapping,
+                             std::size_t max_points, Overflow overflow, PipelineStats& stats, PipelineTimings& timings,
                              const std::atomic<bool>& stop)
     : scans_(scans),
       stats_(stats),
       timings_(timings),
       thread_("odometry", config.threads.odometry, stop),
-      odometry_(config, odometry, can, [this] { return thread_.idle(); }),
+      odometry_(config, odometry, can, imu, [this] { return thread_.idle(); }),
       poses_(kPoseSlots, Overflow::wait, [] { return PoseSlot{}; }) {
   if (mapping) {
     map_slots_.emplace(kMapSlots, overflow, [max_points] {
@@ -47,6 +47,7 @@ void OdometryStage::loop() {
     stats_.scans_without_wheels.store(counts.scans_without_wheels, std::memory_order_relaxed);
     stats_.gravity_priors.store(counts.gravity_priors, std::memory_order_relaxed);
     stats_.scans_without_gravity.store(counts.scans_without_gravity, std::memory_order_relaxed);
+    copy_imu_stats();
     if (timings_.odometry_ms.size() < kTimingCapacity) timings_.odometry_ms.push_back(odometry_.registration_ms());
     if (first_stamp_ns_ == 0) first_stamp_ns_ = slot->scan.start_time_ns;
     last_stamp_ns_ = slot->scan.start_time_ns;
@@ -63,6 +64,10 @@ void OdometryStage::loop() {
   stats_.dropped_scans.store(scans_.dropped());
   poses_.close();
   if (map_slots_) map_slots_->close();
+}
+
+void OdometryStage::copy_imu_stats() {
+  if (const ImuSource* imu = odometry_.imu()) copy_stats(imu->imu_stats(), stats_.imu);
 }
 
 // Copies (no allocation: the slot's buffers are reserved).

@@ -9,6 +9,7 @@
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/lidar_source.hpp"
 #include "adit/daemon/mapping_stage.hpp"
+#include "adit/daemon/ouster_imu.hpp"
 #include "adit/daemon/odometry_stage.hpp"
 #include "adit/daemon/output_stage.hpp"
 #include "adit/daemon/scan_odometry.hpp"
@@ -17,9 +18,18 @@
 namespace adit::daemon {
 namespace {
 
+// The CAN thread runs for the wheels, a CAN IMU, or both.
 std::unique_ptr<CanFeed> can_feed_of(const config::Config& c) {
-  if (!c.can.enabled || !c.wheel_odometry.enabled) return nullptr;
+  const bool imu = c.imu.enabled && c.imu.source == config::ImuSource::can;
+  if (!c.can.enabled || (!c.wheel_odometry.enabled && !imu)) return nullptr;
   return std::make_unique<CanFeed>(c);
+}
+
+// The IMU the odometry reads: the CAN feed's or the Ouster's (LidarSource), or none.
+ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& source) {
+  if (!c.imu.enabled) return nullptr;
+  if (c.imu.source == config::ImuSource::ouster) return source.imu();
+  return can;
 }
 
 }  // namespace
@@ -30,8 +40,8 @@ struct Pipeline::Impl {
         source(c, o.replay_speed, o.odometry.max_scan_points, stats, stop),
         odometry_config(odometry_config_of(c, o.odometry, source.max_points_per_scan())),
         can(can_feed_of(c)),
-        odometry(c, odometry_config, source.scans(), can.get(), o.mapping, source.max_points_per_scan(),
-                 source.overflow(), stats, timings, stop),
+        odometry(c, odometry_config, source.scans(), can.get(), imu_source_of(c, can.get(), source), o.mapping,
+                 source.max_points_per_scan(), source.overflow(), stats, timings, stop),
         output(c, odometry.poses(), o.sinks.pose, stats, timings, stop),
         empty_map(slam::TiledMapConfig{}) {
     if (o.mapping)
@@ -110,6 +120,7 @@ void Pipeline::join() {
   i.output.join();
   if (i.mapping) i.mapping->join();
   if (i.can) i.can->stop();
+  i.odometry.copy_imu_stats();  // the readings after the last scan too
   if (i.started) {
     i.timings.duration_s = 1e-9 * static_cast<double>(monotonic_ns() - i.started_ns);
     i.timings.sensor_span_s = 1e-9 * static_cast<double>(i.odometry.last_stamp_ns() - i.odometry.first_stamp_ns());

@@ -20,11 +20,12 @@ slam::OdometryConfig odometry_config_of(const config::Config& config, slam::Odom
 }
 
 ScanOdometry::ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
-                           std::function<bool()> idle)
+                           ImuSource* imu, std::function<bool()> idle)
     : odometry_(odometry),
       extrinsic_(isometry_of(config.lidar.extrinsics).cast<float>()),
       can_(can),
-      imu_(can != nullptr && config.imu.enabled),
+      wheels_(can != nullptr && can->has_wheels()),
+      imu_(config.imu.enabled ? imu : nullptr),
       gravity_sigma_rad_(config.imu.gravity_sigma_deg * std::numbers::pi / 180.0),
       idle_(std::move(idle)) {
   body_points_.reserve(odometry.max_scan_points);
@@ -40,7 +41,15 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
   }
   float sweep_s = 0.0F;
   for (const float t : body_times_) sweep_s = std::max(sweep_s, t);
-  const std::optional<slam::MotionPrior> prior = wheel_prior_for(scan.start_time_ns, sweep_s);
+  // The motion sensors' samples up to the sweep's end and a little past it,
+  // for the accelerometer's mean over the sweep and the wheels' speed there.
+  // A replayed CAN log or pcap is waited for, so a replay as fast as
+  // possible still gets its priors. A CAN IMU is the CAN feed: its second
+  // catch_up costs nothing.
+  const double until = 1e-9 * static_cast<double>(scan.start_time_ns) + sweep_s + kSpeedHalfWindow_s;
+  if (can_ != nullptr) can_->catch_up(until, idle_);
+  if (imu_ != nullptr) imu_->catch_up(until, idle_);
+  const std::optional<slam::MotionPrior> prior = wheel_prior_for(scan.start_time_ns);
   const std::optional<slam::UpMeasurement> up = up_for(scan.start_time_ns, sweep_s);
   const std::int64_t t0 = monotonic_ns();
   result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up}, prior);
@@ -49,33 +58,28 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
 }
 
 // The wheels' motion since the previous scan, or nullopt (then odometry
-// predicts with constant velocity). A replayed CAN log is waited for, so a
-// replay as fast as possible still gets its priors. The samples are taken up
-// to the sweep's end and a little past it, for the accelerometer's mean over
-// the sweep and the wheels' speed there.
-std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(std::int64_t stamp_ns, float sweep_s) {
-  if (can_ == nullptr) return std::nullopt;
+// predicts with constant velocity).
+std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(std::int64_t stamp_ns) {
+  if (!wheels_) return std::nullopt;
   const double t = 1e-9 * static_cast<double>(stamp_ns);
-  const double until = t + sweep_s + kSpeedHalfWindow_s;
-  slam::ImuHistory* imu = imu_ ? &imu_history_ : nullptr;
-  can_->drain_into(wheel_history_, until, imu, idle_);
   const double previous = previous_stamp_s_;
   previous_stamp_s_ = t;
   if (previous <= 0.0) return std::nullopt;
-  std::optional<slam::MotionPrior> prior = wheel_history_.prior(previous, t);
+  std::optional<slam::MotionPrior> prior = can_->wheels().prior(previous, t);
   ++(prior ? counts_.wheel_priors : counts_.scans_without_wheels);
   return prior;
 }
 
 // After wheel_prior_for: gravity's up in the body frame over the sweep, from
 // the accelerometer's mean with the wheels' kinematic acceleration removed
-// (slam/gravity.hpp), or nullopt.
+// (slam/gravity.hpp), or nullopt. Without wheels there is no acceleration to
+// remove: no prior, and nothing counted.
 std::optional<slam::UpMeasurement> ScanOdometry::up_for(std::int64_t stamp_ns, float sweep_s) {
-  if (!imu_) return std::nullopt;
+  if (imu_ == nullptr || !wheels_) return std::nullopt;
   const double t0 = 1e-9 * static_cast<double>(stamp_ns);
   const double t1 = t0 + std::max(sweep_s, 0.01F);
-  const std::optional<Eigen::Vector3d> force = imu_history_.mean(t0, t1);
-  const std::optional<Eigen::Vector3d> acceleration = wheel_history_.acceleration(t0, t1, kSpeedHalfWindow_s);
+  const std::optional<Eigen::Vector3d> force = imu_->history().mean(t0, t1);
+  const std::optional<Eigen::Vector3d> acceleration = can_->wheels().acceleration(t0, t1, kSpeedHalfWindow_s);
   std::optional<slam::UpMeasurement> up;
   if (force && acceleration) up = slam::measured_up(*force, *acceleration, gravity_sigma_rad_);
   ++(up ? counts_.gravity_priors : counts_.scans_without_gravity);

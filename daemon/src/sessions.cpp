@@ -25,6 +25,29 @@
 #include "adit/slam/tum.hpp"
 
 namespace adit::daemon {
+
+namespace {
+
+// summary.json's "imu": the IMU source's figures (imu_stats.hpp).
+nlohmann::json imu_summary(const ImuStats& imu) {
+  nlohmann::json problems = nlohmann::json::object();
+  for (std::size_t k = 0; k < kImuProblemKinds; ++k) {
+    const auto p = static_cast<ImuProblem>(k);
+    problems[std::string(to_string(p))] = imu.count(p);
+  }
+  const double spread = imu.clock_spread_s.load();
+  return {{"packets", imu.packets.load()},
+          {"readings", imu.samples.load()},
+          {"with_gyro", imu.gyro_samples.load()},
+          {"dropped", imu.dropped.load()},
+          {"rate_hz", imu.rate_hz.load()},
+          {"longest_gap_s", imu.longest_gap_s.load()},
+          {"time_offset_s", imu.time_offset_s.load()},
+          {"clock_spread_s", std::isfinite(spread) ? nlohmann::json(spread) : nlohmann::json(nullptr)},
+          {"problems", problems}};
+}
+
+}  // namespace
 namespace {
 
 // pose_t.FLAG_*: kept here as numbers so this file needs no LCM header.
@@ -251,6 +274,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"wheels_missing", s.scans_without_wheels.load()},
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
+        {"imu", imu_summary(s.imu)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
@@ -267,6 +291,11 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
     log::info("session {}: stopped; {} poses, {} map points in {} tiles; files in {}", id, s.poses.load(), map.size(),
               map.tile_count(), dir.string());
+    if (config_.imu.enabled) {
+      const std::string problems =
+          describe_problems(s.imu, config_.imu.source == config::ImuSource::ouster ? "ouster" : "can");
+      if (!problems.empty()) log::warn("session {}: {}", id, problems);
+    }
   } catch (const std::exception& e) {
     // The trajectory is on disk already; say what is missing and carry on.
     log::error("session {}: writing its files failed: {}", id, e.what());
@@ -345,6 +374,22 @@ StatusSample Sessions::status_sample() {
   lidar.last_seen_utime = s.last_packet_realtime_ns.load() / 1000;
   lidar.time_offset_s = static_cast<float>(1e-9 * static_cast<double>(s.clock_offset_ns.load()));
   sample.sensors.push_back(lidar);
+  // The IMU as one more sensor (sensor_health_t unchanged, so older clients
+  // read it): its rate from its own stamps, its dropped and refused readings
+  // (time going back, undecodable, unclocked), its configured clock offset;
+  // its other problems (gaps, saturation, stuck axes) name themselves in the fault.
+  const ImuStats& imu = s.imu;
+  const std::string imu_source = config_.imu.source == config::ImuSource::ouster ? "ouster" : "can";
+  if (config_.imu.enabled) {
+    SensorHealth h;
+    h.name = "imu " + imu_source;
+    h.packet_rate_hz = static_cast<float>(imu.rate_hz.load());
+    h.packets_dropped = static_cast<std::int64_t>(imu.dropped.load() + imu.count(ImuProblem::time_back) +
+                                                  imu.count(ImuProblem::undecodable) + imu.count(ImuProblem::unclocked));
+    h.last_seen_utime = imu.last_seen_realtime_ns.load() / 1000;
+    h.time_offset_s = static_cast<float>(imu.time_offset_s.load());
+    sample.sensors.push_back(h);
+  }
   const std::vector<StageLoad> loads = pipeline_->loads();
   last_cpu_s_.resize(loads.size(), 0.0);
   for (std::size_t i = 0; i < loads.size(); ++i) {
@@ -363,6 +408,10 @@ StatusSample Sessions::status_sample() {
   else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
     sample.fault = fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
                                s.dropped_scans.load());
+  else if (config_.imu.enabled && imu.samples.load() == 0 && s.scans.load() > 10)
+    sample.fault = fmt::format("no IMU readings ({}) after {} scans", imu_source, s.scans.load());
+  else if (config_.imu.enabled)
+    sample.fault = describe_problems(imu, imu_source);  // "" when the IMU has none
   return sample;
 }
 

@@ -13,6 +13,8 @@
 #include "adit/config/load.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "adit/daemon/supervisor.hpp"
+#include "adit/drivers/pcap_reader.hpp"
+#include "can_logs.hpp"
 #include "shared_data.hpp"
 
 namespace adit::daemon {
@@ -69,6 +71,46 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   }
   EXPECT_EQ(mapped, s.mapped_scans.load());
   EXPECT_GE(mapped, 5U);
+}
+
+TEST(Pipeline, RunsWithACanImuAndNoWheels) {
+  // A drone's or a handheld's payload: the IMU alone on the CAN bus
+  // (accelerometer and gyroscope), no wheels, with the real capture; the log
+  // starts at the capture's first packet and covers it.
+  ADIT_REQUIRE_SHARED_DATA(dir, "lidar/velodyne-hdl32e");
+  drivers::PcapReader reader(dir / "capture.pcap");
+  drivers::UdpDatagram d;
+  ASSERT_TRUE(reader.next(d));
+  const double t0 = 1e-9 * static_cast<double>(d.capture_time_ns) - 0.5;
+  const std::filesystem::path log = test::imu_only_log(3.0, "pipeline-imu", [](int, test::ImuFrames&) {}, t0);
+  const auto out = test::binary_dir() / "pipeline-imu-test";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);  // a session's folder exists before its pipeline starts
+  config::Config c = hdl32e_replay(dir, out);
+  const config::Config imu = test::imu_only_config(log);
+  c.can = imu.can;
+  c.wheel_odometry = imu.wheel_odometry;
+  c.imu = imu.imu;
+  PipelineOptions options;
+  options.mapping = false;
+  Pipeline pipeline(c, options);
+  SessionFiles files;
+  files.can_record_file = out / "can.log";
+  pipeline.start(files);
+  pipeline.join();
+  ASSERT_TRUE(pipeline.drained());
+  const PipelineStats& s = pipeline.stats();
+  EXPECT_GE(s.scans.load(), 5U);
+  EXPECT_EQ(s.poses.load(), s.scans.load());
+  // The IMU's readings reached the odometry (each scan waited for its own), with their gyroscope.
+  EXPECT_GT(s.imu.samples.load(), 40U);
+  EXPECT_EQ(s.imu.gyro_samples.load(), s.imu.samples.load());
+  EXPECT_NEAR(s.imu.rate_hz.load(), 100.0, 1.0);
+  EXPECT_EQ(describe_problems(s.imu, "can"), "");
+  // No wheels: no wheel prior sought, none counted missing.
+  EXPECT_EQ(s.wheel_priors.load() + s.scans_without_wheels.load(), 0U);
+  EXPECT_TRUE(std::filesystem::exists(out / "can.log"));
+  std::filesystem::remove(log);
 }
 
 TEST(Pipeline, StopsOnRequestEvenMidReplay) {

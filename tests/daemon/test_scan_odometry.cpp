@@ -93,5 +93,26 @@ TEST(ScanOdometry, CountsScansTheCanLogDoesNotCover) {
   EXPECT_EQ(counts.scans_without_wheels, 2U);
 }
 
+TEST(ScanOdometry, RunsOnACanImuWithoutWheelsAndKeepsItsReadingsForEachScan) {
+  // A drone's bus: the IMU alone (accelerometer and gyroscope, 100 Hz over 3 s).
+  OnReplayedCan replay(test::imu_only_config(test::imu_only_log(3.0, "scan-odometry-imu", [](int, test::ImuFrames&) {})));
+  ASSERT_NE(replay.odometry.imu(), nullptr);
+  EXPECT_EQ(replay.odometry.imu(), static_cast<const ImuSource*>(&replay.can));
+  for (int k = 0; k < 10; ++k) {
+    const std::int64_t stamp = 1'000'500'000'000 + k * 100'000'000LL;
+    replay.odometry.process(room_scan(stamp));
+    // Each scan waited for the readings over its sweep (and 50 ms more), not for wheels.
+    EXPECT_GE(replay.odometry.imu()->history().latest(), 1e-9 * static_cast<double>(stamp) + 0.1) << k;
+    EXPECT_TRUE(replay.odometry.imu()->history().mean(1e-9 * static_cast<double>(stamp),
+                                                        1e-9 * static_cast<double>(stamp) + 0.1).has_value()) << k;
+  }
+  replay.can.stop();
+  const MotionAidCounts& counts = replay.odometry.counts();
+  // No wheels: no prior and nothing counted missing; the up needs the wheels' acceleration.
+  EXPECT_EQ(counts.wheel_priors + counts.scans_without_wheels, 0U);
+  EXPECT_EQ(counts.gravity_priors + counts.scans_without_gravity, 0U);
+  EXPECT_GT(replay.can.imu_stats().gyro_samples.load(), 100U);
+}
+
 }  // namespace
 }  // namespace adit::daemon

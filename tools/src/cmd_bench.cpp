@@ -122,12 +122,13 @@ int bench_odometry(const BenchOptions& o) {
   if (!o.config_file.empty()) {
     payload = config::load_config(o.config_file);
     config = daemon::odometry_config_of(payload, config, most_points);
-    if (payload.can.enabled && payload.wheel_odometry.enabled) {
+    const bool can_imu = payload.imu.enabled && payload.imu.source == config::ImuSource::can;
+    if (payload.can.enabled && (payload.wheel_odometry.enabled || can_imu)) {
       can = std::make_unique<daemon::CanFeed>(payload);
       can->start({});
     }
-    fmt::print("payload: {} (body frame; {}{})\n", o.config_file, can ? "CAN wheels" : "no wheels",
-               can && payload.imu.enabled ? " and accelerometer" : "");
+    fmt::print("payload: {} (body frame; {}{})\n", o.config_file, can && can->has_wheels() ? "CAN wheels" : "no wheels",
+               can && can->has_imu() ? (payload.imu.gyro_x_signal.empty() ? ", CAN accelerometer" : ", CAN IMU") : "");
   }
   const double rss_before = resident_mb();
   daemon::ScanOdometry odometry(payload, config, can.get(), [] { return true; });
@@ -160,13 +161,19 @@ int bench_odometry(const BenchOptions& o) {
     can->stop();
     const daemon::CanFeedStats& feed = can->stats();
     const daemon::MotionAidCounts& counts = odometry.counts();
-    fmt::print("wheels: {} samples ({} not trusted; {} wheel slips held); {} scans with their prior, {} outside the "
-               "wheel log on constant velocity; the prior disagreed with the scan on {} scans (constant velocity used)\n",
-               feed.samples.load(), feed.untrusted.load(), feed.slip_episodes.load(), counts.wheel_priors,
-               counts.scans_without_wheels, wheel_rejected);
-    if (payload.imu.enabled)
-      fmt::print("accelerometer: {} readings; gravity's up held {} scans, {} without\n", feed.imu_samples.load(),
-                 counts.gravity_priors, counts.scans_without_gravity);
+    if (can->has_wheels())
+      fmt::print("wheels: {} samples ({} not trusted; {} wheel slips held); {} scans with their prior, {} outside the "
+                 "wheel log on constant velocity; the prior disagreed with the scan on {} scans (constant velocity used)\n",
+                 feed.samples.load(), feed.untrusted.load(), feed.slip_episodes.load(), counts.wheel_priors,
+                 counts.scans_without_wheels, wheel_rejected);
+    if (can->has_imu()) {
+      const daemon::ImuStats& imu = can->imu_stats();
+      fmt::print("IMU: {} readings ({} with gyro) at {:.1f} Hz; gravity's up held {} scans, {} without\n",
+                 imu.samples.load(), imu.gyro_samples.load(), imu.rate_hz.load(), counts.gravity_priors,
+                 counts.scans_without_gravity);
+      if (const std::string problems = daemon::describe_problems(imu, "can"); !problems.empty())
+        fmt::print("{}\n", problems);
+    }
   }
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "

@@ -4,6 +4,7 @@
 
 #include <stdlib.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -89,6 +90,17 @@ int replay(const ReplayOptions& o) {
   } else {
     fmt::print("replay of {} ({})\n{}", source_of(config), config.lidar.model, figures_text(figures, o.memory_from));
     if (!o.out.empty()) fmt::print("trajectory: {} ({} poses)\n", o.out, figures.poses - figures.invalid_poses);
+    if (config.imu.enabled) {
+      const daemon::ImuStats& imu = pipeline.stats().imu;
+      const char* source = config.imu.source == config::ImuSource::ouster ? "ouster" : "can";
+      fmt::print("imu {}: {} packets or frames, {} readings ({} with gyro) at {:.1f} Hz{}\n", source,
+                 imu.packets.load(), imu.samples.load(), imu.gyro_samples.load(), imu.rate_hz.load(),
+                 std::isfinite(imu.clock_spread_s.load())
+                     ? fmt::format(", IMU packets' clock {:+.4f} s from the LiDAR's", imu.clock_spread_s.load())
+                     : std::string());
+      if (const std::string problems = daemon::describe_problems(imu, source); !problems.empty())
+        fmt::print("{}\n", problems);
+    }
   }
   if (figures.scans == 0) throw InputError(source_of(config), "lidar.model", "no scans decoded: is it a " + config.lidar.model + " capture?");
   return kExitOk;

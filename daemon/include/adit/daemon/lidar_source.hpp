@@ -4,7 +4,10 @@
 // In:   UDP datagrams (live), a pcap file or a directory of scans (replay).
 // Out:  scans in the sensor frame with per-point times (ScanSlot) through
 //       scans(), each with when its last packet arrived; the raw packets as
-//       pcap when a record file is open.
+//       pcap when a record file is open. With `imu.source: ouster`, the
+//       sensor's IMU packets (its IMU port, 7503, in the same pcap or on a
+//       socket of their own) go through the same packet pool to imu()
+//       (OusterImu), and are recorded with the LiDAR's on their own port.
 // Threads: "receiver" reads the source into a pool of packets and records
 // them; "assembly" decodes the packets and cuts scans (drivers::DecodeStream).
 // A scan directory needs no assembly: the receiver hands its scans on. Live,
@@ -26,6 +29,8 @@
 #include "adit/daemon/stage_thread.hpp"
 
 namespace adit::daemon {
+
+class OusterImu;
 
 class LidarSource {
  public:
@@ -50,6 +55,9 @@ class LidarSource {
   Overflow overflow() const { return overflow_; }
   // The most points one scan can hold: the hand-offs after this stage reserve it.
   std::size_t max_points_per_scan() const { return max_points_; }
+
+  // The Ouster's IMU (imu.source ouster), or null.
+  OusterImu* imu();
 
   std::vector<StageThread*> threads();
   std::size_t packets_waiting() const;

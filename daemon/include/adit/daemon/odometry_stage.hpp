@@ -1,8 +1,8 @@
 #pragma once
 // The pipeline's odometry stage: scans in, poses out.
 //
-// In:   ScanSlot from the LiDAR source (sensor frame), and the CAN feed's
-//       wheel and accelerometer samples when configured.
+// In:   ScanSlot from the LiDAR source (sensor frame), the CAN feed's wheel
+//       samples and the IMU source's readings (CAN or Ouster) when configured.
 // Out:  every scan's result (PoseSlot) to the output stage; each valid scan's
 //       body-frame points, times and intensities with its pose (MapSlot) to
 //       the mapping stage when mapping is on.
@@ -29,8 +29,8 @@ class OdometryStage {
   // `max_points`: the most points a scan can hold (the map hand-off reserves
   // it); `overflow`: the map hand-off's policy (the source's).
   OdometryStage(const config::Config& config, const slam::OdometryConfig& odometry, Handoff<ScanSlot>& scans,
-                CanFeed* can, bool mapping, std::size_t max_points, Overflow overflow, PipelineStats& stats,
-                PipelineTimings& timings, const std::atomic<bool>& stop);
+                CanFeed* can, ImuSource* imu, bool mapping, std::size_t max_points, Overflow overflow,
+                PipelineStats& stats, PipelineTimings& timings, const std::atomic<bool>& stop);
 
   void start();
   void join() { thread_.join(); }
@@ -42,6 +42,8 @@ class OdometryStage {
   // First and last scan stamps (after join()).
   std::int64_t first_stamp_ns() const { return first_stamp_ns_; }
   std::int64_t last_stamp_ns() const { return last_stamp_ns_; }
+  // The IMU source's figures into the pipeline's stats (the odometry thread after each scan; anyone after join()).
+  void copy_imu_stats();
 
  private:
   void loop();

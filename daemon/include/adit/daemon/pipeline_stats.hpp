@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "adit/daemon/imu_stats.hpp"
+
 namespace adit::daemon {
 
 // Statistics, readable while running (atomics) and complete after join().
@@ -45,7 +47,11 @@ struct PipelineStats {
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
   std::atomic<std::uint64_t> gravity_priors{0};        // scans registered with the accelerometer's up
-  std::atomic<std::uint64_t> scans_without_gravity{0}; // IMU configured, but no readings or not gravity-sized
+  std::atomic<std::uint64_t> scans_without_gravity{0}; // IMU and wheels configured, but no readings or not gravity-sized
+  // The IMU source's figures (imu.enabled; imu_stats.hpp: rate, gaps,
+  // saturation, stuck axes, time going back, clock offsets), copied from the
+  // source by the odometry thread after each scan and at the end.
+  ImuStats imu;
 };
 
 // A stage's queue and its thread's CPU time, for the status message.

@@ -2,11 +2,14 @@
 // One LiDAR scan to one pose, as aditd's odometry stage runs it and as
 // `adit bench odometry` measures it: the scan's points from the sensor frame
 // to the body frame (lidar.extrinsics) with their firing times in seconds,
-// the wheels' motion prior and the accelerometer's gravity from the CAN feed
-// when one is configured (slam/motion_history.hpp, slam/gravity.hpp), then
-// slam::Odometry. Thread-free: it runs on its caller's thread and waits only
-// for a replayed CAN log to catch up with the scan. No allocation per scan
-// after construction.
+// the wheels' motion prior from the CAN feed and the accelerometer's gravity
+// from the IMU source (CAN or Ouster, imu_source.hpp) when configured
+// (slam/motion_history.hpp, slam/gravity.hpp), then slam::Odometry. The
+// gravity prior needs the wheels' acceleration to remove: without wheels the
+// IMU's readings are kept in its history (with the gyroscope's) but give no
+// prior yet. Thread-free: it runs on its caller's thread and waits only for
+// a replayed CAN log or pcap's IMU to catch up with the scan. No allocation
+// per scan after construction.
 
 #include <cstdint>
 #include <functional>
@@ -18,6 +21,7 @@
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/imu_source.hpp"
 #include "adit/drivers/lidar/point.hpp"
 #include "adit/slam/motion_history.hpp"
 #include "adit/slam/odometry.hpp"
@@ -34,16 +38,21 @@ struct MotionAidCounts {
   std::uint64_t wheel_priors = 0;           // scans registered with the wheels' prior
   std::uint64_t scans_without_wheels = 0;   // wheels configured, but no samples around the scan
   std::uint64_t gravity_priors = 0;         // scans registered with the accelerometer's up
-  std::uint64_t scans_without_gravity = 0;  // IMU configured, but no readings or not gravity-sized
+  std::uint64_t scans_without_gravity = 0;  // IMU and wheels configured, but no readings or not gravity-sized
 };
 
 class ScanOdometry {
  public:
-  // `can`: the CAN feed (wheels, accelerometer), or null. `idle` is called
-  // while a replayed CAN log lags the scan: it beats the caller's heartbeat
-  // and returns false to stop waiting.
-  ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
+  // `can`: the CAN feed (wheels, and an IMU with imu.source can), or null;
+  // `imu`: the IMU source (the CAN feed itself, or the Ouster's), or null.
+  // `idle` is called while a replayed source lags the scan: it beats the
+  // caller's heartbeat and returns false to stop waiting.
+  ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can, ImuSource* imu,
                std::function<bool()> idle);
+  // The CAN feed's own IMU, if it has one.
+  ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
+               std::function<bool()> idle)
+      : ScanOdometry(config, odometry, can, can != nullptr && can->has_imu() ? can : nullptr, std::move(idle)) {}
 
   const slam::OdometryResult& process(const drivers::LidarScan& scan);
 
@@ -52,9 +61,11 @@ class ScanOdometry {
   std::span<const float> body_times() const { return body_times_; }
   double registration_ms() const { return registration_ms_; }  // slam::Odometry::process, last scan
   const MotionAidCounts& counts() const { return counts_; }
+  // The IMU the odometry reads (its readings, mounting and stats), or null.
+  const ImuSource* imu() const { return imu_; }
 
  private:
-  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns, float sweep_s);
+  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns);
   std::optional<slam::UpMeasurement> up_for(std::int64_t stamp_ns, float sweep_s);
 
   static constexpr double kSpeedHalfWindow_s = 0.05;  // the wheels' speed: central differences over ±50 ms
@@ -62,11 +73,10 @@ class ScanOdometry {
   slam::Odometry odometry_;
   Eigen::Isometry3f extrinsic_;
   CanFeed* can_;
-  bool imu_;
+  bool wheels_;
+  ImuSource* imu_;
   double gravity_sigma_rad_;
   std::function<bool()> idle_;
-  slam::WheelHistory wheel_history_{8192};  // 80 s at 100 Hz
-  slam::ImuHistory imu_history_{4096};      // 40 s at 100 Hz
   double previous_stamp_s_ = 0.0;
   std::vector<Eigen::Vector3f> body_points_;
   std::vector<float> body_times_;

@@ -127,6 +127,10 @@ struct ImuSection {
   std::array<double, 3> rpy_deg{0.0, 0.0, 0.0};     // the IMU's axes in the body frame (roll, pitch, yaw)
   std::array<double, 3> position_m{0.0, 0.0, 0.0};  // the IMU's origin in the body frame (lever arm)
   double time_offset_s = 0.0;            // IMU clock minus LiDAR clock
+  // The unit's measuring range: a reading at or beyond it is counted
+  // saturated (besides one at its CAN signal's encoding limit); 0 = no range.
+  double accel_range_mps2 = 0.0;
+  double gyro_range_radps = 0.0;
   double gravity_sigma_deg = 0.2;        // the odometry's trust in the measured up, per scan
   double gyro_noise_density = 1.7e-4;    // rad/s/√Hz
   double accel_noise_density = 2.0e-3;   // m/s²/√Hz
