@@ -11,6 +11,7 @@ packages=(
   clang libclang-rt-14-dev
   # libraries
   libeigen3-dev          # geometry and linear algebra
+  libceres-dev           # the loop-closure pose graph
   libyaml-cpp-dev        # payload configuration
   libspdlog-dev libfmt-dev  # logging, formatting
   libcli11-dev           # command-line options of aditd and adit

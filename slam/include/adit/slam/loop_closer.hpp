@@ -1,0 +1,108 @@
+#pragma once
+// Loop closure over keyframes, one keyframe at a time: Scan Context place
+// recognition gated by the graph's uncertainty (place_recognition.hpp),
+// verification by registration (loop_verification.hpp), the false-loop guard
+// (loop_consistency.hpp) and the Ceres pose graph (pose_graph_solver.hpp).
+// Pure and single-threaded: aditd runs it on its own low-priority thread
+// (daemon/src/loop_closure_stage.cpp); tests and tools call it directly.
+//
+// The keyframes' poses come from the mapping stage (its refined "map" poses,
+// called odometry here: the frame the graph corrects). The graph's estimate
+// of keyframe k, G_k, starts as G_{k-1}·(O_{k-1}⁻¹·O_k); the correction
+// map→odometry is G_k·O_k⁻¹ of the newest keyframe.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/slam/loop_consistency.hpp"
+#include "adit/slam/loop_verification.hpp"
+#include "adit/slam/place_recognition.hpp"
+#include "adit/slam/pose_graph.hpp"
+#include "adit/slam/pose_graph_solver.hpp"
+#include "adit/slam/scan_context.hpp"
+
+namespace adit::slam {
+
+struct LoopClosureConfig {
+  ScanContextConfig descriptor;
+  PlaceRecognitionConfig search;
+  LoopVerificationConfig verification;
+  ConsistencyConfig consistency;
+  PoseGraphSolverConfig solver;
+  OdometryNoise odometry;
+  int submap_keyframes = 5;          // each side of the candidate go into its submap
+  float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
+  float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
+  double gravity_sigma_rad = 0.0;    // > 0: a roll/pitch prior per keyframe with an `up`
+};
+
+// One candidate's fate, for the log and summary.json.
+struct LoopEvent {
+  std::size_t query = 0;
+  std::size_t candidate = 0;
+  double descriptor_distance = 0.0;
+  std::string outcome;  // a LoopVerdict's name, or "inconsistent", "waiting", "accepted"
+  double inlier_ratio = 0.0;
+  double rmse_m = 0.0;
+  double conditioning = 0.0;
+};
+
+struct LoopClosureStats {
+  std::size_t keyframes = 0;
+  std::size_t candidates = 0;             // found by place recognition
+  std::size_t verified = 0;               // passed registration
+  std::size_t accepted = 0;               // in the graph
+  std::size_t rejected_verification = 0;  // failed registration (overlap, fit, conditioning, ambiguity)
+  std::size_t rejected_inconsistent = 0;  // failed the guard
+  std::size_t optimizations = 0;
+  double last_optimization_s = 0.0;
+};
+
+class LoopCloser {
+ public:
+  explicit LoopCloser(const LoopClosureConfig& config = {});
+
+  // Adds a keyframe (`points` in its body frame) and closes what loops it
+  // can. Returns true when the graph was optimised (the poses moved).
+  bool add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
+                    std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body = {});
+
+  // The graph's estimate of every keyframe, in order.
+  const std::vector<Eigen::Isometry3d>& poses() const { return graph_.nodes; }
+  const std::vector<Eigen::Isometry3d>& odometry_poses() const { return odometry_; }
+  const std::vector<std::int64_t>& stamps() const { return stamps_; }
+  // map→odometry: G·O⁻¹ of the newest keyframe (identity before any loop).
+  Eigen::Isometry3d correction() const;
+  // G·O⁻¹ at time t: interpolated between the keyframes around it (held
+  // beyond the ends), for scans between keyframes.
+  Eigen::Isometry3d correction_at(std::int64_t stamp_ns) const;
+  const LoopClosureStats& stats() const { return stats_; }
+  const std::vector<LoopEvent>& events() const { return events_; }
+  const PoseGraph& graph() const { return graph_; }
+  // A last optimisation of the whole graph (session end).
+  void refine();
+
+ private:
+  bool try_candidate(const LoopCandidate& candidate);
+
+  LoopClosureConfig config_;
+  PoseGraph graph_;
+  LoopGuard guard_;
+  std::vector<Eigen::Isometry3d> odometry_;
+  std::vector<std::int64_t> stamps_;
+  std::vector<std::vector<Eigen::Vector3f>> points_;
+  std::vector<std::vector<Eigen::Vector3f>> query_points_;
+  std::vector<ScanContext> descriptors_;
+  std::vector<double> path_m_;
+  std::vector<double> variance_;
+  LoopClosureStats stats_;
+  std::vector<LoopEvent> events_;
+};
+
+}  // namespace adit::slam

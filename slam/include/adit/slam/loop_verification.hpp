@@ -1,0 +1,70 @@
+#pragma once
+// Geometric verification of a loop candidate: the query keyframe's scan is
+// registered (slam/registration.hpp, the odometry's own point-to-plane
+// Gauss-Newton, no prior) against a submap of the keyframes around the
+// candidate, placed in the candidate's frame by the graph. The loop is
+// accepted only when the registration
+//   - overlaps: inlier_ratio ≥ min_inlier_ratio (the share of the scan with a
+//     plane of the submap within reach; a person in front of the sensor or a
+//     different drift lowers it),
+//   - fits: the robust RMS of the point-to-plane residuals ≤ max_rmse_m,
+//   - is well conditioned: the data Hessian's weakest normalised eigenvalue
+//     ≥ min_conditioning (Zhang, Kaess & Singh, ICRA 2016: along a plain
+//     tunnel the translation along the axis is unobserved, so a registration
+//     "fits" anywhere along it; such a loop says nothing and is refused),
+//   - is unambiguous: registered from every initial guess (the graph's
+//     relative pose and Scan Context's two yaw readings), no two guesses
+//     converge to different poses that both pass (a symmetric or repetitive
+//     section matches two ways; neither is trusted).
+// The accepted measurement's covariance is the registration's, floored
+// (it is optimistic: Censi, ICRA 2007).
+
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/slam/lie.hpp"
+#include "adit/slam/registration.hpp"
+#include "adit/slam/voxel_hash_map.hpp"
+
+namespace adit::slam {
+
+struct LoopVerificationConfig {
+  float submap_voxel_m = 0.5F;          // as the refinement map (slam/map_refiner.hpp)
+  float submap_point_spacing_m = 0.1F;
+  std::size_t submap_capacity_voxels = std::size_t{1} << 16;
+  double max_distance_m = 1.5;          // correspondences: the guess may be the drift plus a yaw sector off
+  double kernel_scale_m = 0.5;
+  double min_inlier_ratio = 0.6;
+  double max_rmse_m = 0.08;
+  double min_conditioning = 0.02;       // twice the odometry's degeneracy threshold (RegistrationConfig)
+  double ambiguity_m = 0.5;             // two passing solutions this far apart: ambiguous
+  double ambiguity_rad = 0.1;
+  double covariance_floor_m = 0.05;     // σ added to the registration's
+  double covariance_floor_rad = 0.005;
+  RegistrationConfig registration;
+};
+
+enum class LoopVerdict { accepted, no_overlap, poor_fit, ill_conditioned, ambiguous };
+std::string_view to_string(LoopVerdict verdict);
+
+struct LoopVerification {
+  LoopVerdict verdict = LoopVerdict::no_overlap;
+  Eigen::Isometry3d relative = Eigen::Isometry3d::Identity();  // T_candidate⁻¹·T_query, measured
+  Matrix6d covariance = Matrix6d::Identity();                  // of `relative`, floored
+  RegistrationResult registration;                             // the best guess's
+  int passing_guesses = 0;
+};
+
+// Adds `points` (a keyframe's scan, its body frame) placed at `pose` into `submap`.
+void add_to_submap(VoxelHashMap& submap, std::span<const Eigen::Vector3f> points, const Eigen::Isometry3d& pose);
+
+// `query_points`: the query keyframe's scan (its body frame); `submap`: the
+// candidate's surroundings in the candidate's frame; `guesses`: initial
+// T_candidate⁻¹·T_query.
+LoopVerification verify_loop(std::span<const Eigen::Vector3f> query_points, const VoxelHashMap& submap,
+                             std::span<const Eigen::Isometry3d> guesses, const LoopVerificationConfig& config = {});
+
+}  // namespace adit::slam

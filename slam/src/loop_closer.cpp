@@ -1,0 +1,144 @@
+// Keyframe-by-keyframe loop closure (loop_closer.hpp).
+#include "adit/slam/loop_closer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "adit/slam/voxel_downsample.hpp"
+
+namespace adit::slam {
+namespace {
+
+Eigen::Isometry3d yawed(const Eigen::Isometry3d& guess, double yaw_rad) {
+  Eigen::Isometry3d g = guess;
+  g.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return g;
+}
+
+double yaw_of(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
+
+}  // namespace
+
+LoopCloser::LoopCloser(const LoopClosureConfig& config) : config_(config), guard_(config.consistency) {}
+
+bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
+                              std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body) {
+  const std::size_t k = graph_.nodes.size();
+  std::vector<Eigen::Vector3f> kept, query;
+  kept.reserve(points.size());
+  query.reserve(points.size());
+  VoxelDownsampler downsampler(points.size());
+  downsampler.downsample(points, config_.points_voxel_m, kept);
+  downsampler.downsample(points, config_.query_voxel_m, query);
+  descriptors_.push_back(make_scan_context(points, config_.descriptor));
+  if (k == 0) {
+    graph_.nodes.push_back(odometry_pose);
+    path_m_.push_back(0.0);
+    variance_.push_back(0.0);
+  } else {
+    const Eigen::Isometry3d motion = odometry_.back().inverse() * odometry_pose;
+    graph_.nodes.push_back(graph_.nodes.back() * motion);
+    const Matrix6d information = odometry_information(motion, config_.odometry);
+    graph_.edges.push_back({k - 1, k, motion, information, EdgeKind::odometry});
+    path_m_.push_back(path_m_.back() + motion.translation().norm());
+    variance_.push_back(variance_.back() + 1.0 / information(0, 0));
+  }
+  if (up_body && config_.gravity_sigma_rad > 0.0)
+    graph_.gravity.push_back({k, *up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad)});
+  odometry_.push_back(odometry_pose);
+  stamps_.push_back(stamp_ns);
+  points_.push_back(std::move(kept));
+  query_points_.push_back(std::move(query));
+  ++stats_.keyframes;
+
+  const KeyframeIndexView view{descriptors_, graph_.nodes, path_m_, variance_};
+  const std::vector<LoopCandidate> candidates = find_loop_candidates(k, view, config_.search);
+  stats_.candidates += candidates.size();
+  bool added = false;
+  for (const LoopCandidate& c : candidates) added = try_candidate(c) || added;
+  if (!added) return false;
+  const PoseGraphSolution solution = optimize(graph_, config_.solver);
+  ++stats_.optimizations;
+  stats_.last_optimization_s = solution.time_s;
+  return true;
+}
+
+bool LoopCloser::try_candidate(const LoopCandidate& c) {
+  LoopEvent event{c.query, c.candidate, c.descriptor_distance, "", 0.0, 0.0, 0.0};
+  // The candidate's surroundings in its own frame, by the graph.
+  VoxelHashMap submap(config_.verification.submap_voxel_m, config_.verification.submap_capacity_voxels,
+                      config_.verification.submap_point_spacing_m);
+  const std::size_t w = static_cast<std::size_t>(std::max(0, config_.submap_keyframes));
+  const std::size_t first = c.candidate >= w ? c.candidate - w : 0;
+  const std::size_t last = std::min(c.candidate + w, c.query - 1);
+  const Eigen::Isometry3d candidate_inverse = graph_.nodes[c.candidate].inverse();
+  for (std::size_t m = first; m <= last; ++m) {
+    if (path_m_[c.query] - path_m_[m] < config_.search.min_path_separation_m) continue;  // not the query's own past
+    add_to_submap(submap, points_[m], candidate_inverse * graph_.nodes[m]);
+  }
+  // Guesses: the graph's; Scan Context's yaw at the graph's position, and its
+  // other reading when the descriptor finds that one plausible as well.
+  const Eigen::Isometry3d graph_guess = candidate_inverse * graph_.nodes[c.query];
+  std::vector<Eigen::Isometry3d> guesses{graph_guess};
+  if (std::abs(std::remainder(c.yaw_rad - yaw_of(graph_guess), 2.0 * M_PI)) > 0.05)
+    guesses.push_back(yawed(graph_guess, c.yaw_rad));
+  const ScanContextMatch m = compare(descriptors_[c.query], descriptors_[c.candidate]);
+  if (m.alternative_distance <= config_.search.max_descriptor_distance)
+    guesses.push_back(yawed(graph_guess, c.alternative_yaw_rad));
+  const LoopVerification v = verify_loop(query_points_[c.query], submap, guesses, config_.verification);
+  event.inlier_ratio = v.registration.inlier_ratio;
+  event.rmse_m = v.registration.rmse_m;
+  event.conditioning = v.registration.weakest_eigenvalue;
+  if (v.verdict != LoopVerdict::accepted) {
+    ++stats_.rejected_verification;
+    event.outcome = std::string(to_string(v.verdict));
+    events_.push_back(event);
+    return false;
+  }
+  ++stats_.verified;
+  const double sigma_m = std::sqrt(v.covariance.block<3, 3>(0, 0).diagonal().maxCoeff());
+  const LoopConstraint loop{c.candidate, c.query, v.relative, sigma_m};
+  GuardDecision decision = GuardDecision::waiting;
+  const std::vector<LoopConstraint> newly = guard_.submit(loop, graph_.nodes, variance_, decision);
+  event.outcome = decision == GuardDecision::accepted ? "accepted"
+                  : decision == GuardDecision::waiting ? "waiting"
+                                                       : "inconsistent";
+  if (decision == GuardDecision::rejected) ++stats_.rejected_inconsistent;
+  events_.push_back(event);
+  Matrix6d information = v.covariance.inverse();
+  for (const LoopConstraint& l : newly) {
+    graph_.edges.push_back({l.from, l.to, l.measurement, information, EdgeKind::loop});
+    ++stats_.accepted;
+  }
+  return !newly.empty();
+}
+
+Eigen::Isometry3d LoopCloser::correction() const {
+  if (graph_.nodes.empty()) return Eigen::Isometry3d::Identity();
+  return graph_.nodes.back() * odometry_.back().inverse();
+}
+
+Eigen::Isometry3d LoopCloser::correction_at(std::int64_t stamp_ns) const {
+  if (stamps_.empty()) return Eigen::Isometry3d::Identity();
+  const auto it = std::lower_bound(stamps_.begin(), stamps_.end(), stamp_ns);
+  if (it == stamps_.begin()) return graph_.nodes.front() * odometry_.front().inverse();
+  if (it == stamps_.end()) return correction();
+  const auto b = static_cast<std::size_t>(it - stamps_.begin());
+  const std::size_t a = b - 1;
+  const Eigen::Isometry3d Ca = graph_.nodes[a] * odometry_[a].inverse();
+  const Eigen::Isometry3d Cb = graph_.nodes[b] * odometry_[b].inverse();
+  const double s = static_cast<double>(stamp_ns - stamps_[a]) / static_cast<double>(std::max<std::int64_t>(1, stamps_[b] - stamps_[a]));
+  return Ca * exp_se3(s * log_se3(Ca.inverse() * Cb));
+}
+
+void LoopCloser::refine() {
+  if (graph_.loop_count() == 0) return;
+  PoseGraphSolverConfig batch = config_.solver;
+  batch.max_iterations = std::max(batch.max_iterations, 200);
+  batch.max_time_s = std::max(batch.max_time_s, 10.0);
+  const PoseGraphSolution solution = optimize(graph_, batch);
+  ++stats_.optimizations;
+  stats_.last_optimization_s = solution.time_s;
+}
+
+}  // namespace adit::slam

@@ -1,0 +1,71 @@
+#pragma once
+// The pose graph's factors as Ceres auto-differentiated cost functors
+// (private to slam/: only pose_graph_solver.cpp sees Ceres). A pose is a unit
+// quaternion q (Eigen's x, y, z, w order, on ceres::EigenQuaternionManifold)
+// and a translation p.
+
+#include <cmath>
+
+#include <ceres/ceres.h>
+#include <Eigen/Geometry>
+
+#include "adit/slam/lie.hpp"
+
+namespace adit::slam::detail {
+
+// Relative pose (as the SE(3) pose-graph residual of Carlone et al., ICRA
+// 2015, §II, in the quaternion form of Ceres's pose_graph_3d example):
+//   p̂ = R_a⁻¹(p_b − p_a),  q̂ = q_a⁻¹·q_b
+//   e = [p̂ − p_z ; 2·vec(q_z⁻¹·q̂)]        (2·vec ≈ the rotation vector for small errors)
+// whitened by the square root of the information, L with LᵀL = Λ.
+struct RelativePoseFactor {
+  RelativePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information)
+      : p_z(z.translation()), q_z(z.linear()), L(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* qa_, const T* pa_, const T* qb_, const T* pb_, T* r_) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qa(qa_), qb(qb_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pa(pa_), pb(pb_);
+    const Eigen::Quaternion<T> qa_inv = qa.conjugate();
+    const Eigen::Matrix<T, 3, 1> p_hat = qa_inv * (pb - pa);
+    const Eigen::Quaternion<T> q_err = q_z.template cast<T>().conjugate() * (qa_inv * qb);
+    Eigen::Matrix<T, 6, 1> e;
+    e << p_hat - p_z.template cast<T>(), T(2.0) * q_err.vec();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(r_);
+    r = L.template cast<T>() * e;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information) {
+    // Ceres takes ownership of the functor and the cost function (its API).
+    return new ceres::AutoDiffCostFunction<RelativePoseFactor, 6, 4, 3, 4, 3>(
+        new RelativePoseFactor(z, sqrt_information));
+  }
+
+  Eigen::Vector3d p_z;
+  Eigen::Quaterniond q_z;
+  Matrix6d L;
+};
+
+// Gravity: R·u_b − e_z, as the registration's gravity term
+// (slam/registration.hpp, GravityPrior); yaw is free.
+struct GravityFactor {
+  GravityFactor(const Eigen::Vector3d& up_body, double sqrt_information) : u_b(up_body), s(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* q_, T* r_) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(r_);
+    r = T(s) * (q * u_b.template cast<T>() - Eigen::Matrix<T, 3, 1>::UnitZ());
+    return true;
+  }
+
+  static ceres::CostFunction* create(const Eigen::Vector3d& up_body, double information) {
+    return new ceres::AutoDiffCostFunction<GravityFactor, 3, 4>(new GravityFactor(up_body, std::sqrt(information)));
+  }
+
+  Eigen::Vector3d u_b;
+  double s;
+};
+
+}  // namespace adit::slam::detail

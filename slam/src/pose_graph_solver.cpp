@@ -1,0 +1,83 @@
+// Ceres optimisation of a pose graph (pose_graph_solver.hpp).
+#include "adit/slam/pose_graph_solver.hpp"
+
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "pose_graph_factors.hpp"
+
+namespace adit::slam {
+namespace {
+
+Matrix6d sqrt_information(const Matrix6d& information) {
+  // Λ = LLᵀ (Cholesky), whitening with Lᵀ: eᵀΛe = |Lᵀe|².
+  const Eigen::LLT<Matrix6d> llt(information);
+  return llt.matrixL().transpose();
+}
+
+}  // namespace
+
+PoseGraphSolution optimize(PoseGraph& graph, const PoseGraphSolverConfig& config) {
+  PoseGraphSolution solution;
+  const std::size_t n = graph.nodes.size();
+  if (n < 2) {
+    solution.converged = true;
+    return solution;
+  }
+  // Parameters: per node a quaternion (x, y, z, w) and a translation.
+  std::vector<Eigen::Quaterniond> q(n);
+  std::vector<Eigen::Vector3d> p(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    q[i] = Eigen::Quaterniond(graph.nodes[i].linear()).normalized();
+    p[i] = graph.nodes[i].translation();
+  }
+  ceres::Problem problem;
+  for (const PoseGraphEdge& e : graph.edges) {
+    if (e.from >= n || e.to >= n || e.from == e.to) continue;
+    ceres::LossFunction* loss =
+        e.kind == EdgeKind::loop ? new ceres::CauchyLoss(config.loop_kernel_scale) : nullptr;  // owned by problem
+    problem.AddResidualBlock(detail::RelativePoseFactor::create(e.measurement, sqrt_information(e.information)), loss,
+                             q[e.from].coeffs().data(), p[e.from].data(), q[e.to].coeffs().data(), p[e.to].data());
+  }
+  for (const GravityPriorEdge& g : graph.gravity) {
+    if (g.node >= n || g.information <= 0.0) continue;
+    problem.AddResidualBlock(detail::GravityFactor::create(g.up_body, g.information), nullptr, q[g.node].coeffs().data());
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!problem.HasParameterBlock(q[i].coeffs().data())) {
+      problem.AddParameterBlock(q[i].coeffs().data(), 4);
+      problem.AddParameterBlock(p[i].data(), 3);
+    }
+    problem.SetManifold(q[i].coeffs().data(), new ceres::EigenQuaternionManifold);  // owned by problem
+  }
+  problem.SetParameterBlockConstant(q[0].coeffs().data());
+  problem.SetParameterBlockConstant(p[0].data());
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = config.max_iterations;
+  options.max_solver_time_in_seconds = config.max_time_s;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  solution.converged = summary.termination_type == ceres::CONVERGENCE;
+  solution.iterations = static_cast<int>(summary.iterations.size());
+  solution.initial_cost = summary.initial_cost;
+  solution.final_cost = summary.final_cost;
+  solution.time_s = summary.total_time_in_seconds;
+  for (std::size_t i = 0; i < n; ++i) {
+    graph.nodes[i].linear() = q[i].normalized().toRotationMatrix();
+    graph.nodes[i].translation() = p[i];
+  }
+  for (const PoseGraphEdge& e : graph.edges) {
+    if (e.kind != EdgeKind::loop || e.from >= n || e.to >= n) continue;
+    const Eigen::Isometry3d err = e.measurement.inverse() * graph.nodes[e.from].inverse() * graph.nodes[e.to];
+    const Vector6d v = log_se3(err);
+    solution.loop_residuals.push_back(std::sqrt(v.dot(e.information * v)));
+  }
+  return solution;
+}
+
+}  // namespace adit::slam

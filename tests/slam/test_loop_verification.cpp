@@ -1,0 +1,133 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "adit/slam/loop_consistency.hpp"
+#include "adit/slam/loop_verification.hpp"
+#include "loop_scenes.hpp"
+#include "synthetic_scenes.hpp"
+
+namespace adit::slam {
+namespace {
+
+Eigen::Isometry3d at(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() << x, y, 0.0;
+  return T;
+}
+
+// The candidate's submap: `world` seen from `candidate`, in its frame.
+VoxelHashMap submap_of(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& candidate, unsigned seed) {
+  const LoopVerificationConfig config;
+  VoxelHashMap submap(config.submap_voxel_m, config.submap_capacity_voxels, config.submap_point_spacing_m);
+  for (int i = 0; i < 3; ++i) add_to_submap(submap, test::scan_of(world, candidate, seed + i), Eigen::Isometry3d::Identity());
+  return submap;
+}
+
+const std::vector<Eigen::Vector3f>& ring_world() {
+  static const std::vector<Eigen::Vector3f> world = test::ring_corridor(30.0F, 40, 11);
+  return world;
+}
+
+// A revisit 0.4 m and 4° from where the graph puts it: registered, accepted,
+// measured within 3 cm and 0.3°.
+TEST(LoopVerification, ARevisitWithPillarsIsAcceptedAndMeasured) {
+  const Eigen::Isometry3d candidate = at(12.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = at(12.8, -0.4, 0.03);
+  const Eigen::Isometry3d truth = candidate.inverse() * query;
+  const Eigen::Isometry3d guess = truth * at(0.3, 0.25, 4.0 * M_PI / 180);
+  const LoopVerification v =
+      verify_loop(test::scan_of(ring_world(), query, 21), submap_of(ring_world(), candidate, 30), std::span(&guess, 1));
+  ASSERT_EQ(v.verdict, LoopVerdict::accepted) << to_string(v.verdict) << " inliers " << v.registration.inlier_ratio
+                                              << " rmse " << v.registration.rmse_m << " cond "
+                                              << v.registration.weakest_eigenvalue;
+  const Eigen::Isometry3d e = truth.inverse() * v.relative;
+  EXPECT_LT(e.translation().norm(), 0.03);
+  EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 0.3 * M_PI / 180);
+}
+
+// A deliberately wrong candidate in a plain, symmetric tunnel: 10 m further
+// along it registers with a fine fit (every stretch of the tunnel looks the
+// same), but the axis is unobserved: refused, whatever the guess.
+TEST(LoopVerification, AWrongCandidateInAPlainTunnelIsRefused) {
+  const std::vector<Eigen::Vector3f> tunnel = test::tunnel(120'000, 3, 200.0F);
+  const Eigen::Isometry3d candidate = at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = at(10.0, 0.0, 0.0);
+  const std::vector<Eigen::Isometry3d> guesses{candidate.inverse() * query * at(-10.0, 0, 0),  // "same place"
+                                               at(0.0, 0.0, M_PI)};                          // the reverse reading
+  const LoopVerification v =
+      verify_loop(test::scan_of(tunnel, query, 41), submap_of(tunnel, candidate, 50), guesses);
+  EXPECT_NE(v.verdict, LoopVerdict::accepted);
+  EXPECT_EQ(v.verdict, LoopVerdict::ill_conditioned) << to_string(v.verdict);
+  EXPECT_GT(v.registration.inlier_ratio, 0.6);  // it fit: only the conditioning tells
+}
+
+// A symmetric room (no pillars): turned half round it fits as well as
+// unturned. Two readings that both pass: ambiguous, refused.
+TEST(LoopVerification, TwoReadingsThatBothFitAreAmbiguous) {
+  const std::vector<Eigen::Vector3f> room = test::room(60'000, 5, 6.0F, 4.0F, 2.0F, false);
+  const Eigen::Isometry3d candidate = at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = at(0.2, 0.1, 0.05);
+  const std::vector<Eigen::Isometry3d> guesses{candidate.inverse() * query, at(0.2, 0.1, 0.05 + M_PI)};
+  const LoopVerification v = verify_loop(test::scan_of(room, query, 61), submap_of(room, candidate, 70), guesses);
+  EXPECT_EQ(v.passing_guesses, 2);
+  EXPECT_EQ(v.verdict, LoopVerdict::ambiguous) << to_string(v.verdict);
+}
+
+// The query is elsewhere (the other side of the ring): little overlap.
+TEST(LoopVerification, AnotherPlaceHasNoOverlap) {
+  const Eigen::Isometry3d candidate = at(12.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = at(12.0, 30.0, M_PI);
+  const Eigen::Isometry3d guess = at(0.0, 0.0, 0.0);
+  const LoopVerification v =
+      verify_loop(test::scan_of(ring_world(), query, 81), submap_of(ring_world(), candidate, 90), std::span(&guess, 1));
+  EXPECT_NE(v.verdict, LoopVerdict::accepted) << to_string(v.verdict);
+}
+
+// The guard: one loop waits for a witness; a second that agrees accepts
+// both; one 2 m off along the corridor disagrees and is rejected.
+TEST(LoopGuard, LoopsNeedAWitnessAndAWrongOneIsRejected) {
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<double> variance;
+  for (int k = 0; k < 100; ++k) {
+    poses.push_back(at(k < 50 ? k : 99 - k, 0.0, k < 50 ? 0.0 : M_PI));  // out 49 m and back
+    variance.push_back(k * 1e-4);
+  }
+  auto loop = [&](std::size_t from, std::size_t to, double error_m) {
+    return LoopConstraint{from, to, poses[from].inverse() * poses[to] * at(error_m, 0, 0), 0.05};
+  };
+  LoopGuard guard;
+  GuardDecision d = GuardDecision::accepted;
+  EXPECT_TRUE(guard.submit(loop(10, 89, 0.0), poses, variance, d).empty());
+  EXPECT_EQ(d, GuardDecision::waiting);
+  EXPECT_EQ(guard.submit(loop(11, 88, 0.02), poses, variance, d).size(), 2U);
+  EXPECT_EQ(d, GuardDecision::accepted);
+  EXPECT_TRUE(guard.submit(loop(12, 87, 2.0), poses, variance, d).empty());
+  EXPECT_EQ(d, GuardDecision::rejected);
+  EXPECT_EQ(guard.accepted().size(), 2U);
+  EXPECT_EQ(guard.rejected(), 1U);
+  EXPECT_TRUE(guard.submit(loop(13, 86, -0.03), poses, variance, d).size() == 1U);
+}
+
+// Consistency follows the odometry's uncertainty between the two loops:
+// 0.5 m of disagreement is too much for neighbours, not for loops 40 m apart
+// along an uncertain path.
+TEST(LoopGuard, PairwiseConsistencyScalesWithTheOdometryBetween) {
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<double> tight, loose;
+  for (int k = 0; k < 200; ++k) {
+    poses.push_back(at(k, 0.0, 0.0));
+    tight.push_back(k * 1e-5);
+    loose.push_back(k * 5e-3);
+  }
+  const LoopConstraint a{0, 100, poses[0].inverse() * poses[100], 0.05};
+  const LoopConstraint near{1, 101, poses[1].inverse() * poses[101] * at(0.5, 0, 0), 0.05};
+  const LoopConstraint far{40, 140, poses[40].inverse() * poses[140] * at(0.5, 0, 0), 0.05};
+  EXPECT_FALSE(pairwise_consistent(a, near, poses, tight));
+  EXPECT_FALSE(pairwise_consistent(a, far, poses, tight));
+  EXPECT_TRUE(pairwise_consistent(a, far, poses, loose));
+}
+
+}  // namespace
+}  // namespace adit::slam

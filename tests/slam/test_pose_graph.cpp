@@ -1,0 +1,114 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "adit/slam/pose_graph.hpp"
+#include "adit/slam/pose_graph_solver.hpp"
+
+namespace adit::slam {
+namespace {
+
+Eigen::Isometry3d pose(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() << x, y, 0.0;
+  return T;
+}
+
+// A 20 m square driven once, one node per metre (80 nodes, back at the start),
+// the odometry turning 0.1° too far per metre.
+struct Square {
+  std::vector<Eigen::Isometry3d> truth;
+  PoseGraph graph;
+};
+
+Square drifted_square() {
+  Square s;
+  for (int k = 0; k <= 80; ++k) {
+    const int side = std::min(k / 20, 3);
+    const double along = k - 20 * side;
+    const double yaw = side * M_PI / 2;
+    const Eigen::Vector2d corners[4] = {{0, 0}, {20, 0}, {20, 20}, {0, 20}};
+    const Eigen::Vector2d p = corners[side] + along * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+    s.truth.push_back(pose(p.x(), p.y(), k == 80 ? 2 * M_PI : yaw));
+  }
+  const Eigen::Isometry3d bias = pose(0, 0, 0.1 * M_PI / 180);
+  s.graph.nodes.push_back(s.truth[0]);
+  for (int k = 1; k <= 80; ++k) {
+    const Eigen::Isometry3d motion = s.truth[k - 1].inverse() * s.truth[k];
+    s.graph.edges.push_back({static_cast<std::size_t>(k - 1), static_cast<std::size_t>(k), motion * bias,
+                             odometry_information(motion), EdgeKind::odometry});
+    s.graph.nodes.push_back(s.graph.nodes.back() * motion * bias);
+  }
+  return s;
+}
+
+double end_error(const Square& s) { return (s.graph.nodes.back().translation() - s.truth.back().translation()).norm(); }
+
+Matrix6d loop_information() {
+  Vector6d d;
+  d << Eigen::Vector3d::Constant(1 / (0.05 * 0.05)), Eigen::Vector3d::Constant(1 / (0.005 * 0.005));
+  return d.asDiagonal();
+}
+
+TEST(PoseGraph, ALoopEdgeClosesTheSquare) {
+  Square s = drifted_square();
+  const double before = end_error(s);
+  s.graph.edges.push_back({0, 80, Eigen::Isometry3d::Identity(), loop_information(), EdgeKind::loop});
+  const PoseGraphSolution solution = optimize(s.graph);
+  EXPECT_TRUE(solution.converged);
+  EXPECT_LT(solution.final_cost, solution.initial_cost);
+  EXPECT_GT(before, 1.0);
+  EXPECT_LT(end_error(s), 0.05);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < s.truth.size(); ++k)
+    worst = std::max(worst, (s.graph.nodes[k].translation() - s.truth[k].translation()).norm());
+  EXPECT_LT(worst, 0.3 * before);  // the correction spreads along the loop
+  EXPECT_TRUE(s.graph.nodes[0].isApprox(s.truth[0], 1e-12));  // node 0 holds the frame
+}
+
+// Among right loops, one that says the end lies 8 m off: the Cauchy kernel
+// keeps the graph with the right ones and leaves the wrong one's residual large.
+TEST(PoseGraph, TheRobustKernelOutvotesAWrongLoop) {
+  Square s = drifted_square();
+  for (int k : {0, 1, 2, 3})
+    s.graph.edges.push_back({static_cast<std::size_t>(k), static_cast<std::size_t>(80 - k),
+                             s.truth[k].inverse() * s.truth[80 - k], loop_information(), EdgeKind::loop});
+  s.graph.edges.push_back({10, 80, s.truth[10].inverse() * s.truth[80] * pose(8.0, 0.0, 0.0), loop_information(),
+                           EdgeKind::loop});
+  const PoseGraphSolution solution = optimize(s.graph);
+  EXPECT_LT(end_error(s), 0.1);
+  ASSERT_EQ(solution.loop_residuals.size(), 5U);
+  for (int i = 0; i < 4; ++i) EXPECT_LT(solution.loop_residuals[i], 3.0);
+  EXPECT_GT(solution.loop_residuals[4], 50.0);
+}
+
+// Odometry that tilts 0.05° per metre: the gravity prior keeps roll and pitch.
+TEST(PoseGraph, GravityHoldsRollAndPitch) {
+  PoseGraph graph;
+  graph.nodes.push_back(Eigen::Isometry3d::Identity());
+  Eigen::Isometry3d tilt = Eigen::Isometry3d::Identity();
+  tilt.linear() = Eigen::AngleAxisd(0.05 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  for (std::size_t k = 1; k <= 40; ++k) {
+    const Eigen::Isometry3d motion = pose(1.0, 0.0, 0.0) * tilt;
+    graph.edges.push_back({k - 1, k, motion, odometry_information(motion), EdgeKind::odometry});
+    graph.nodes.push_back(graph.nodes.back() * motion);
+    graph.gravity.push_back({k, Eigen::Vector3d::UnitZ(), 1.0 / (0.001 * 0.001)});
+  }
+  const double before = std::acos((graph.nodes.back().linear() * Eigen::Vector3d::UnitZ()).z());
+  optimize(graph);
+  const double after = std::acos(std::min(1.0, (graph.nodes.back().linear() * Eigen::Vector3d::UnitZ()).z()));
+  EXPECT_GT(before, 1.5 * M_PI / 180);
+  EXPECT_LT(after, 0.2 * M_PI / 180);
+}
+
+TEST(PoseGraph, OdometryInformationLoosensWithDistance) {
+  const Matrix6d near = odometry_information(pose(0.1, 0, 0));
+  const Matrix6d far = odometry_information(pose(5.0, 0, 0));
+  EXPECT_GT(near(0, 0), far(0, 0));
+  EXPECT_GT(near(5, 5), far(5, 5));
+}
+
+}  // namespace
+}  // namespace adit::slam
