@@ -132,6 +132,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   if (keyframe) {
     keyframe_downsampler_.downsample(deskewed_, static_cast<float>(config_.keyframe_voxel_m), keyframe_points_);
     keyframes_.push_back({slot.stamp_ns, map_pose, keyframe_points_});
+    if (loops_ != nullptr) loops_->push({slot.stamp_ns, map_pose, keyframe_points_});
     keyframe_bytes_ += sizeof(slam::Keyframe) + keyframes_.back().points.capacity() * sizeof(Eigen::Vector3f);
     stats_.keyframes.store(keyframes_.size(), std::memory_order_relaxed);
     stats_.keyframe_bytes.store(keyframe_bytes_, std::memory_order_relaxed);

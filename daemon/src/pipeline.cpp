@@ -8,6 +8,7 @@
 #include "adit/common/clock.hpp"
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/lidar_source.hpp"
+#include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/mapping_stage.hpp"
 #include "adit/daemon/ouster_imu.hpp"
 #include "adit/daemon/odometry_stage.hpp"
@@ -46,6 +47,10 @@ struct Pipeline::Impl {
         empty_map(slam::TiledMapConfig{}) {
     if (o.mapping)
       mapping.emplace(c, odometry_config, *odometry.map_scans(), source.max_points_per_scan(), o.sinks.tile, stats, stop);
+    if (mapping && c.map.loop_closure) {
+      loops.emplace(c, stats, stop);
+      mapping->feed_loops(&loops->input());
+    }
     open_files(o.trajectory_file, o.map_trajectory_file, o.record_file);
   }
 
@@ -61,7 +66,7 @@ struct Pipeline::Impl {
     out.push_back(&odometry.thread());
     out.push_back(&output.thread());
     if (mapping) out.push_back(&mapping->thread());
-    return out;
+    return out;  // not the loop-closure thread: a background thread is no watchdog matter
   }
 
   config::Config config;
@@ -74,6 +79,7 @@ struct Pipeline::Impl {
   OdometryStage odometry;
   OutputStage output;
   std::optional<MappingStage> mapping;
+  std::optional<LoopClosureStage> loops;
   slam::TiledVoxelMap empty_map;  // map() without mapping
   std::vector<slam::Keyframe> no_keyframes;
   mutable std::mutex warnings_mutex;  // start() writes, the status reads: never per item
@@ -104,6 +110,7 @@ void Pipeline::start(const SessionFiles& files) {
   i.started = true;
   i.started_ns = monotonic_ns();
   // Consumers first, so that each hand-off has its reader when its writer starts.
+  if (i.loops) i.loops->start();
   if (i.mapping) i.mapping->start();
   i.output.start();
   i.odometry.start();
@@ -119,6 +126,7 @@ void Pipeline::join() {
   i.odometry.join();
   i.output.join();
   if (i.mapping) i.mapping->join();
+  if (i.loops) i.loops->finish();  // drains the keyframes the mapping left, then a last optimisation
   if (i.can) i.can->stop();
   i.odometry.copy_imu_stats();  // the readings after the last scan too
   if (i.started) {
@@ -160,6 +168,7 @@ std::vector<StageLoad> Pipeline::loads() const {
 }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }
+const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &*impl_->loops : nullptr; }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;
@@ -169,6 +178,10 @@ std::vector<std::string> Pipeline::warnings() const {
   std::vector<std::string> out;
   for (const StageThread* t : impl_->threads()) {
     const std::vector<std::string> w = t->warnings();
+    out.insert(out.end(), w.begin(), w.end());
+  }
+  if (impl_->loops) {
+    const std::vector<std::string> w = impl_->loops->thread().warnings();
     out.insert(out.end(), w.begin(), w.end());
   }
   const std::lock_guard lock(impl_->warnings_mutex);

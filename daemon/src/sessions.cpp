@@ -21,6 +21,7 @@
 #include "adit/config/load.hpp"
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
+#include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/tum.hpp"
 
@@ -45,6 +46,51 @@ nlohmann::json imu_summary(const ImuStats& imu) {
           {"time_offset_s", imu.time_offset_s.load()},
           {"clock_spread_s", std::isfinite(spread) ? nlohmann::json(spread) : nlohmann::json(nullptr)},
           {"problems", problems}};
+}
+
+// summary.json's "loops": what loop closure found, accepted and refused, and
+// the correction the graph applied to the map (docs/LOOPS.md).
+nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::CorrectionTrack& track) {
+  if (loops == nullptr) return {{"enabled", false}};
+  const slam::LoopClosureStats& s = loops->closer().stats();
+  nlohmann::json by_outcome = nlohmann::json::object();
+  nlohmann::json events = nlohmann::json::array();
+  for (const slam::LoopEvent& e : loops->closer().events()) {
+    by_outcome[e.outcome] = by_outcome.value(e.outcome, 0) + 1;
+    if (events.size() < 200)  // the first ones; the counts cover all
+      events.push_back({{"query", e.query}, {"candidate", e.candidate}, {"descriptor_distance", e.descriptor_distance},
+                        {"outcome", e.outcome}, {"inlier_ratio", e.inlier_ratio}, {"rmse_m", e.rmse_m},
+                        {"conditioning", e.conditioning}});
+  }
+  const Eigen::Isometry3d last = track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back();
+  return {{"enabled", true},
+          {"keyframes", s.keyframes},
+          {"candidates", s.candidates},
+          {"verified", s.verified},
+          {"accepted", s.accepted},
+          {"rejected", s.rejected_verification + s.rejected_inconsistent},
+          {"rejected_by_verification", s.rejected_verification},
+          {"rejected_inconsistent", s.rejected_inconsistent},
+          {"waiting_unconfirmed", loops->closer().events().empty() ? 0 : by_outcome.value("waiting", 0)},
+          {"outcomes", by_outcome},
+          {"optimizations", s.optimizations},
+          {"last_optimization_s", s.last_optimization_s},
+          {"refine_s", loops->refine_time_s()},
+          {"correction", {{"last_translation_m", last.translation().norm()},
+                          {"last_rotation_deg", Eigen::AngleAxisd(last.linear()).angle() * 180.0 / M_PI},
+                          {"max_translation_m", track.max_translation_m()},
+                          {"max_rotation_deg", track.max_rotation_rad() * 180.0 / M_PI}}},
+          {"events", events}};
+}
+
+// The map follows the graph: each sample moves by the correction at its
+// scan's time (slam/correction_track.hpp).
+void correct(std::span<const slam::MapSample> in, const slam::CorrectionTrack& track, std::vector<slam::MapSample>& out) {
+  out.assign(in.begin(), in.end());
+  for (slam::MapSample& s : out) {
+    const Eigen::Isometry3d c = track.at(static_cast<std::int64_t>(std::llround(s.time_s * 1e9)));
+    s.position = (c * s.position.cast<double>()).cast<float>();
+  }
 }
 
 }  // namespace
@@ -229,6 +275,18 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                                     coords[i].z * config_.map.tile_size_m};
       for (std::size_t a = 0; a < 3; ++a) corner[a] = i == 0 ? c[a] : std::min(corner[a], c[a]);
     }
+    // With loop closure the map's points move by the graph's correction
+    // (only when a loop was accepted: otherwise the correction is identity).
+    const LoopClosureStage* loops = pipeline->loop_closure();
+    const slam::CorrectionTrack track = loops != nullptr ? loops->correction() : slam::CorrectionTrack{};
+    const bool corrected = loops != nullptr && loops->closer().stats().accepted > 0;
+    if (corrected) {  // the corner stays at or below every moved point
+      double reach = 0.0;
+      for (const slam::TileCoord& c : coords)
+        reach = std::max(reach, config_.map.tile_size_m * (std::abs(c.x) + std::abs(c.y) + std::abs(c.z) + 3.0));
+      const double margin = track.max_translation_m() + track.max_rotation_rad() * reach + 1.0;
+      for (double& v : corner) v -= margin;
+    }
     for (double& v : corner) v = std::floor(v);
     std::vector<protocol::MapFileWriter> writers;
     writers.reserve(config_.session.exports.size());
@@ -238,6 +296,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       files.push_back(file.filename().string());
     }
     std::vector<slam::MapSample> read_back;
+    std::vector<slam::MapSample> moved;
     for (const slam::TileCoord& c : coords) {
       std::span<const slam::MapSample> samples = map.tile(c);
       if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
@@ -248,14 +307,20 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         if (!problem.empty()) throw std::runtime_error(problem);
         samples = read_back;
       }
+      if (corrected) {
+        correct(samples, track, moved);
+        samples = moved;
+      }
       const std::vector<protocol::MapPoint> points = map_points_of(samples);
       for (protocol::MapFileWriter& w : writers) w.write(points);
     }
     for (protocol::MapFileWriter& w : writers) w.finish();
-    slam::Trajectory keyframes;
-    for (const slam::Keyframe& k : pipeline->keyframes()) {
+    slam::Trajectory keyframes;  // the graph's poses with loop closure (the same keyframes, in order)
+    const std::vector<Eigen::Isometry3d>* graph = loops != nullptr ? &loops->closer().poses() : nullptr;
+    for (std::size_t i = 0; i < pipeline->keyframes().size(); ++i) {
+      const slam::Keyframe& k = pipeline->keyframes()[i];
       keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
-      keyframes.poses.push_back(k.pose);
+      keyframes.poses.push_back(graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose);
     }
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
@@ -275,6 +340,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},
+        {"loops", loops_summary(loops, track)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},

@@ -89,24 +89,30 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
   event.inlier_ratio = v.registration.inlier_ratio;
   event.rmse_m = v.registration.rmse_m;
   event.conditioning = v.registration.weakest_eigenvalue;
-  if (v.verdict != LoopVerdict::accepted) {
+  if (v.verdict != LoopVerdict::accepted && v.verdict != LoopVerdict::partial) {
     ++stats_.rejected_verification;
     event.outcome = std::string(to_string(v.verdict));
     events_.push_back(event);
     return false;
   }
   ++stats_.verified;
-  const double sigma_m = std::sqrt(v.covariance.block<3, 3>(0, 0).diagonal().maxCoeff());
-  const LoopConstraint loop{c.candidate, c.query, v.relative, sigma_m};
+  if (v.verdict == LoopVerdict::partial) ++stats_.partial;
+  const LoopConstraint loop{c.candidate, c.query, v.relative, config_.verification.covariance_sigma_m, v.free_axis};
   GuardDecision decision = GuardDecision::waiting;
   const std::vector<LoopConstraint> newly = guard_.submit(loop, graph_.nodes, variance_, decision);
-  event.outcome = decision == GuardDecision::accepted ? "accepted"
-                  : decision == GuardDecision::waiting ? "waiting"
-                                                       : "inconsistent";
+  const std::string kind = v.verdict == LoopVerdict::partial ? "_partial" : "";
+  event.outcome = (decision == GuardDecision::accepted  ? "accepted"
+                   : decision == GuardDecision::waiting ? "waiting"
+                                                        : "inconsistent") +
+                  kind;
   if (decision == GuardDecision::rejected) ++stats_.rejected_inconsistent;
   events_.push_back(event);
-  Matrix6d information = v.covariance.inverse();
+  // The information of each loop the guard let in (waiting ones kept theirs).
+  if (decision != GuardDecision::rejected) information_.push_back({c.query, c.candidate, v.information});
   for (const LoopConstraint& l : newly) {
+    Matrix6d information = v.information;
+    for (const PendingInformation& p : information_)
+      if (p.query == l.to && p.candidate == l.from) information = p.information;
     graph_.edges.push_back({l.from, l.to, l.measurement, information, EdgeKind::loop});
     ++stats_.accepted;
   }
@@ -116,19 +122,6 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
 Eigen::Isometry3d LoopCloser::correction() const {
   if (graph_.nodes.empty()) return Eigen::Isometry3d::Identity();
   return graph_.nodes.back() * odometry_.back().inverse();
-}
-
-Eigen::Isometry3d LoopCloser::correction_at(std::int64_t stamp_ns) const {
-  if (stamps_.empty()) return Eigen::Isometry3d::Identity();
-  const auto it = std::lower_bound(stamps_.begin(), stamps_.end(), stamp_ns);
-  if (it == stamps_.begin()) return graph_.nodes.front() * odometry_.front().inverse();
-  if (it == stamps_.end()) return correction();
-  const auto b = static_cast<std::size_t>(it - stamps_.begin());
-  const std::size_t a = b - 1;
-  const Eigen::Isometry3d Ca = graph_.nodes[a] * odometry_[a].inverse();
-  const Eigen::Isometry3d Cb = graph_.nodes[b] * odometry_[b].inverse();
-  const double s = static_cast<double>(stamp_ns - stamps_[a]) / static_cast<double>(std::max<std::int64_t>(1, stamps_[b] - stamps_[a]));
-  return Ca * exp_se3(s * log_se3(Ca.inverse() * Cb));
 }
 
 void LoopCloser::refine() {

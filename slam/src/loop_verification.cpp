@@ -8,6 +8,7 @@ namespace adit::slam {
 std::string_view to_string(LoopVerdict verdict) {
   switch (verdict) {
     case LoopVerdict::accepted: return "accepted";
+    case LoopVerdict::partial: return "partial";
     case LoopVerdict::no_overlap: return "no_overlap";
     case LoopVerdict::poor_fit: return "poor_fit";
     case LoopVerdict::ill_conditioned: return "ill_conditioned";
@@ -29,7 +30,8 @@ namespace {
 LoopVerdict judge(const RegistrationResult& r, const LoopVerificationConfig& c) {
   if (r.inlier_ratio < c.min_inlier_ratio) return LoopVerdict::no_overlap;
   if (r.rmse_m > c.max_rmse_m) return LoopVerdict::poor_fit;
-  if (r.degenerate || r.weakest_eigenvalue < c.min_conditioning) return LoopVerdict::ill_conditioned;
+  if (r.degenerate || r.weakest_eigenvalue < c.min_conditioning)
+    return c.allow_partial ? LoopVerdict::partial : LoopVerdict::ill_conditioned;
   return LoopVerdict::accepted;
 }
 
@@ -37,7 +39,8 @@ LoopVerdict judge(const RegistrationResult& r, const LoopVerificationConfig& c) 
 // failure is reported when no guess passes.
 int rank(LoopVerdict v) {
   switch (v) {
-    case LoopVerdict::accepted: return 4;
+    case LoopVerdict::accepted: return 5;
+    case LoopVerdict::partial: return 4;
     case LoopVerdict::ambiguous: return 3;
     case LoopVerdict::ill_conditioned: return 2;
     case LoopVerdict::poor_fit: return 1;
@@ -61,7 +64,7 @@ LoopVerification verify_loop(std::span<const Eigen::Vector3f> query_points, cons
     const RegistrationResult r =
         register_scan(query_points, submap, prior, config.max_distance_m, config.kernel_scale_m, config.registration, planes);
     const LoopVerdict v = judge(r, config);
-    if (v == LoopVerdict::accepted) {
+    if (v == LoopVerdict::accepted || v == LoopVerdict::partial) {
       passing.push_back(r);
     } else if (!have_best_failure || rank(v) > rank(out.verdict) ||
                (rank(v) == rank(out.verdict) && r.inlier_ratio > out.registration.inlier_ratio)) {
@@ -76,6 +79,7 @@ LoopVerification verify_loop(std::span<const Eigen::Vector3f> query_points, cons
   std::size_t best = 0;
   for (std::size_t i = 1; i < passing.size(); ++i)
     if (passing[i].inlier_ratio > passing[best].inlier_ratio) best = i;
+  const RegistrationResult& r = passing[best];
   out.registration = passing[best];
   out.relative = passing[best].pose;
   for (const RegistrationResult& other : passing) {
@@ -85,14 +89,26 @@ LoopVerification verify_loop(std::span<const Eigen::Vector3f> query_points, cons
       return out;
     }
   }
-  out.verdict = LoopVerdict::accepted;
-  // The registration's covariance is for a left perturbation of the pose in
-  // the submap's (the candidate's) frame: the graph's loop edge is T_c⁻¹·T_q
-  // in the same frame. Floored per axis.
-  Vector6d floor;
-  floor << Eigen::Vector3d::Constant(config.covariance_floor_m * config.covariance_floor_m),
-      Eigen::Vector3d::Constant(config.covariance_floor_rad * config.covariance_floor_rad);
-  out.covariance = passing[best].covariance + Matrix6d(floor.asDiagonal());
+  out.verdict = judge(r, config);
+  // Information in the registration's body-frame perturbation δ (the query's
+  // frame, T·exp(δ)), fixed σ, with a partial loop's weakest direction w
+  // projected out: Λ_δ = (I − wwᵀ) Λ (I − wwᵀ).
+  Vector6d diagonal;
+  diagonal << Eigen::Vector3d::Constant(1.0 / (config.covariance_sigma_m * config.covariance_sigma_m)),
+      Eigen::Vector3d::Constant(1.0 / (config.covariance_sigma_rad * config.covariance_sigma_rad));
+  Matrix6d information = diagonal.asDiagonal();
+  const Eigen::Matrix3d R = r.pose.linear();
+  if (out.verdict == LoopVerdict::partial) {
+    const Vector6d w = r.weakest_direction.normalized();
+    const Matrix6d P = Matrix6d::Identity() - w * w.transpose();
+    information = P * information * P;
+    if (w.head<3>().norm() > 0.5) out.free_axis = (R * w.head<3>()).normalized();
+  }
+  // The graph's residual is e = [R·δ_v; δ_ω] to first order (Ẑ = Z·exp(δ)),
+  // e = J·δ with J = diag(R, I): Λ_e = J⁻ᵀ Λ_δ J⁻¹, J⁻¹ = diag(Rᵀ, I).
+  Matrix6d J_inv = Matrix6d::Identity();
+  J_inv.topLeftCorner<3, 3>() = R.transpose();
+  out.information = J_inv.transpose() * information * J_inv;
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "adit/slam/correction_track.hpp"
 #include "adit/slam/pose_graph.hpp"
 #include "adit/slam/pose_graph_solver.hpp"
 
@@ -108,6 +109,26 @@ TEST(PoseGraph, OdometryInformationLoosensWithDistance) {
   const Matrix6d far = odometry_information(pose(5.0, 0, 0));
   EXPECT_GT(near(0, 0), far(0, 0));
   EXPECT_GT(near(5, 5), far(5, 5));
+}
+
+}  // namespace
+}  // namespace adit::slam
+
+namespace adit::slam {
+namespace {
+
+TEST(CorrectionTrack, InterpolatesBetweenKeyframesAndHoldsBeyond) {
+  const std::vector<std::int64_t> stamps{100, 200};
+  const std::vector<Eigen::Isometry3d> odometry{pose(0, 0, 0), pose(1, 0, 0)};
+  const std::vector<Eigen::Isometry3d> graph{pose(0, 0, 0), pose(1, 0.2, 0.1)};
+  const CorrectionTrack track(stamps, graph, odometry);
+  EXPECT_TRUE(track.at(50).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  const Eigen::Isometry3d end = graph[1] * odometry[1].inverse();
+  EXPECT_TRUE(track.at(200).isApprox(end, 1e-12));
+  EXPECT_TRUE(track.at(999).isApprox(end, 1e-12));
+  const Eigen::Isometry3d mid = track.at(150);
+  EXPECT_NEAR(Eigen::AngleAxisd(mid.linear()).angle(), 0.05, 1e-9);  // half the turn
+  EXPECT_NEAR(track.max_rotation_rad(), 0.1, 1e-9);
 }
 
 }  // namespace

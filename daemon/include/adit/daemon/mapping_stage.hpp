@@ -22,6 +22,7 @@
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/handoff.hpp"
+#include "adit/daemon/keyframe_queue.hpp"
 #include "adit/daemon/pipeline_items.hpp"
 #include "adit/daemon/pipeline_stats.hpp"
 #include "adit/daemon/stage_thread.hpp"
@@ -48,6 +49,8 @@ class MappingStage {
   // the file); where evicted tiles and old keyframes' scans go (empty = RAM).
   void write_map_trajectory_to(const std::filesystem::path& file);
   void spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir);
+  // Before start(): each keyframe also goes to `loops` (the loop-closure stage's queue).
+  void feed_loops(KeyframeQueue* loops) { loops_ = loops; }
   void start();
   void join() { thread_.join(); }
 
@@ -82,6 +85,7 @@ class MappingStage {
   std::filesystem::path keyframes_dir_;   // empty = keyframe scans stay in RAM
   std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
   std::uint64_t keyframe_bytes_ = 0;
+  KeyframeQueue* loops_ = nullptr;
   slam::KeyframeSelector keyframe_selector_;
   std::vector<slam::Keyframe> keyframes_;
   slam::VoxelDownsampler keyframe_downsampler_;

@@ -28,6 +28,8 @@
 
 namespace adit::daemon {
 
+class LoopClosureStage;
+
 struct PipelineOptions {
   std::filesystem::path trajectory_file;  // TUM, written as poses arrive; empty = none
   // TUM: each mapped scan's pose as the map placed it (with map.refine, the
@@ -90,6 +92,8 @@ class Pipeline {
   const slam::TiledVoxelMap& map() const;
   const TileSpill* tile_spill() const;  // null without SessionFiles::tiles_dir
   const std::vector<slam::Keyframe>& keyframes() const;
+  // The loop-closure stage (map.loop_closure), complete after join(); null without it.
+  const LoopClosureStage* loop_closure() const;
 
  private:
   struct Impl;

@@ -44,6 +44,11 @@ struct PipelineStats {
   std::atomic<std::uint64_t> spilled_keyframes{0};    // keyframes whose scan went to keyframes_dir
   std::atomic<std::uint64_t> tile_file_errors{0};     // a tile or keyframe that could not be written (kept) or read (skipped)
   std::atomic<std::uint64_t> dropped_in_evicted{0};   // points not mapped: their tile could not be read back
+  // The loop-closure thread's counts (loop_closure_stage.hpp).
+  std::atomic<std::uint64_t> loop_keyframes{0};       // keyframes in the pose graph
+  std::atomic<std::uint64_t> loop_candidates{0};      // found by place recognition
+  std::atomic<std::uint64_t> loops_accepted{0};       // in the graph
+  std::atomic<std::uint64_t> loops_rejected{0};       // refused by verification or the guard
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
   std::atomic<std::uint64_t> gravity_priors{0};        // scans registered with the accelerometer's up

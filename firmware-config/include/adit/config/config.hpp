@@ -177,6 +177,10 @@ struct MapSection {
   // before it (slam::MapRefiner) before it enters the map; false = the map
   // takes the odometry's poses as they are.
   bool refine = true;
+  // Keyframes go to the loop-closure thread (Scan Context, verification by
+  // registration, a Ceres pose graph: docs/LOOPS.md); the exported map and
+  // keyframes.tum follow the graph. false = the odometry's map as it is.
+  bool loop_closure = true;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.

@@ -203,6 +203,7 @@ void describe(V& v, MapSection& s) {
   v.optional("evict_after_keyframes", s.evict_after_keyframes, Range<int>{0, 1000000});
   v.optional("compact_tile_voxels", s.compact_tile_voxels, Range<int>{0, 100000000});
   v.optional("refine", s.refine);
+  v.optional("loop_closure", s.loop_closure);
 }
 
 template <typename V>

@@ -20,6 +20,7 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/slam/correction_track.hpp"
 #include "adit/slam/loop_consistency.hpp"
 #include "adit/slam/loop_verification.hpp"
 #include "adit/slam/place_recognition.hpp"
@@ -47,7 +48,7 @@ struct LoopEvent {
   std::size_t query = 0;
   std::size_t candidate = 0;
   double descriptor_distance = 0.0;
-  std::string outcome;  // a LoopVerdict's name, or "inconsistent", "waiting", "accepted"
+  std::string outcome;  // a refused LoopVerdict's name, or "accepted", "waiting", "inconsistent" (+ "_partial")
   double inlier_ratio = 0.0;
   double rmse_m = 0.0;
   double conditioning = 0.0;
@@ -57,6 +58,7 @@ struct LoopClosureStats {
   std::size_t keyframes = 0;
   std::size_t candidates = 0;             // found by place recognition
   std::size_t verified = 0;               // passed registration
+  std::size_t partial = 0;                // of which partial (one direction unobserved)
   std::size_t accepted = 0;               // in the graph
   std::size_t rejected_verification = 0;  // failed registration (overlap, fit, conditioning, ambiguity)
   std::size_t rejected_inconsistent = 0;  // failed the guard
@@ -79,9 +81,8 @@ class LoopCloser {
   const std::vector<std::int64_t>& stamps() const { return stamps_; }
   // map→odometry: G·O⁻¹ of the newest keyframe (identity before any loop).
   Eigen::Isometry3d correction() const;
-  // G·O⁻¹ at time t: interpolated between the keyframes around it (held
-  // beyond the ends), for scans between keyframes.
-  Eigen::Isometry3d correction_at(std::int64_t stamp_ns) const;
+  // G·O⁻¹ through time (slam/correction_track.hpp), for every map point.
+  CorrectionTrack correction_track() const { return CorrectionTrack(stamps_, graph_.nodes, odometry_); }
   const LoopClosureStats& stats() const { return stats_; }
   const std::vector<LoopEvent>& events() const { return events_; }
   const PoseGraph& graph() const { return graph_; }
@@ -103,6 +104,11 @@ class LoopCloser {
   std::vector<double> variance_;
   LoopClosureStats stats_;
   std::vector<LoopEvent> events_;
+  struct PendingInformation {
+    std::size_t query, candidate;
+    Matrix6d information;
+  };
+  std::vector<PendingInformation> information_;  // of the loops that passed verification
 };
 
 }  // namespace adit::slam

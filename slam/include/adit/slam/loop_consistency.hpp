@@ -7,9 +7,11 @@
 // and Z_b ≈ T_k⁻¹T_l, agree when the cycle they close with the odometry
 // between their ends is near identity:
 //     E = (O_ik · Z_b)⁻¹ · Z_a · O_jl,   O_ik = T_i⁻¹T_k, O_jl = T_j⁻¹T_l (the graph's estimate)
-// The translation of E is gated by chi-square (3 dof, 99 %) against the two
-// loops' σ² plus the odometry's accumulated σ² along i→k and j→l; its
-// rotation by max_rotation_rad. Two wrong loops rarely agree with each other
+// In practice the two estimates of T_i⁻¹T_l, Z_a·O_jl and O_ik·Z_b, are
+// compared in i's frame. The translation difference, less its components
+// along a partial loop's unobserved axis (loop_verification.hpp), is gated
+// by chi-square (3 dof, 99 %) against the two loops' σ² plus the odometry's
+// accumulated σ² along i→k and j→l; the rotation by max_rotation_rad. Two wrong loops rarely agree with each other
 // and with a right one: a symmetric tunnel's false match is off by a
 // different amount at each keyframe.
 //
@@ -36,6 +38,7 @@ struct LoopConstraint {
   std::size_t to = 0;    // the newer one (query)
   Eigen::Isometry3d measurement = Eigen::Isometry3d::Identity();  // T_from⁻¹·T_to
   double sigma_m = 0.05;     // per-axis σ of its translation
+  Eigen::Vector3d free_axis = Eigen::Vector3d::Zero();  // a partial loop's unobserved translation, `from`'s frame
 };
 
 struct ConsistencyConfig {

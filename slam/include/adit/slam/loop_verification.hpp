@@ -8,16 +8,23 @@
 //     plane of the submap within reach; a person in front of the sensor or a
 //     different drift lowers it),
 //   - fits: the robust RMS of the point-to-plane residuals ≤ max_rmse_m,
-//   - is well conditioned: the data Hessian's weakest normalised eigenvalue
-//     ≥ min_conditioning (Zhang, Kaess & Singh, ICRA 2016: along a plain
+//   - is conditioned: the data Hessian's weakest normalised eigenvalue
+//     ≥ min_conditioning (Zhang, Kaess & Singh, ICRA 2016). Along a plain
 //     tunnel the translation along the axis is unobserved, so a registration
-//     "fits" anywhere along it; such a loop says nothing and is refused),
+//     "fits" anywhere along it. Such a loop is accepted as *partial*: its
+//     information along the weakest direction is removed, so it holds the
+//     directions the scan does observe (across the tunnel, height, attitude)
+//     and says nothing along the axis, where the registration's step was
+//     projected off and the measurement is the graph's own guess anyway
+//     (solution remapping). With allow_partial false it is refused;
 //   - is unambiguous: registered from every initial guess (the graph's
 //     relative pose and Scan Context's two yaw readings), no two guesses
 //     converge to different poses that both pass (a symmetric or repetitive
 //     section matches two ways; neither is trusted).
-// The accepted measurement's covariance is the registration's, floored
-// (it is optimistic: Censi, ICRA 2007).
+// The accepted measurement's information is fixed σ (covariance_sigma_*),
+// not the registration's covariance: that one is scaled by the odometry's
+// deliberately loose point σ (decision 010) and optimistic in its shape
+// (Censi, ICRA 2007); the acceptance thresholds above bound the fit instead.
 
 #include <span>
 #include <string_view>
@@ -42,18 +49,22 @@ struct LoopVerificationConfig {
   double min_conditioning = 0.02;       // twice the odometry's degeneracy threshold (RegistrationConfig)
   double ambiguity_m = 0.5;             // two passing solutions this far apart: ambiguous
   double ambiguity_rad = 0.1;
-  double covariance_floor_m = 0.05;     // σ added to the registration's
-  double covariance_floor_rad = 0.005;
+  double covariance_sigma_m = 0.05;     // σ of an accepted loop's translation, per axis
+  double covariance_sigma_rad = 0.005;  // and rotation
+  bool allow_partial = true;            // an ill-conditioned fit becomes a partial loop (above)
   RegistrationConfig registration;
 };
 
-enum class LoopVerdict { accepted, no_overlap, poor_fit, ill_conditioned, ambiguous };
+enum class LoopVerdict { accepted, partial, no_overlap, poor_fit, ill_conditioned, ambiguous };
 std::string_view to_string(LoopVerdict verdict);
 
 struct LoopVerification {
   LoopVerdict verdict = LoopVerdict::no_overlap;
   Eigen::Isometry3d relative = Eigen::Isometry3d::Identity();  // T_candidate⁻¹·T_query, measured
-  Matrix6d covariance = Matrix6d::Identity();                  // of `relative`, floored
+  // Of the pose graph's loop residual (slam/src/pose_graph_factors.hpp):
+  // [translation in the candidate's frame; rotation in the query's].
+  Matrix6d information = Matrix6d::Identity();
+  Eigen::Vector3d free_axis = Eigen::Vector3d::Zero();  // partial: the unobserved translation, candidate frame (unit)
   RegistrationResult registration;                             // the best guess's
   int passing_guesses = 0;
 };

@@ -1,0 +1,55 @@
+#pragma once
+// The loop-closure stage: the mapping thread's keyframes in, the pose graph
+// and the map→odometry correction out (docs/LOOPS.md).
+//
+// In:   keyframes (KeyframeQueue), each with the pose the map placed it at.
+// Out:  the graph's poses and the correction through time (correction()),
+//       counts in PipelineStats (loop_*), read after join().
+// Thread "loops", lowered to nice 10 on top of its thread settings: it takes
+// the CPU the other stages leave. It never blocks another stage: the mapping
+// thread only pushes into the queue; the odometry never sees it. At the end
+// it drains the queue and, with `refine_at_end`, optimises the whole graph
+// once more before the exports.
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "adit/config/config.hpp"
+#include "adit/daemon/keyframe_queue.hpp"
+#include "adit/daemon/pipeline_stats.hpp"
+#include "adit/daemon/stage_thread.hpp"
+#include "adit/slam/correction_track.hpp"
+#include "adit/slam/loop_closer.hpp"
+
+namespace adit::daemon {
+
+class LoopClosureStage {
+ public:
+  LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
+                   const slam::LoopClosureConfig& loops = {});
+
+  KeyframeQueue& input() { return keyframes_; }
+  void start();
+  // After the mapping stage has joined: closes the queue, lets the thread
+  // drain it and refine, and joins.
+  void finish();
+
+  StageThread& thread() { return thread_; }
+  // Complete after finish().
+  const slam::LoopCloser& closer() const { return closer_; }
+  slam::CorrectionTrack correction() const { return closer_.correction_track(); }
+  double refine_time_s() const { return refine_time_s_; }
+
+ private:
+  void loop();
+  void update_stats();
+
+  PipelineStats& stats_;
+  StageThread thread_;
+  KeyframeQueue keyframes_;
+  slam::LoopCloser closer_;
+  double refine_time_s_ = 0.0;
+};
+
+}  // namespace adit::daemon

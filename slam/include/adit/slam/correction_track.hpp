@@ -1,0 +1,39 @@
+#pragma once
+// The map→odometry correction through time: at each keyframe k the graph's
+// pose G_k against the pose O_k the map was built at, C_k = G_k·O_k⁻¹; between
+// two keyframes C is interpolated on SE(3) (C_a·exp(s·log(C_a⁻¹·C_b))), beyond
+// the ends it is held. A map point measured at time t moves to C(t)·p: the
+// map follows the graph without its scans being kept (each map sample carries
+// its scan's time, slam/tiled_map.hpp).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/slam/lie.hpp"
+
+namespace adit::slam {
+
+class CorrectionTrack {
+ public:
+  CorrectionTrack() = default;
+  // `stamps_ns` increasing; `graph` and `odometry` as long.
+  CorrectionTrack(std::span<const std::int64_t> stamps_ns, std::span<const Eigen::Isometry3d> graph,
+                  std::span<const Eigen::Isometry3d> odometry);
+
+  Eigen::Isometry3d at(std::int64_t stamp_ns) const;
+  bool empty() const { return stamps_.empty(); }
+  // The largest correction over the keyframes: translation (m) and rotation (rad).
+  double max_translation_m() const;
+  double max_rotation_rad() const;
+  const std::vector<Eigen::Isometry3d>& corrections() const { return corrections_; }
+
+ private:
+  std::vector<std::int64_t> stamps_;
+  std::vector<Eigen::Isometry3d> corrections_;
+  std::vector<Vector6d> steps_;  // log(C_k⁻¹·C_k+1)
+};
+
+}  // namespace adit::slam

@@ -1,0 +1,41 @@
+// The map→odometry correction through time (correction_track.hpp).
+#include "adit/slam/correction_track.hpp"
+
+#include <algorithm>
+
+namespace adit::slam {
+
+CorrectionTrack::CorrectionTrack(std::span<const std::int64_t> stamps_ns, std::span<const Eigen::Isometry3d> graph,
+                                 std::span<const Eigen::Isometry3d> odometry) {
+  const std::size_t n = std::min({stamps_ns.size(), graph.size(), odometry.size()});
+  stamps_.assign(stamps_ns.begin(), stamps_ns.begin() + static_cast<std::ptrdiff_t>(n));
+  corrections_.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) corrections_.push_back(graph[k] * odometry[k].inverse());
+  steps_.reserve(n);
+  for (std::size_t k = 0; k + 1 < n; ++k) steps_.push_back(log_se3(corrections_[k].inverse() * corrections_[k + 1]));
+}
+
+Eigen::Isometry3d CorrectionTrack::at(std::int64_t stamp_ns) const {
+  if (stamps_.empty()) return Eigen::Isometry3d::Identity();
+  const auto it = std::upper_bound(stamps_.begin(), stamps_.end(), stamp_ns);
+  if (it == stamps_.begin()) return corrections_.front();
+  if (it == stamps_.end()) return corrections_.back();
+  const auto b = static_cast<std::size_t>(it - stamps_.begin());
+  const std::size_t a = b - 1;
+  const double s = static_cast<double>(stamp_ns - stamps_[a]) / static_cast<double>(stamps_[b] - stamps_[a]);
+  return corrections_[a] * exp_se3(s * steps_[a]);
+}
+
+double CorrectionTrack::max_translation_m() const {
+  double m = 0.0;
+  for (const Eigen::Isometry3d& c : corrections_) m = std::max(m, c.translation().norm());
+  return m;
+}
+
+double CorrectionTrack::max_rotation_rad() const {
+  double m = 0.0;
+  for (const Eigen::Isometry3d& c : corrections_) m = std::max(m, Eigen::AngleAxisd(c.linear()).angle());
+  return m;
+}
+
+}  // namespace adit::slam
