@@ -12,6 +12,7 @@
 #   without arguments, the twelve drives of docs/decisions/014-judge-map-on-twelve-drives.md (about 3 minutes on 2 cores).
 # Sessions are made once under build/sessions/bench-map/; each run's files go to build/bench-map/.
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds those folders (default: build).
+# ADIT_BENCH_YAML: lines appended to each run's aditd.yaml, e.g. $'map:\n  loops_move_map: true'.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/sim-sessions.sh
@@ -34,6 +35,7 @@ for drive in "${drives[@]}"; do
       -e "s#  log: can.log#  log: $session/can.log#" \
       -e "s#  replay_speed: 1.0#  replay_speed: 0#" "$session/session.yaml" > "$work/aditd.yaml"
   printf 'threads:\n  lock_memory: false\n' >> "$work/aditd.yaml"
+  [ -z "${ADIT_BENCH_YAML:-}" ] || printf '%s\n' "$ADIT_BENCH_YAML" >> "$work/aditd.yaml"
   "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
     { echo "bench-map: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
   folder=$(ls -d "$work"/state/sessions/*/ | head -1)

@@ -50,7 +50,7 @@ nlohmann::json imu_summary(const ImuStats& imu) {
 
 // summary.json's "loops": what loop closure found, accepted and refused, and
 // the correction the graph applied to the map (docs/LOOPS.md).
-nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::CorrectionTrack& track) {
+nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::CorrectionTrack& track, bool moved) {
   if (loops == nullptr) return {{"enabled", false}};
   const slam::LoopClosureStats& s = loops->closer().stats();
   nlohmann::json by_outcome = nlohmann::json::object();
@@ -64,6 +64,7 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
   }
   const Eigen::Isometry3d last = track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back();
   return {{"enabled", true},
+          {"map_moved", moved},
           {"keyframes", s.keyframes},
           {"candidates", s.candidates},
           {"verified", s.verified},
@@ -279,7 +280,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     // (only when a loop was accepted: otherwise the correction is identity).
     const LoopClosureStage* loops = pipeline->loop_closure();
     const slam::CorrectionTrack track = loops != nullptr ? loops->correction() : slam::CorrectionTrack{};
-    const bool corrected = loops != nullptr && loops->closer().stats().accepted > 0;
+    const bool corrected = loops != nullptr && config_.map.loops_move_map && loops->closer().stats().accepted > 0;
     if (corrected) {  // the corner stays at or below every moved point
       double reach = 0.0;
       for (const slam::TileCoord& c : coords)
@@ -340,7 +341,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},
-        {"loops", loops_summary(loops, track)},
+        {"loops", loops_summary(loops, track, corrected)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},

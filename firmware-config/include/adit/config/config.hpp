@@ -178,9 +178,15 @@ struct MapSection {
   // takes the odometry's poses as they are.
   bool refine = true;
   // Keyframes go to the loop-closure thread (Scan Context, verification by
-  // registration, a Ceres pose graph: docs/LOOPS.md); the exported map and
-  // keyframes.tum follow the graph. false = the odometry's map as it is.
+  // registration, a Ceres pose graph: docs/LOOPS.md); keyframes.tum holds
+  // the graph's poses and summary.json the loops. false = no such thread.
   bool loop_closure = true;
+  // The exported map follows the graph: each point moves by the correction
+  // at its scan's time. Off by default: with one closure per drive the graph
+  // spreads the gap evenly along the route, and on the 300 s mine drives the
+  // map's drift sat in the last 60 m, so the map lost 5-22 points of 100
+  // within 5 cm on two drives of three (docs/LOOPS.md, "Measured").
+  bool loops_move_map = false;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.

@@ -204,6 +204,7 @@ void describe(V& v, MapSection& s) {
   v.optional("compact_tile_voxels", s.compact_tile_voxels, Range<int>{0, 100000000});
   v.optional("refine", s.refine);
   v.optional("loop_closure", s.loop_closure);
+  v.optional("loops_move_map", s.loops_move_map);
 }
 
 template <typename V>

@@ -1,0 +1,82 @@
+// The loop-closure stage on its own thread: keyframes pushed from another
+// thread (as the mapping thread does), the graph closed in the background,
+// the correction read after finish(). Listed in .ci/run's tsan_tests.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "../slam/loop_scenes.hpp"
+#include "adit/daemon/loop_closure_stage.hpp"
+
+namespace adit::daemon {
+namespace {
+
+Eigen::Isometry3d at(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() << x, y, 0.0;
+  return T;
+}
+
+constexpr float kSide = 20.0F;
+
+// 1.25 laps of an 80 m ring, the map's poses 1 % long and turning 0.05° per
+// metre too far: pushed from a producer thread that never waits for the stage.
+TEST(LoopClosureStage, ClosesLoopsInTheBackgroundAndPublishesTheCorrection) {
+  const std::vector<Eigen::Vector3f> world = slam::test::ring_corridor(kSide, 30, 23, 20.0F);
+  config::Config config;
+  PipelineStats stats;
+  std::atomic<bool> stop{false};
+  LoopClosureStage stage(config, stats, stop);
+  stage.start();
+  Eigen::Isometry3d odometry = slam::test::ring_pose(kSide, 0.0);
+  Eigen::Isometry3d truth_end;
+  std::vector<double> push_ms;
+  std::thread producer([&] {
+    const double step = 2.0;
+    for (int k = 0; k * step <= 1.25 * 4 * kSide; ++k) {
+      const Eigen::Isometry3d truth = slam::test::ring_pose(kSide, k * step);
+      if (k > 0) {
+        const Eigen::Isometry3d motion = slam::test::ring_pose(kSide, (k - 1) * step).inverse() * truth;
+        odometry = odometry * motion * at(0.01 * motion.translation().norm(), 0.0, 0.05 * M_PI / 180 * step);
+      }
+      KeyframeItem item{static_cast<std::int64_t>(k) * 1'000'000'000, odometry,
+                        slam::test::scan_of(world, truth, 300 + static_cast<unsigned>(k))};
+      const auto t0 = std::chrono::steady_clock::now();
+      stage.input().push(std::move(item));
+      push_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      truth_end = truth;
+    }
+  });
+  producer.join();
+  stage.finish();
+  const slam::LoopCloser& closer = stage.closer();
+  EXPECT_EQ(stats.loop_keyframes.load(), closer.poses().size());
+  EXPECT_GE(stats.loops_accepted.load(), 3U);
+  EXPECT_EQ(stats.loops_accepted.load(), closer.stats().accepted);
+  const double before = (odometry.translation() - truth_end.translation()).norm();
+  const double after = (closer.poses().back().translation() - truth_end.translation()).norm();
+  EXPECT_LT(after, 0.5 * before);
+  // The correction, applied to the newest map pose, gives the graph's.
+  const slam::CorrectionTrack track = stage.correction();
+  EXPECT_TRUE((track.at(closer.stamps().back()) * odometry).isApprox(closer.poses().back(), 1e-9));
+  EXPECT_GT(track.max_translation_m(), 0.1);
+  for (double ms : push_ms) EXPECT_LT(ms, 50.0);  // a push never waits for the graph
+}
+
+// Stopped at once (request_stop): the thread ends without draining or refining.
+TEST(LoopClosureStage, StopsAtOnce) {
+  config::Config config;
+  PipelineStats stats;
+  std::atomic<bool> stop{false};
+  LoopClosureStage stage(config, stats, stop);
+  stage.start();
+  stop.store(true);
+  stage.finish();
+  EXPECT_EQ(stage.closer().stats().keyframes, 0U);
+}
+
+}  // namespace
+}  // namespace adit::daemon
