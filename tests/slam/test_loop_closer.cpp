@@ -50,6 +50,8 @@ Outcome close_loops(const std::vector<Eigen::Vector3f>& world, const Drive& d) {
                         test::scan_of(world, d.truth[k], 1000 + static_cast<unsigned>(k)));
   Outcome o;
   o.stats = closer.stats();
+  // Every verified loop is accepted, refused by the guard or still waiting: none is lost.
+  EXPECT_EQ(o.stats.verified, o.stats.accepted + o.stats.rejected_inconsistent + closer.unconfirmed());
   for (std::size_t k = 0; k < d.truth.size(); ++k) {
     o.error_before = std::max(o.error_before, (d.odometry[k].translation() - d.truth[k].translation()).norm());
     o.error_after = std::max(o.error_after, (closer.poses()[k].translation() - d.truth[k].translation()).norm());

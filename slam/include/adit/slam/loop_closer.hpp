@@ -48,7 +48,9 @@ struct LoopEvent {
   std::size_t query = 0;
   std::size_t candidate = 0;
   double descriptor_distance = 0.0;
-  std::string outcome;  // a refused LoopVerdict's name, or "accepted", "waiting", "inconsistent" (+ "_partial")
+  // A refused LoopVerdict's name, or the guard's decision when verified: "accepted", "waiting" (for a
+  // witness: accepted later if one agrees, see LoopCloser::unconfirmed()), "inconsistent"; "_partial" appended.
+  std::string outcome;
   double inlier_ratio = 0.0;
   double rmse_m = 0.0;
   double conditioning = 0.0;
@@ -84,6 +86,8 @@ class LoopCloser {
   // G·O⁻¹ through time (slam/correction_track.hpp), for every map point.
   CorrectionTrack correction_track() const { return CorrectionTrack(stamps_, graph_.nodes, odometry_); }
   const LoopClosureStats& stats() const { return stats_; }
+  // Verified loops still waiting for a witness (never in the graph unless one comes).
+  std::size_t unconfirmed() const { return guard_.waiting().size(); }
   const std::vector<LoopEvent>& events() const { return events_; }
   const PoseGraph& graph() const { return graph_; }
   // A last optimisation of the whole graph (session end).
