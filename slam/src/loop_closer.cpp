@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "adit/common/clock.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 
 namespace adit::slam {
@@ -24,6 +25,7 @@ LoopCloser::LoopCloser(const LoopClosureConfig& config) : config_(config), guard
 bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
                               std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body) {
   const std::size_t k = graph_.nodes.size();
+  const std::int64_t search_start_ns = monotonic_ns();
   std::vector<Eigen::Vector3f> kept, query;
   kept.reserve(points.size());
   query.reserve(points.size());
@@ -54,8 +56,17 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   const KeyframeIndexView view{descriptors_, graph_.nodes, path_m_, variance_};
   const std::vector<LoopCandidate> candidates = find_loop_candidates(k, view, config_.search);
   stats_.candidates += candidates.size();
+  const double search_s = 1e-9 * static_cast<double>(monotonic_ns() - search_start_ns);
+  stats_.search_s_total += search_s;
+  stats_.search_s_max = std::max(stats_.search_s_max, search_s);
   bool added = false;
-  for (const LoopCandidate& c : candidates) added = try_candidate(c) || added;
+  for (const LoopCandidate& c : candidates) {
+    const std::int64_t t0 = monotonic_ns();
+    added = try_candidate(c) || added;
+    const double verification_s = 1e-9 * static_cast<double>(monotonic_ns() - t0);
+    stats_.verification_s_total += verification_s;
+    stats_.verification_s_max = std::max(stats_.verification_s_max, verification_s);
+  }
   if (!added) return false;
   const PoseGraphSolution solution = optimize(graph_, config_.solver);
   ++stats_.optimizations;
