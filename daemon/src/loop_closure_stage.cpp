@@ -17,7 +17,6 @@ namespace {
 
 constexpr int kNice = 10;  // below every other stage under SCHED_OTHER
 
-config::ThreadSettings background(const config::ThreadSettings&) { return {}; }  // never SCHED_FIFO
 
 // With an accelerometer the map's poses hold roll and pitch by gravity
 // (decision 008; the map refiner keeps them within σ 0.002 rad of the
@@ -34,7 +33,7 @@ slam::LoopClosureConfig loop_config_of(const config::Config& config, slam::LoopC
 LoopClosureStage::LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
                                    const slam::LoopClosureConfig& loops)
     : stats_(stats),
-      thread_("loops", background(config.threads.mapping), stop),
+      thread_("loops", config::ThreadSettings{}, stop),  // SCHED_OTHER whatever the other stages use, never FIFO
       closer_(loop_config_of(config, loops)),
       gravity_(loop_config_of(config, loops).gravity_sigma_rad > 0.0) {}
 
