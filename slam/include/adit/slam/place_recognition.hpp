@@ -2,7 +2,7 @@
 // Loop candidates for a new keyframe: old keyframes the pose graph says it
 // could be at, whose Scan Context looks like the new one's.
 //
-// Two gates, both needed (docs/decisions/020-loop-closure-scan-context.md):
+// Two gates, both needed (docs/decisions/021-loop-closure-scan-context.md):
 // 1. Position, by the graph's own uncertainty: the candidate's estimated
 //    position lies within base_radius_m + gate_sigmas·σ of the query's, σ the
 //    odometry's accumulated per-axis position σ along the path between them

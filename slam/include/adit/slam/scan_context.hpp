@@ -18,7 +18,7 @@
 // unturned. `compare` therefore returns the best shift and the best shift at
 // least `kAlternativeSeparationRad` away from it; verification registers from
 // both (slam/loop_verification.hpp). Why Scan Context:
-// docs/decisions/020-loop-closure-scan-context.md.
+// docs/decisions/021-loop-closure-scan-context.md.
 
 #include <span>
 
