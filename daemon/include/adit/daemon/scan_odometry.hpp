@@ -78,6 +78,8 @@ class ScanOdometry {
   double gravity_sigma_rad_;
   std::function<bool()> idle_;
   double previous_stamp_s_ = 0.0;
+  double previous_scan_s_ = 0.0;  // the last scan's start, for the IMU's readings since
+  std::vector<slam::ImuSample> imu_samples_;  // reserved only with a gyroscope
   std::vector<Eigen::Vector3f> body_points_;
   std::vector<float> body_times_;
   slam::OdometryResult result_;
