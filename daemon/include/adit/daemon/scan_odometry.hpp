@@ -5,9 +5,10 @@
 // the wheels' motion prior from the CAN feed and the accelerometer's gravity
 // from the IMU source (CAN or Ouster, imu_source.hpp) when configured
 // (slam/motion_history.hpp, slam/gravity.hpp), then slam::Odometry. The
-// gravity prior needs the wheels' acceleration to remove: without wheels the
-// IMU's readings are kept in its history (with the gyroscope's) but give no
-// prior yet. Thread-free: it runs on its caller's thread and waits only for
+// gravity prior needs the wheels' acceleration to remove. Without wheels, an
+// IMU with a gyroscope makes the odometry LiDAR-inertial: its readings from
+// the previous scan to past the sweep go with the scan (ScanInput::imu).
+// Thread-free: it runs on its caller's thread and waits only for
 // a replayed CAN log or pcap's IMU to catch up with the scan. No allocation
 // per scan after construction.
 
