@@ -22,6 +22,16 @@ DetectedLidar detect_lidar(std::span<const std::uint8_t> payload, std::uint16_t 
   return {};
 }
 
+std::string_view known_lidar_packets() {
+  return "Velodyne 1206 B, blocks 0xFF 0xEE, product byte 0x22/0x24 VLP-16, 0x28 VLP-32C, 0x21 HDL-32E, "
+         "0xA1/0x63 VLS-128 (port 2368); Hesai pre-header 0xEE 0xFF: 6.1 XT16 568 B, XT32 1080 B, XT32M 820 B, "
+         "3.1 QT64 1072 B, 3.2 QT128 818-1127 B (by header flags), Pandar64 1194/1198 B, Pandar40P 1262/1266 B "
+         "(blocks 0xFF 0xEE); RoboSense MSOP 1248 B (0x55 0xAA 0x05 0x0A / 0x55 0xAA 0x05 0x5A); "
+         "Livox SDK2 (Mid-360) version 0, length field = size, ports 56300/56301 (points) 56401 (IMU); "
+         "Livox SDK1 (Avia) version 5, data types 0-7, port 56001 (any); Ouster by port 7502 and the metadata's "
+         "packet size";
+}
+
 const LidarFamily* find_lidar_family(std::string_view name) {
   for (const LidarFamily& family : lidar_families()) {
     if (family.name == name) return &family;

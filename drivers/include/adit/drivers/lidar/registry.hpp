@@ -34,6 +34,9 @@ std::span<const LidarFamily> lidar_families();
 // The first family that recognises the packet; family == nullptr when none does.
 DetectedLidar detect_lidar(std::span<const std::uint8_t> payload, std::uint16_t dst_port);
 const LidarFamily* find_lidar_family(std::string_view name);
+// One line naming every data packet detection knows (model: size, header, factory bytes, port),
+// for the message of a tool that recognised nothing.
+std::string_view known_lidar_packets();
 // The family of a configured model name (VLP-16, PandarXT32, Helios16P, OS1-64, ...), nullptr when unknown.
 const LidarFamily* lidar_family_of_model(std::string_view model);
 
