@@ -10,6 +10,7 @@ std::span<const LidarFamily> lidar_families() {
       velodyne_family(),
       hesai_family(),
       robosense_family(),
+      livox_family(),   // before Ouster: version byte, length field and size must all agree
       ouster_family(),  // last: it recognises packets by port only
   };
   return kFamilies;
@@ -43,7 +44,8 @@ const LidarFamily* lidar_family_of_model(std::string_view model) {
   // Model names are the makers' own, and their prefixes do not overlap.
   static constexpr std::pair<std::string_view, std::string_view> kPrefixes[] = {
       {"VLP-", "velodyne"}, {"HDL-", "velodyne"}, {"VLS-", "velodyne"}, {"Pandar", "hesai"},
-      {"RS-", "robosense"}, {"Helios", "robosense"}, {"OS", "ouster"}};
+      {"RS-", "robosense"}, {"Helios", "robosense"}, {"OS", "ouster"},
+      {"Mid-360", "livox"}, {"Avia", "livox"}};
   for (const auto& [prefix, family] : kPrefixes)
     if (model.starts_with(prefix)) return find_lidar_family(family);
   return nullptr;

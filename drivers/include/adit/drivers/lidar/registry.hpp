@@ -15,7 +15,7 @@
 namespace adit::drivers {
 
 struct LidarFamily {
-  std::string_view name;  // "velodyne", "hesai", "robosense", "ouster"
+  std::string_view name;  // "velodyne", "hesai", "robosense", "livox", "ouster"
   // The model name when `payload` (sent to `dst_port`) is a data packet of this family, else "".
   std::string (*detect)(std::span<const std::uint8_t> payload, std::uint16_t dst_port);
   // A decoder for `model`, configured by its calibration or metadata file (some families can do
@@ -45,5 +45,6 @@ LidarFamily velodyne_family();
 LidarFamily hesai_family();
 LidarFamily robosense_family();
 LidarFamily ouster_family();
+LidarFamily livox_family();
 
 }  // namespace adit::drivers
