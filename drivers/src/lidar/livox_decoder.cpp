@@ -2,6 +2,7 @@
 // (layouts in livox_packet.hpp, scan cutting by time phase in livox.hpp).
 #include "adit/drivers/lidar/livox.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <numbers>
@@ -14,6 +15,7 @@ namespace adit::drivers {
 namespace {
 
 constexpr std::size_t kAngleSteps = 36000;  // 0.01°
+constexpr float kLastPhaseDeg = 359.9999F;
 constexpr std::size_t kMaxSdk2Points = (1472 - kLivoxSdk2HeaderBytes) / 8;
 
 std::string lower_alnum(std::string_view s) {
@@ -119,7 +121,8 @@ DecodedPacket LivoxDecoder::decode(std::span<const std::uint8_t> payload, std::i
   for (std::size_t i = 0; i < h.records; ++i) {
     const std::uint8_t* rec = data + i * h.format.record_bytes;
     const std::int64_t t = h.timestamp_ns + static_cast<std::int64_t>(i) * record_ns;
-    const float phase = static_cast<float>(t % period) * phase_scale;
+    // In float, the last nanoseconds of a window round up to 360°: keep them in this window.
+    const float phase = std::min(static_cast<float>(t % period) * phase_scale, kLastPhaseDeg);
     const auto ring = static_cast<std::uint16_t>(i % lines_);
     for (std::size_t k = 0; k < h.format.returns; ++k) {
       float x = 0.0F, y = 0.0F, z = 0.0F, range = 0.0F;
