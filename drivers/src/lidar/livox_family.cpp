@@ -9,8 +9,9 @@ LidarFamily livox_family() {
   LidarFamily f;
   f.name = "livox";
   f.detect = [](std::span<const std::uint8_t> payload, std::uint16_t) -> std::string {
+    // Point packets only: an IMU packet (another port) is not where the data is.
     const auto model = livox_model_from_packet(payload);
-    return model ? std::string(livox_model_name(*model)) : std::string();
+    return model && !decode_livox_imu(payload) ? std::string(livox_model_name(*model)) : std::string();
   };
   f.make_decoder = [](const std::string& model, const std::filesystem::path&) -> std::unique_ptr<LidarDecoder> {
     return make_livox_decoder(model);
