@@ -122,7 +122,7 @@ std::optional<LivoxImuReading> decode_livox_imu(std::span<const std::uint8_t> p)
     imu.sensor_time_ns = r.header.timestamp_ns;
     for (std::size_t k = 0; k < 3; ++k) {
       imu.gyro_rad_s[k] = le_f32(p, at + 4 * k);
-      imu.accel_m_s2[k] = static_cast<float>(le_f32(p, at + 12 + 4 * k) * kLivoxStandardGravity);
+      imu.accel_m_s2[k] = le_f32(p, at + 12 + 4 * k) * static_cast<float>(kLivoxStandardGravity);  // in float: no overflow
     }
     for (std::size_t k = 0; k < 3; ++k) {
       // NaN or absurd values (a damaged packet): no reading.

@@ -29,7 +29,7 @@ std::string_view known_lidar_packets() {
          "3.1 QT64 1072 B, 3.2 QT128 818-1127 B (by header flags), Pandar64 1194/1198 B, Pandar40P 1262/1266 B "
          "(blocks 0xFF 0xEE); RoboSense MSOP 1248 B (0x55 0xAA 0x05 0x0A / 0x55 0xAA 0x05 0x5A); "
          "Livox SDK2 (Mid-360) version 0, length field = size, ports 56300/56301 (points) 56401 (IMU); "
-         "Livox SDK1 (Avia) version 5, data types 0-7, port 56001 (any); Ouster by port 7502 and the metadata's "
+         "Livox SDK1 (Avia) version 5, data types 0-8 (1362 B for types 2 and 4), port 56001 (any); Ouster by port 7502 and the metadata's "
          "packet size";
 }
 
