@@ -41,6 +41,15 @@ void OdometryStage::loop() {
     ScanSlot* slot = scans_.take_or_wait(idle);
     if (slot == nullptr) break;
     thread_.beat.beat();
+    // The map starts from a full revolution: a stream joined mid-turn gives a
+    // first scan that covers part of the view, and the next registration
+    // against so small a map can settle tens of centimetres off, which a
+    // LiDAR-inertial filter then takes for velocity.
+    if (first_stamp_ns_ == 0 && !slot->scan.stats.complete) {
+      stats_.skipped_start_scans.fetch_add(1, std::memory_order_relaxed);
+      scans_.release(slot);
+      continue;
+    }
     const slam::OdometryResult& result = odometry_.process(slot->scan);
     const MotionAidCounts& counts = odometry_.counts();
     stats_.wheel_priors.store(counts.wheel_priors, std::memory_order_relaxed);

@@ -16,18 +16,43 @@ slam::OdometryConfig odometry_config_of(const config::Config& config, slam::Odom
   base.min_range_m = static_cast<float>(config.lidar.min_range_m);
   base.max_range_m = static_cast<float>(config.lidar.max_range_m);
   base.max_scan_points = std::max(base.max_scan_points, max_points);
+  if (config.imu.enabled) {
+    base.inertial.noise = {config.imu.gyro_noise_density, config.imu.accel_noise_density, config.imu.gyro_bias_walk,
+                           config.imu.accel_bias_walk};
+  }
   return base;
 }
 
+namespace {
+
+// The IMU's lever arm as its source knows it (the config's, or the Ouster's
+// metadata).
+slam::OdometryConfig with_imu_position(slam::OdometryConfig odometry, const ImuSource* imu) {
+  if (imu != nullptr) odometry.inertial.imu_position = imu->mounting().position_m;
+  return odometry;
+}
+
+bool has_gyro(const config::ImuSection& imu) {
+  return imu.source == config::ImuSource::ouster || !imu.gyro_x_signal.empty();
+}
+
+}  // namespace
+
 ScanOdometry::ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
                            ImuSource* imu, std::function<bool()> idle)
-    : odometry_(odometry),
+    : odometry_(with_imu_position(odometry, config.imu.enabled ? imu : nullptr)),
       extrinsic_(isometry_of(config.lidar.extrinsics).cast<float>()),
       can_(can),
       wheels_(can != nullptr && can->has_wheels()),
       imu_(config.imu.enabled ? imu : nullptr),
       gravity_sigma_rad_(config.imu.gravity_sigma_deg * std::numbers::pi / 180.0),
       idle_(std::move(idle)) {
+  // LiDAR-inertial without wheels (drone, handheld). With wheels the tuned
+  // wheel and gravity priors stay: the filter with the wheels fused into its
+  // prior ends 10x further off on the simulated robot (ODOMETRY.md, Limits).
+  if (imu_ != nullptr && has_gyro(config.imu) && !wheels_) {
+    imu_samples_.reserve(kImuHistoryCapacity);
+  }
   body_points_.reserve(odometry.max_scan_points);
   body_times_.reserve(odometry.max_scan_points);
 }
@@ -51,8 +76,15 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
   if (imu_ != nullptr) imu_->catch_up(until, idle_);
   const std::optional<slam::MotionPrior> prior = wheel_prior_for(scan.start_time_ns);
   const std::optional<slam::UpMeasurement> up = up_for(scan.start_time_ns, sweep_s);
+  // With a gyroscope: its readings from the previous scan's start to past
+  // this sweep's end, for the LiDAR-inertial step.
+  const double t = 1e-9 * static_cast<double>(scan.start_time_ns);
+  imu_samples_.clear();
+  if (imu_samples_.capacity() > 0)
+    imu_->history().copy_covering(previous_scan_s_ > 0.0 ? previous_scan_s_ : t, t + sweep_s, imu_samples_);
+  previous_scan_s_ = t;
   const std::int64_t t0 = monotonic_ns();
-  result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up}, prior);
+  result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up, imu_samples_}, prior);
   registration_ms_ = 1e-6 * static_cast<double>(monotonic_ns() - t0);
   return result_;
 }

@@ -339,7 +339,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
                    {"recorded_datagrams", s.recorded_datagrams.load()}}},
         {"scans", {{"total", s.scans.load()}, {"incomplete", s.incomplete_scans.load()},
-                   {"dropped", s.dropped_scans.load()}}},
+                   {"dropped", s.dropped_scans.load()}, {"skipped_at_start", s.skipped_start_scans.load()}}},
         {"poses", {{"total", s.poses.load()}, {"invalid", s.invalid_poses.load()},
                    {"degenerate", s.degenerate_poses.load()}, {"with_wheel_prior", s.wheel_priors.load()},
                    {"wheels_missing", s.scans_without_wheels.load()},

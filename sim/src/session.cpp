@@ -17,6 +17,8 @@
 #include "adit/sim/robot_path.hpp"
 #include "adit/sim/session_config.hpp"
 #include "adit/sim/spinning_lidar.hpp"
+#include "adit/sim/livox_lidar.hpp"
+#include "adit/drivers/lidar/livox_encoder.hpp"
 #include "adit/sim/targets.hpp"
 #include "adit/sim/truth.hpp"
 #include "adit/sim/imu.hpp"
@@ -43,6 +45,20 @@ Eigen::Isometry3d sensor_extrinsics(const std::string& platform) {
 bool is_drone(const SimOptions& o) { return o.platform == "drone"; }
 bool is_handheld(const SimOptions& o) { return o.platform == "handheld"; }
 bool is_ouster(const SimOptions& o) { return o.sensor.starts_with("OS"); }
+bool is_livox(const SimOptions& o) { return o.sensor == "Mid-360"; }
+
+// The Mid-360's own IMU, inside the sensor (livox_lidar.hpp), at its 200 Hz.
+ImuOptions livox_imu_options(const SimOptions& o, const Eigen::Isometry3d& extrinsics) {
+  ImuOptions imu;
+  imu.noise = o.imu_noise;
+  imu.motion = o.platform == "robot" ? ImuMotion::wheeled : ImuMotion::smooth;
+  imu.vibration.enabled = o.vibration == "on" || (o.vibration == "auto" && o.platform == "drone");
+  imu.mount = extrinsics * livox_mid360_imu_in_sensor();
+  imu.rate_hz = 200.0;
+  imu.time_offset_s = o.imu_time_offset_s;  // stamped by the sensor's clock, as its points
+  imu.seed = o.seed ^ 0x4C69766F78ULL;      // another unit than a CAN IMU's
+  return imu;
+}
 
 double min_duration_s(const SimOptions& o) {
   return is_drone(o) ? drone_min_duration_s() : is_handheld(o) ? handheld_min_duration_s() : robot_min_duration_s();
@@ -133,7 +149,8 @@ void validate(const SimOptions& o) {
           "unknown scene '" + o.scene + "' (mine, drift, building)");
   require(o.platform == "robot" || o.platform == "drone" || o.platform == "handheld", "--platform",
           "unknown platform '" + o.platform + "' (robot, drone, handheld)");
-  const SpinningSensor sensor = make_spinning_sensor(o.sensor);  // throws for models the simulator does not have
+  // Throws for models the simulator does not have.
+  const SpinningSensor sensor = is_livox(o) ? SpinningSensor{} : make_spinning_sensor(o.sensor);
   const double shortest = min_duration_s(o);
   require(std::isfinite(o.duration_s) && o.duration_s >= shortest && o.duration_s <= 7200.0, "--duration",
           "must be between " + std::to_string(shortest) + " and 7200 s for the " + o.platform);
@@ -199,8 +216,8 @@ SimSummary run_simulation(const SimOptions& o) {
   const RayCaster caster(scene.mesh);
   const std::vector<Target> targets = place_targets(scene, caster, o.targets);
 
-  const SpinningSensor sensor = make_spinning_sensor(o.sensor);
-  {
+  const SpinningSensor sensor = is_livox(o) ? SpinningSensor{} : make_spinning_sensor(o.sensor);
+  if (!is_livox(o)) {  // a Livox needs no calibration file: its packets carry Cartesian points
     std::ofstream out(o.out / sensor.calibration_file, std::ios::trunc);
     out << sensor.calibration_text;
     if (!out) throw InputError((o.out / sensor.calibration_file).string(), "", "could not write the calibration");
@@ -236,11 +253,49 @@ SimSummary run_simulation(const SimOptions& o) {
     }
   };
   const People people = simulated_people(scene, o);
-  const LidarSimStats stats =
-      simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, people, lidar, pcap,
-                              ouster_imu ? std::function<void(std::int64_t)>(write_imu_packets) : nullptr);
+  LidarSimStats stats;
+  // A Mid-360 sends its IMU's SDK2 packets (200 Hz, to port 56401) beside its points, always.
+  const ImuOptions livox_imu = livox_imu_options(o, lidar.extrinsics);
+  const std::vector<ImuSample> livox_samples = is_livox(o) ? simulate_imu(body, livox_imu) : std::vector<ImuSample>{};
+  std::size_t livox_imu_written = 0;
+  const auto write_livox_imu_packets = [&](std::int64_t until_ns) {
+    drivers::UdpEndpoints endpoints;
+    endpoints.src_port = 56400;
+    endpoints.dst_port = drivers::kLivoxMid360ImuPort;
+    constexpr std::int64_t kCaptureLatencyNs = 100'000;
+    std::vector<std::uint8_t> bytes(drivers::kLivoxSdk2ImuPacketBytes);
+    for (; livox_imu_written < livox_samples.size(); ++livox_imu_written) {
+      const ImuSample& sample = livox_samples[livox_imu_written];
+      const std::int64_t stamp_ns = o.start_time_ns + std::llround(sample.stamp * 1e9);
+      if (stamp_ns + kCaptureLatencyNs > until_ns) break;
+      const float gyro[3] = {static_cast<float>(sample.gyro.x()), static_cast<float>(sample.gyro.y()),
+                             static_cast<float>(sample.gyro.z())};
+      const float accel_g[3] = {static_cast<float>(sample.accel.x() / kStandardGravity),
+                                static_cast<float>(sample.accel.y() / kStandardGravity),
+                                static_cast<float>(sample.accel.z() / kStandardGravity)};
+      drivers::encode_livox_sdk2_imu(stamp_ns, static_cast<std::uint16_t>(livox_imu_written), gyro, accel_g, bytes);
+      pcap.write_udp(stamp_ns + kCaptureLatencyNs, endpoints, bytes);
+    }
+  };
+  if (is_livox(o)) {
+    LivoxSimOptions livox;
+    livox.effects = lidar.effects;
+    livox.seed = o.seed;
+    livox.start_time_ns = o.start_time_ns;
+    livox.extrinsics = lidar.extrinsics;
+    const LivoxSimStats s = simulate_livox_lidar(LivoxPattern{}, body, caster, scene.mesh, targets, people, livox, pcap,
+                                                 write_livox_imu_packets);
+    write_livox_imu_packets(std::numeric_limits<std::int64_t>::max());
+    stats.packets = s.packets;
+    stats.rays = s.rays;
+    stats.returns = s.returns;
+  } else {
+    stats = simulate_spinning_lidar(sensor, body, caster, scene.mesh, targets, people, lidar, pcap,
+                                    ouster_imu ? std::function<void(std::int64_t)>(write_imu_packets) : nullptr);
+  }
   write_imu_packets(std::numeric_limits<std::int64_t>::max());
   pcap.flush();
+  if (is_livox(o)) write_imu_truth(o.out / "truth_livox_imu.csv", livox_samples, o.start_time_ns, livox_imu.time_offset_s);
 
   WheelOptions wheels;
   wheels.radius_error = o.wheel_radius_error;
@@ -281,7 +336,7 @@ SimSummary run_simulation(const SimOptions& o) {
   write_ply(o.out / "scene.ply", scene.mesh);
   if (!scene.design.triangles.empty()) write_ply_points(o.out / "bim.ply", sample_surface(scene.design, 100.0, o.seed));
   write_targets_csv(o.out / "targets.csv", targets);
-  write_session_config(o.out / "session.yaml", o, sensor.calibration_file, wheels,
+  write_session_config(o.out / "session.yaml", o, is_livox(o) ? std::string() : sensor.calibration_file, wheels,
                        simulated_imu(o, imu_source == SimImuSource::none ? SimImuSource::can : imu_source), imu_source,
                        lidar.extrinsics);
 

@@ -31,10 +31,11 @@ void write_session_config(const std::filesystem::path& file, const SimOptions& o
       "# Replays lidar.pcap and can.log; ground truth is in truth_*.tum, truth_imu.csv, scene.ply, targets.csv.\n"
       "payload:\n  id: sim-{}-{}\n  state_dir: state\n\n"
       "log:\n  level: info\n\n"
-      "lidar:\n  model: {}\n  source: pcap\n  pcap: lidar.pcap\n  calibration: {}\n  replay_speed: 1.0\n"
+      "lidar:\n  model: {}\n  source: pcap\n  pcap: lidar.pcap\n{}  replay_speed: 1.0\n"
       "  return_mode: strongest\n  min_range_m: {}\n  max_range_m: {}\n"
       "  extrinsics:\n    xyz_m: [{}, {}, {}]\n    rpy_deg: [{}, {}, {}]\n\n",
-      o.scene, o.platform, o.sensor, o.duration_s, o.seed, o.scene, o.seed, o.sensor, calibration_file, o.min_range_m, o.max_range_m,
+      o.scene, o.platform, o.sensor, o.duration_s, o.seed, o.scene, o.seed, o.sensor,
+      calibration_file.empty() ? std::string() : "  calibration: " + calibration_file + "\n", o.min_range_m, o.max_range_m,
       t.x(), t.y(), t.z(), rpy.x() + 0.0, rpy.y() + 0.0, rpy.z() + 0.0);  // + 0.0: no "-0"
   const bool wheels = o.wheels && o.platform == "robot";
   const bool can_imu = imu_source == SimImuSource::can;

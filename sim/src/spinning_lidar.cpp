@@ -27,7 +27,7 @@ SpinningSensor make_spinning_sensor(std::string_view model) {
   if (model == "PandarXT32") return hesai_xt32_sensor();
   if (model == "OS1-64") return ouster_os1_64_sensor();
   throw InputError("adit sim", "--sensor",
-                   "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32, OS1-64)");
+                   "unsupported sensor '" + std::string(model) + "' (VLP-16, RS-16, PandarXT32, OS1-64, Mid-360)");
 }
 
 LidarSimStats simulate_spinning_lidar(const SpinningSensor& sensor, const BodyTrack& body, const RayCaster& caster,

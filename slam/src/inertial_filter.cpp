@@ -106,6 +106,10 @@ void InertialFilter::reset(const InertialState& state, const Matrix6d& pose_cova
 bool InertialFilter::propagate(std::span<const ImuSample> samples, double t_end) {
   if (!covers(samples, state_.t, t_end, config_.max_sample_gap_s)) return false;
   const ImuNoise& n = config_.noise;
+  const double gyro_density2 = n.gyro_noise_density * n.gyro_noise_density +
+                               config_.gyro_model_error_density * config_.gyro_model_error_density;
+  const double accel_density2 = n.accel_noise_density * n.accel_noise_density +
+                                config_.accel_model_error_density * config_.accel_model_error_density;
   for_each_piece(samples, state_.t, t_end, [&](const Reading& a, const Reading& b, double dt) {
     const Eigen::Matrix3d R = state_.pose.linear();
     const auto [w, f] = integrate(state_, a, b, dt, config_.imu_position);
@@ -120,9 +124,10 @@ bool InertialFilter::propagate(std::span<const ImuSample> samples, double t_end)
     F.block<3, 3>(kV, kBa) = -dt * R;
     F.block<3, 3>(kV, kG) = dt * Eigen::Matrix3d::Identity();
     covariance_ = F * covariance_ * F.transpose();
-    // White noise integrated over dt: density² · dt (isotropic, so R·Q·Rᵀ = Q).
-    covariance_.block<3, 3>(kTheta, kTheta).diagonal().array() += n.gyro_noise_density * n.gyro_noise_density * dt;
-    covariance_.block<3, 3>(kV, kV).diagonal().array() += n.accel_noise_density * n.accel_noise_density * dt;
+    // White noise integrated over dt: density² · dt (isotropic, so R·Q·Rᵀ = Q),
+    // the model error's with the datasheet's.
+    covariance_.block<3, 3>(kTheta, kTheta).diagonal().array() += gyro_density2 * dt;
+    covariance_.block<3, 3>(kV, kV).diagonal().array() += accel_density2 * dt;
     covariance_.block<3, 3>(kBg, kBg).diagonal().array() += n.gyro_bias_walk * n.gyro_bias_walk * dt;
     covariance_.block<3, 3>(kBa, kBa).diagonal().array() += n.accel_bias_walk * n.accel_bias_walk * dt;
   });

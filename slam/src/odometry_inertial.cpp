@@ -89,8 +89,12 @@ void Odometry::register_inertial(const ScanInput& scan, const std::optional<Moti
   const double reacquire_sigma = config_.initial_threshold_m / 3.0;
   const Eigen::Matrix3d position_covariance = inertial_.covariance().topLeftCorner<3, 3>();
   const double predicted_sigma = std::sqrt(std::max(0.0, position_covariance.selfadjointView<Eigen::Upper>().eigenvalues().maxCoeff()));
-  const double sigma =
-      reacquire_ ? reacquire_sigma : std::min(std::max(threshold_.sigma(), predicted_sigma), reacquire_sigma);
+  // At least what lets the kernel start at its floor (the range noise's scale):
+  // an IMU predicts so well that the prediction's σ alone would gate out the
+  // residuals of a correct alignment (range noise, map spacing, plane fit).
+  const double floor_sigma = 3.0 * inertial_registration_.min_kernel_scale_m;
+  const double sigma = reacquire_ ? reacquire_sigma
+                                  : std::clamp(std::max(threshold_.sigma(), predicted_sigma), floor_sigma, reacquire_sigma);
   reacquire_ = false;
   const auto register_from = [&](const PosePrior& start) {
     return register_scan(source, map_, start, 3.0 * sigma, sigma / 3.0, inertial_registration_, planes_);

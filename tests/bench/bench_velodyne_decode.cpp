@@ -13,6 +13,7 @@
 
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/velodyne.hpp"
+#include "adit/drivers/lidar/velodyne_encoder.hpp"
 #include "adit/drivers/pcap_reader.hpp"
 #include "shared_data.hpp"
 
@@ -135,6 +136,51 @@ void BM_DecodeAndAssemble(benchmark::State& state) {
   state.SetItemsProcessed(points);
 }
 
+// VLS-128 (no real capture is public): 256 synthetic strongest-return packets written by the
+// encoder (3 firing sequences x 128 lasers each, every laser returning), and dual packets.
+void BM_DecodeVls128Synthetic(benchmark::State& state) {
+  const bool dual = state.range(0) == 1;
+  VelodyneCalibration calibration;
+  for (int l = 0; l < 128; ++l) {
+    VelodyneLaser laser;
+    laser.laser_id = l;
+    laser.vert_correction = (l - 64) * 0.003;
+    laser.rot_correction = (l % 8 - 4) * 0.01;
+    calibration.lasers.push_back(laser);
+  }
+  std::vector<std::vector<std::uint8_t>> packets;
+  for (int k = 0; k < 256; ++k) {
+    VelodyneDataPacket p;
+    p.us_past_hour = static_cast<std::uint32_t>(1000 + k * (dual ? 53 : 160));
+    p.mode = dual ? VelodyneReturnMode::dual : VelodyneReturnMode::strongest;
+    for (std::size_t b = 0; b < 12; ++b) {
+      const std::size_t group = dual ? 0 : b / 4;
+      p.blocks[b].azimuth = static_cast<std::uint16_t>((k * (dual ? 20 : 60) + group * 20) % 36000);
+      for (std::size_t c = 0; c < 32; ++c) {
+        p.blocks[b].distance[c] = static_cast<std::uint16_t>(dual && b >= 8 ? 0 : 2000 + c + (dual ? b % 2 : 0) * 7);
+        p.blocks[b].reflectivity[c] = static_cast<std::uint8_t>(c);
+      }
+    }
+    packets.emplace_back(kVelodyneDataPacketSize);
+    encode_velodyne_packet(VelodyneModel::vls128, p, std::span<std::uint8_t, kVelodyneDataPacketSize>(packets.back()));
+    if (dual) {  // the encoder writes single-return bank flags; a dual packet pairs them
+      for (std::size_t b = 0; b < 8; ++b) packets.back()[b * 100 + 1] = static_cast<std::uint8_t>(0xEE - 0x11 * (b / 2));
+    }
+  }
+  VelodyneDecoder decoder(VelodyneModel::vls128, calibration);
+  std::int64_t points = 0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const DecodedPacket d = decoder.decode(packets[i], 1'700'000'000'000'000'000);
+    if (d.status != PacketStatus::ok) state.SkipWithError("a synthetic VLS-128 packet did not decode");
+    benchmark::DoNotOptimize(d.points.data());
+    points += static_cast<std::int64_t>(d.points.size());
+    i = i + 1 == packets.size() ? 0 : i + 1;
+  }
+  state.SetItemsProcessed(points);
+}
+
+BENCHMARK(BM_DecodeVls128Synthetic)->Arg(0)->Arg(1)->ArgName("single_dual");
 BENCHMARK(BM_Decode)->Arg(0)->Arg(1)->ArgName("vlp16dual_vlp32c");
 BENCHMARK(BM_DecodeNaiveBaseline)->Arg(0)->Arg(1)->ArgName("vlp16dual_vlp32c");
 BENCHMARK(BM_DecodeAndAssemble)->Arg(0)->Arg(1)->ArgName("vlp16dual_vlp32c");

@@ -15,6 +15,8 @@ struct HesaiLayout {
   int lasers, blocks, unit_bytes, after_body;
   int tail_bytes, t_return_mode, t_date, t_timestamp, t_sequence;  // -1: none
   int year_base;
+  int protocol_minor = 1;
+  int header_flags = 1;  // header byte 11: bit 0 UDP sequence (QT128: also 0x04 safety, 0x08 signature, 0x10 confidence)
 };
 
 inline std::vector<HesaiLayout> hesai_layouts() {
@@ -23,7 +25,10 @@ inline std::vector<HesaiLayout> hesai_layouts() {
       {"PandarXT32", 0, 6, 32, 8, 4, 0, 28, 10, 13, 19, 24, 1900},
       {"PandarXT32M", 0, 6, 32, 6, 4, 0, 28, 10, 13, 19, 24, 1900},
       {"PandarQT64", 0, 3, 64, 4, 4, 0, 28, 16, 18, 12, 24, 1900},
-      {"PandarQT128", 0, 1, 128, 2, 4, 21, 34, 12, 15, 21, 26, 1900},
+      // QT128C2X, protocol 3.2 (Hesai SDK 2.0 udp_protocol_v3_2.h; QT128C2X manual "Point Cloud Data Packet"):
+      // 12-byte head, 2 x (azimuth + 128 x 4-byte units), body CRC 4, functional safety 17, tail 26,
+      // sequence 4, tail CRC 4, signature 32 = 1127 bytes with every header flag set (0x1D).
+      {"PandarQT128", 0, 3, 128, 2, 4, 4 + 17, 26 + 4 + 4 + 32, 12, 15, 21, 26, 1900, 2, 0x1D},
       {"Pandar40P", 2, 0, 40, 10, 3, 0, 22, 14, 16, 10, -1, 2000},
       {"Pandar64", 1, 0, 64, 6, 3, 0, 22, 14, 16, 10, -1, 2000},
   };
@@ -54,9 +59,10 @@ inline std::vector<std::uint8_t> hesai_packet(const HesaiLayout& l, const HesaiC
   const int tail = header + l.blocks * block_bytes + l.after_body;
   std::vector<std::uint8_t> p(static_cast<std::size_t>(tail + l.tail_bytes), 0);
   if (l.framing == 0) {
-    p[0] = 0xEE, p[1] = 0xFF, p[2] = static_cast<std::uint8_t>(l.protocol_major), p[3] = 1;
+    p[0] = 0xEE, p[1] = 0xFF, p[2] = static_cast<std::uint8_t>(l.protocol_major);
+    p[3] = static_cast<std::uint8_t>(l.protocol_minor);
     p[6] = static_cast<std::uint8_t>(l.lasers), p[7] = static_cast<std::uint8_t>(l.blocks);
-    p[9] = c.dis_unit_mm, p[10] = 1, p[11] = 1;
+    p[9] = c.dis_unit_mm, p[10] = 1, p[11] = static_cast<std::uint8_t>(l.header_flags);
   } else if (l.framing == 1) {
     p[0] = 0xEE, p[1] = 0xFF, p[2] = static_cast<std::uint8_t>(l.lasers), p[3] = static_cast<std::uint8_t>(l.blocks);
     p[5] = c.dis_unit_mm;

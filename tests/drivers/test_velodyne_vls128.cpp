@@ -36,10 +36,11 @@ VelodyneCalibration vls128_calibration() {
   return c;
 }
 
-// When laser l fires after the sequence start (manual's firing-timing table).
+// When laser l fires after the packet's timestamp (manual §9.5: FiringGroupIndex = l / 8 + l / 64,
+// ExactPointTime = Timestamp + 2.665 µs x FiringGroupIndex - 8.7 µs).
 std::int64_t firing_ns(int laser) {
-  const int group = laser / 8;
-  return (group + (group >= 8 ? 1 : 0)) * 2'665;
+  const int group = laser / 8 + laser / 64;
+  return group * 2'665 - 8'700;
 }
 
 struct Echo {
@@ -90,7 +91,7 @@ TEST(VelodyneVls128Dual, DecodesBothReturnsOfEveryBankWithRingAndFiringTime) {
   ASSERT_EQ(d.status, PacketStatus::ok);
   EXPECT_EQ(decoder.last_return_mode(), VelodyneReturnMode::dual);
   ASSERT_EQ(d.points.size(), 2u * kLasers);
-  EXPECT_EQ(d.sensor_time_ns, host);
+  EXPECT_EQ(d.sensor_time_ns, host - 8'700);  // the first firing, 8.7 µs before the stamp
   for (std::size_t i = 0; i < d.points.size(); ++i) {
     const int block = static_cast<int>(i) / 32;
     const int laser = block / 2 * 32 + static_cast<int>(i) % 32;
@@ -124,7 +125,7 @@ TEST(VelodyneVls128Dual, InterpolatesAzimuthWithTheAdvanceSincePreviousPacket) {
   const double advance = std::round(20.0 * 53'300 / 53'000);  // 0.01° per 53.3 µs sequence
   for (std::size_t i = 0; i < d.points.size(); ++i) {
     const int laser = static_cast<int>(i) / 64 * 32 + static_cast<int>(i) % 32;
-    const double az = std::round(10 + advance * static_cast<double>(firing_ns(laser)) / 53'300.0);
+    const double az = std::round(10 + advance * static_cast<double>(firing_ns(laser) + 8'700) / 53'300.0);
     EXPECT_NEAR(d.points[i].azimuth_deg, az / 100.0, 1e-4) << "laser " << laser;
   }
   // The last firing group: 0.8 of the way to the next sequence.

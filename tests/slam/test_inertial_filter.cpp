@@ -118,6 +118,15 @@ TEST(InertialFilter, PredictedMotionIsTheBodysRelativeMotion) {
   EXPECT_DOUBLE_EQ(filter.state().t, 2.0);  // predicting changes nothing
 }
 
+// The filter's arithmetic on an IMU that is exactly its model: no error
+// beyond the datasheet's noise (these samples have none at all).
+InertialConfig exactly_modelled() {
+  InertialConfig config;
+  config.gyro_model_error_density = 0.0;
+  config.accel_model_error_density = 0.0;
+  return config;
+}
+
 TEST(InertialFilter, SamplesThatDoNotCoverTheIntervalAreRefused) {
   const Motion m;
   InertialFilter filter(InertialConfig{});
@@ -141,7 +150,7 @@ TEST(InertialFilter, PoseUpdatesRevealVelocityBiasesAndGravity) {
   const Eigen::Vector3d gyro_bias(0.004, -0.006, 0.003);     // rad/s, 0.2-0.3°/s
   const Eigen::Vector3d accel_bias(0.08, -0.05, 0.1);        // m/s²
   const std::vector<ImuSample> imu = samples(m, 0.0, 31.0, 200.0, gyro_bias, accel_bias);
-  InertialFilter filter(InertialConfig{});
+  InertialFilter filter(exactly_modelled());
   InertialState start = m.state(0.0);
   start.velocity.setZero();  // unknown: the body is moving at 2.5 m/s
   start.gravity = Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()) * start.gravity;  // 1.1° off
@@ -174,7 +183,7 @@ TEST(InertialFilter, PoseUpdatesRevealVelocityBiasesAndGravity) {
 
 TEST(InertialFilter, ThePriorIsThePropagatedPoseWithItsCovariance) {
   const Motion m;
-  InertialFilter filter(InertialConfig{});
+  InertialFilter filter(exactly_modelled());
   filter.reset(m.state(0.0));
   const std::vector<ImuSample> imu = samples(m, 0.0, 0.2, 200.0);
   ASSERT_TRUE(filter.propagate(imu, 0.1));
@@ -185,6 +194,21 @@ TEST(InertialFilter, ThePriorIsThePropagatedPoseWithItsCovariance) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(std::sqrt(covariance(i, i)), 0.2, 0.02) << i;
   // Rotation: the gyroscope's bias σ (0.01 rad/s) for 0.1 s, 1 mrad.
   for (int i = 3; i < 6; ++i) EXPECT_NEAR(std::sqrt(covariance(i, i)), 1e-3, 2e-4) << i;
+}
+
+// The model error widens the rotation's σ as a white rate noise would:
+// σ² = (σ_bg·dt)² + density²·dt, with the datasheet's density beside it.
+TEST(InertialFilter, ModelErrorAddsToTheDatasheetNoise) {
+  const Motion m;
+  InertialConfig config;
+  config.gyro_model_error_density = 0.02;
+  config.noise.gyro_noise_density = 0.01;
+  InertialFilter filter(config);
+  filter.reset(m.state(0.0));
+  ASSERT_TRUE(filter.propagate(samples(m, 0.0, 0.2, 200.0), 0.1));
+  const Matrix6d covariance = filter.pose_prior().information.inverse();
+  const double expected = std::sqrt(1e-3 * 1e-3 + (0.02 * 0.02 + 0.01 * 0.01) * 0.1);
+  for (int i = 3; i < 6; ++i) EXPECT_NEAR(std::sqrt(covariance(i, i)), expected, 0.1 * expected) << i;
 }
 
 }  // namespace

@@ -43,6 +43,7 @@ struct BenchOptions {
   std::string baseline_out;
   std::string baseline = "gicp";
   std::string config_file;  // the payload's config (aditd's): extrinsics, ranges, CAN wheels and accelerometer
+  std::string imu = "on";  // off: the config's IMU ignored (LiDAR only, or LiDAR + wheels), for comparison
   double scan_period_s = 0.0;  // 0 = from the scans' stamps
   float max_range_m = 100.0F;
   float map_voxel_m = 0.5F;
@@ -75,8 +76,11 @@ void print_drift(const std::string& label, const slam::Trajectory& truth, const 
   if (const auto fit = eval::align_trajectory(a.ref, a.est, eval::Alignment::se3)) {
     std::vector<slam::Pose> aligned;
     for (const auto& pose : a.est) aligned.push_back(fit->apply(pose));
-    const eval::Stats ape = eval::compute_stats(eval::absolute_pose_errors(a.ref, aligned).translation);
-    fmt::print("{}: APE (SE(3)-aligned) rmse {:.3f} m, max {:.3f} m over {} poses\n", label, ape.rmse, ape.max, ape.count);
+    const eval::PoseErrors errors = eval::absolute_pose_errors(a.ref, aligned);
+    const eval::Stats ape = eval::compute_stats(errors.translation);
+    const eval::Stats attitude = eval::compute_stats(errors.rotation_deg);
+    fmt::print("{}: APE (SE(3)-aligned) rmse {:.3f} m, max {:.3f} m over {} poses; attitude rmse {:.3f} deg, max {:.3f} deg\n",
+               label, ape.rmse, ape.max, ape.count, attitude.rmse, attitude.max);
   }
   if (const auto kitti = eval::kitti_drift(a.ref, a.est)) {
     fmt::print("{}: drift {:.3f} % and {:.4f} deg/100 m (KITTI, {} segments of 100-800 m)\n", label,
@@ -121,6 +125,7 @@ int bench_odometry(const BenchOptions& o) {
   std::unique_ptr<daemon::CanFeed> can;
   if (!o.config_file.empty()) {
     payload = config::load_config(o.config_file);
+    if (o.imu == "off") payload.imu.enabled = false;
     config = daemon::odometry_config_of(payload, config, most_points);
     const bool can_imu = payload.imu.enabled && payload.imu.source == config::ImuSource::can;
     if (payload.can.enabled && (payload.wheel_odometry.enabled || can_imu)) {
@@ -245,6 +250,11 @@ void register_bench_commands(CLI::App& app, int& status) {
                        "Payload config as aditd reads it (e.g. the session.yaml of adit sim): the odometry runs in the "
                        "body frame with its extrinsics and range limits, and with the wheels and accelerometer of its "
                        "CAN bus when configured (--max-range then comes from lidar.max_range_m)");
+  odometry->add_option("--imu", o->imu,
+                       "on: the config's IMU as aditd uses it (LiDAR-inertial without wheels, gravity with them); "
+                       "off: ignored, to compare")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   odometry->add_option("--scan-period", o->scan_period_s, "Seconds per scan (default: from the scans' stamps)");
   odometry->add_option("--max-range", o->max_range_m, "Maximum range used, m (default 100)");
   odometry->add_option("--map-voxel", o->map_voxel_m, "Local map voxel, m (default 0.5)");

@@ -151,7 +151,16 @@ int pcap_info(const DecodeOptions& o) {
   }
   const Detected found = detect(o.file, o.port > 0 ? std::optional<std::uint16_t>(o.port) : std::nullopt);
   if (found.lidar.family == nullptr) {
-    fmt::print("sensor: none recognised\n");
+    // Say what was seen, so that an unknown model or a firmware variant can be named.
+    std::string seen;
+    for (const auto& [port, p] : ports) {
+      if (o.port > 0 && port != o.port) continue;
+      std::string sizes;
+      for (const auto& [size, n] : p.sizes) sizes += fmt::format("{}{} B", sizes.empty() ? "" : "/", size);
+      seen += fmt::format("{}port {} ({})", seen.empty() ? "" : ", ", port, sizes);
+    }
+    fmt::print("sensor: none recognised; saw {}\nknown data packets: {}\n", seen.empty() ? "no UDP datagrams" : seen,
+               drivers::known_lidar_packets());
     return kExitOk;
   }
   fmt::print("sensor: {} {} (data on port {})\n", found.lidar.family->name, found.lidar.model, found.port);

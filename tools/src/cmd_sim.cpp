@@ -21,7 +21,7 @@ void register_sim_commands(CLI::App& app, int& status) {
                   "Platform: robot (differential drive, wheel encoders on CAN), drone (6-DoF multirotor) or handheld "
                   "(a person walking with the scanner)")
       ->capture_default_str();
-  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16, RS-16, PandarXT32 or OS1-64 (1024x10, LEGACY profile, 600 rpm)")->capture_default_str();
+  cmd->add_option("--sensor", o->sensor, "LiDAR model: VLP-16, RS-16, PandarXT32, OS1-64 (1024x10, LEGACY profile, 600 rpm) or Mid-360 (Livox SDK2 points and IMU, a non-repetitive pattern model)")->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Session length, seconds")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed: the same seed and options give byte-identical files")->capture_default_str();
   cmd->add_option("--out", *out, "Output folder (created)")->required();

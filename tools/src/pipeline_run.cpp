@@ -65,6 +65,7 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.datagrams = s.datagrams.load();
   f.scans = s.scans.load();
   f.incomplete_scans = s.incomplete_scans.load();
+  f.skipped_start_scans = s.skipped_start_scans.load();
   f.poses = s.poses.load();
   f.invalid_poses = s.invalid_poses.load();
   f.degenerate_poses = s.degenerate_poses.load();
@@ -126,6 +127,7 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
       {"datagrams", f.datagrams},
       {"scans", f.scans},
       {"incomplete_scans", f.incomplete_scans},
+      {"skipped_start_scans", f.skipped_start_scans},
       {"poses", f.poses},
       {"invalid_poses", f.invalid_poses},
       {"degenerate_poses", f.degenerate_poses},
@@ -158,13 +160,13 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
 
 std::string figures_text(const PipelineFigures& f, double from_fraction) {
   std::string text = fmt::format(
-      "scans {} ({} incomplete), poses {} ({} invalid, {} degenerate); dropped {} packets, {} scans; {} bad packets\n"
+      "scans {} ({} incomplete, {} skipped before the first full one), poses {} ({} invalid, {} degenerate); dropped {} packets, {} scans; {} bad packets\n"
       "odometry per scan: median {:.2f} ms, p99 {:.2f} ms\n"
       "latency, last packet of a scan to its pose: median {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms "
       "(beyond odometry: median {:.2f} ms, p99 {:.2f} ms)\n"
       "{:.1f} s of data in {:.1f} s = {:.1f}x real time\n"
       "memory: peak resident {:.1f} MB",
-      f.scans, f.incomplete_scans, f.poses, f.invalid_poses, f.degenerate_poses, f.dropped_packets, f.dropped_scans,
+      f.scans, f.incomplete_scans, f.skipped_start_scans, f.poses, f.invalid_poses, f.degenerate_poses, f.dropped_packets, f.dropped_scans,
       f.bad_packets, f.odometry_median_ms, f.odometry_p99_ms, f.latency_median_ms, f.latency_p99_ms, f.latency_max_ms,
       f.beyond_odometry_median_ms, f.beyond_odometry_p99_ms, f.sensor_span_s, f.duration_s, f.speed(), f.peak_resident_mb);
   if (const auto g = memory_growth(f.memory, from_fraction))

@@ -124,32 +124,42 @@ DecodedPacket HesaiDecoder::decode(std::span<const std::uint8_t> p, std::int64_t
       if (p.size() > s.max_packet_bytes() || p.size() == 1206) return out;
       break;
   }
-  // 2. Size.
-  if (p.size() < s.min_packet_bytes()) return out.status = PacketStatus::truncated, out;
-  if (p.size() > s.max_packet_bytes()) return out.status = PacketStatus::malformed, out;
+  // 2. Size (QT128: the size the header's flags announce, exactly).
+  const HesaiPacketLayout layout = hesai_packet_layout(s, p);
+  if (p.size() < layout.min_bytes) return out.status = PacketStatus::truncated, out;
+  if (p.size() > layout.max_bytes) return out.status = PacketStatus::malformed, out;
 
   // 3. Tail: return mode, time.
-  const std::size_t tail = s.tail_offset();
+  const std::size_t tail = layout.tail;
   const std::uint8_t mode = p[tail + s.tail_return_mode];
   const std::size_t returns = returns_of(mode);
-  const int year_byte = p[tail + s.tail_date_time];
+  const std::size_t date = tail + s.tail_date_time;
+  const int year_byte = p[date];
   const std::uint32_t micros = bytes::le32(p, tail + s.tail_timestamp);
-  const auto seconds = seconds_since_epoch(CivilTime{
-      s.year_base + year_byte, p[tail + s.tail_date_time + 1], p[tail + s.tail_date_time + 2],
-      p[tail + s.tail_date_time + 3], p[tail + s.tail_date_time + 4], p[tail + s.tail_date_time + 5]});
+  std::optional<std::int64_t> seconds;
+  if (s.year_either_century && year_byte == 0) {
+    seconds = static_cast<std::int64_t>(std::uint32_t{p[date + 2]} << 24 | std::uint32_t{p[date + 3]} << 16 |
+                                        std::uint32_t{p[date + 4]} << 8 | std::uint32_t{p[date + 5]});
+  } else {
+    const int year = s.year_either_century && year_byte < 100 ? 2000 + year_byte : s.year_base + year_byte;
+    seconds = seconds_since_epoch(CivilTime{year, p[date + 1], p[date + 2], p[date + 3], p[date + 4], p[date + 5]});
+  }
   if (returns == 0 || s.blocks % returns != 0 || unit_m <= 0.0F || !seconds || micros >= 1'000'000U) {
     return out.status = PacketStatus::malformed, out;
   }
   const std::int64_t packet_ns = *seconds * 1'000'000'000LL + static_cast<std::int64_t>(micros) * 1000;
-  const std::size_t loop_of_packet =
-      s.tail_mode_flag != kNoField ? (p[tail + s.tail_mode_flag] & 0x01U ? 0U : 1U) : 0U;
-  if (s.tail_sequence != kNoField) out.sequence = bytes::le32(p, tail + s.tail_sequence);
-  else if (p.size() >= s.min_packet_bytes() + 4) out.sequence = bytes::le32(p, s.min_packet_bytes());
+  // QT128 firing loop of block b (Hesai SDK 2.0, udp3_2_parser.cc): (mode flag + b / returns + 1) % 2,
+  // 0 = loop 1. nebula's pandar_qt128.hpp agrees for multi-return and for mode flag 1 in single return.
+  const unsigned mode_flag = s.tail_mode_flag != kNoField ? p[tail + s.tail_mode_flag] & 0x01U : 0U;
+  const std::size_t loop_of_packet = (mode_flag + 1U) % 2U;
+  if (layout.sequence_at != 0) out.sequence = bytes::le32(p, layout.sequence_at);
+  else if (p.size() >= layout.min_bytes + 4) out.sequence = bytes::le32(p, layout.min_bytes);
   info_ = {mode, static_cast<std::uint8_t>(returns), bytes::le16(p, tail + s.tail_motor_speed), unit_m};
 
   // 4. Blocks. All blocks of one firing group share the first block's azimuth.
   const std::size_t lasers = s.lasers;
-  const std::size_t block_bytes = s.block_bytes();
+  const std::size_t block_bytes = layout.block_bytes;
+  const std::size_t unit_bytes = layout.unit_bytes;
   const std::size_t body = s.header_bytes();
   std::size_t n = 0;
   for (std::size_t b = 0; b < s.blocks; ++b) {
@@ -160,8 +170,8 @@ DecodedPacket HesaiDecoder::decode(std::span<const std::uint8_t> p, std::int64_t
     const std::size_t group_at = body + (b - b % returns) * block_bytes + s.block_prefix_bytes();
     const std::uint16_t raw_az = bytes::le16(p, group_at);
     if (raw_az >= kAzimuthSteps) return out.status = PacketStatus::malformed, out;
-    // Single return: QT128 alternates loops block by block; multi-return: the tail's mode flag says.
-    const std::size_t loop = s.two_loops() ? (returns == 1 ? b % 2 : loop_of_packet) : 0;
+    // QT128 alternates loops firing by firing, starting from the one the tail's mode flag names.
+    const std::size_t loop = s.two_loops() ? (loop_of_packet + b / returns) % 2 : 0;
     const std::int32_t* firing = firing_ns_[returns - 1][loop].data() + b * lasers;
     const float ca = cos_az_[raw_az];
     const float sa = sin_az_[raw_az];
@@ -171,7 +181,7 @@ DecodedPacket HesaiDecoder::decode(std::span<const std::uint8_t> p, std::int64_t
     const float az_deg = static_cast<float>(raw_az) * 0.01F;
     const std::uint8_t ret = return_index(mode, b % returns, s.reversed_first_last);
     const std::uint8_t* unit = p.data() + at + s.block_prefix_bytes() + 2;
-    for (std::size_t c = 0; c < lasers; ++c, unit += s.unit_bytes) {
+    for (std::size_t c = 0; c < lasers; ++c, unit += unit_bytes) {
       const std::uint16_t raw = static_cast<std::uint16_t>(unit[0] | (unit[1] << 8));
       if (raw == 0) continue;  // no return
       const float r = static_cast<float>(raw) * unit_m;

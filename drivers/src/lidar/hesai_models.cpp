@@ -73,7 +73,7 @@ constexpr Spec xt_series(HesaiModel model, std::string_view name, std::uint16_t 
                          std::uint16_t blocks, std::int32_t channel_step_ns, std::uint16_t modulo) {
   return Spec{model, name, HesaiFraming::preheader12, 6, lasers, blocks, 4, 0, 0,
               /*return_mode*/ 10, /*motor*/ 11, /*date*/ 13, /*timestamp*/ 19, kNoField,
-              /*sequence*/ 24, /*tail_bytes*/ 28, 1900, /*optional*/ 0, true,
+              /*sequence*/ 24, /*tail_bytes*/ 28, 1900, /*optional*/ 0, true, false, false,
               // XT manuals: block m ends 50 us apart, the tail time is 5.632 us after the
               // last block's start; channel i fires 0.368 us + step * i after its block.
               5632, -50000.0, true, {{}, {}}, 368, channel_step_ns, modulo};
@@ -87,23 +87,29 @@ constexpr std::array<Spec, 7> kSpecs = {
     // QT64 3.x tail: reserved[10], motor speed, timestamp, return mode, factory, date-time, sequence.
     // Blocks are 1/3 ms apart (600 rpm, 0.6 deg); the first fires 25.71 us after the tail time.
     Spec{HesaiModel::pandar_qt64, "PandarQT64", HesaiFraming::preheader12, 3, 64, 4, 4, 0, 0,
-         16, 10, 18, 12, kNoField, 24, 28, 1900, 0, false,
+         16, 10, 18, 12, kNoField, 24, 28, 1900, 0, false, false, false,
          25710, 500000.0 / 3.0, false, {kQt64Channel, {}}, 0, 0, 64},
-    // QT128C2X 1.4: body, body CRC u32, functional safety (17 bytes), then the tail:
-    // reserved[5], mode flag, reserved[6], return mode, motor speed, date-time, timestamp,
-    // factory, sequence u32, tail CRC u32; optionally a 32-byte signature.
-    Spec{HesaiModel::pandar_qt128, "PandarQT128", HesaiFraming::preheader12, 1, 128, 2, 4, 0, 21,
-         12, 13, 15, 21, 5, 26, 34, 1900, 32, false,
+    // QT128C2X, protocol 3.2 (not 1.4: that is the Pandar128E3X, whose header also says
+    // 128 lasers x 2 blocks). Hesai SDK 2.0 udp_protocol_v3_2.h and udp_parser.cc
+    // ("case 3 / minor 2: QT128"); nebula pandar_qt128.hpp. Body: blocks of azimuth u16 and
+    // 128 units of distance u16, reflectivity u8 [, confidence u8 when header flag 0x10], body
+    // CRC u32, [functional safety, 17 bytes, flag 0x04], then the 26-byte tail: reserved[5],
+    // mode flag, reserved[3], azimuth flag u16, working mode, return mode, motor speed u16,
+    // date-time[6], timestamp u32, factory; [UDP sequence u32, flag 0x01], tail CRC u32,
+    // [signature 32 bytes, flag 0x08]. The numbers below are the full packet (flags 0x1D:
+    // 1127 bytes); hesai_packet_layout() follows the flags of each packet.
+    Spec{HesaiModel::pandar_qt128, "PandarQT128", HesaiFraming::preheader12, 3, 128, 2, 4, 0, 21,
+         12, 13, 15, 21, 5, 26, 34, 1900, 32, false, true, true,
          9000, 111110.0, true, {kQt128Loop1, kQt128Loop2}, 0, 0, 128},
     // Pandar40P: 10 blocks of (0xFFEE, azimuth, 40 x 3 bytes), then reserved[5], high-temperature
     // flag, reserved[2], motor speed, timestamp, return mode, factory, date-time (year - 2000),
     // optional UDP sequence. Blocks are 55.56 us apart; the tail time is after the last block.
     Spec{HesaiModel::pandar_40p, "Pandar40P", HesaiFraming::sob_blocks, 0, 40, 10, 3, 4, 0,
-         14, 8, 16, 10, kNoField, kNoField, 22, 2000, 4, false,
+         14, 8, 16, 10, kNoField, kNoField, 22, 2000, 4, false, false, false,
          -28580, -55560.0, true, {kP40Channel, {}}, 0, 0, 40},
     // Pandar64: 8-byte header, 6 blocks of (azimuth, 64 x 3 bytes), the Pandar40P tail.
     Spec{HesaiModel::pandar_64, "Pandar64", HesaiFraming::header8, 0, 64, 6, 3, 0, 0,
-         14, 8, 16, 10, kNoField, kNoField, 22, 2000, 4, false,
+         14, 8, 16, 10, kNoField, kNoField, 22, 2000, 4, false, false, false,
          -42580, -55560.0, true, {kP64Channel, {}}, 0, 0, 64},
 };
 
@@ -136,9 +142,34 @@ std::optional<HesaiModel> hesai_model_from_name(std::string_view name) {
 
 std::string_view hesai_model_name(HesaiModel model) { return hesai_spec(model).name; }
 
+HesaiPacketLayout hesai_packet_layout(const Spec& s, std::span<const std::uint8_t> p) {
+  HesaiPacketLayout l;
+  if (!s.flag_driven_layout || p.size() < s.header_bytes()) {
+    l.unit_bytes = s.unit_bytes;
+    l.block_bytes = s.block_bytes();
+    l.tail = s.tail_offset();
+    l.min_bytes = s.min_packet_bytes();
+    l.max_bytes = s.max_packet_bytes();
+    l.sequence_at = s.tail_sequence != kNoField ? l.tail + s.tail_sequence : 0;
+    return l;
+  }
+  const std::uint8_t flags = p[11];
+  constexpr std::size_t kBodyCrc = 4, kSafety = 17, kTail = 26, kSequence = 4, kTailCrc = 4, kSignature = 32;
+  l.unit_bytes = (flags & kHesaiFlagConfidence) != 0 ? 4 : 3;
+  l.block_bytes = 2 + s.lasers * l.unit_bytes;
+  l.tail = s.header_bytes() + s.blocks * l.block_bytes + kBodyCrc + ((flags & kHesaiFlagFunctionalSafety) != 0 ? kSafety : 0);
+  const bool sequence = (flags & kHesaiFlagSequence) != 0;
+  l.sequence_at = sequence ? l.tail + kTail : 0;
+  l.min_bytes = l.tail + kTail + (sequence ? kSequence : 0) + kTailCrc +
+                ((flags & kHesaiFlagSignature) != 0 ? kSignature : 0);
+  l.max_bytes = l.min_bytes;
+  return l;
+}
+
 std::optional<HesaiModel> hesai_model_from_packet(std::span<const std::uint8_t> p) {
   for (const auto& s : kSpecs) {
-    if (p.size() < s.min_packet_bytes() || p.size() > s.max_packet_bytes()) continue;
+    const HesaiPacketLayout layout = hesai_packet_layout(s, p);
+    if (p.size() < layout.min_bytes || p.size() > layout.max_bytes) continue;
     const bool ours = s.framing == HesaiFraming::preheader12
                           ? p[0] == 0xEE && p[1] == 0xFF && p[2] == s.protocol_major && p[6] == s.lasers && p[7] == s.blocks
                       : s.framing == HesaiFraming::header8 ? p[0] == 0xEE && p[1] == 0xFF && p[2] == s.lasers && p[3] == s.blocks
@@ -150,8 +181,9 @@ std::optional<HesaiModel> hesai_model_from_packet(std::span<const std::uint8_t> 
 
 std::int64_t hesai_packet_period_ns(HesaiModel model, std::span<const std::uint8_t> p) {
   const Spec& s = hesai_spec(model);
-  if (p.size() < s.min_packet_bytes()) return 0;
-  const std::uint8_t mode = p[s.tail_offset() + s.tail_return_mode];
+  const HesaiPacketLayout layout = hesai_packet_layout(s, p);
+  if (p.size() < layout.min_bytes) return 0;
+  const std::uint8_t mode = p[layout.tail + s.tail_return_mode];
   const int returns = mode >= 0x33 && mode <= 0x38 ? 1 : mode >= 0x39 && mode <= 0x3C ? 2 : mode == 0x3D ? 3 : 0;
   if (returns == 0) return 0;
   return static_cast<std::int64_t>(std::llround(s.blocks / returns * std::abs(s.block_step_ns)));

@@ -40,6 +40,14 @@ struct HesaiDecoder::Spec {
   int year_base;                 // the date-time's year is year_base + byte
   std::uint16_t optional_bytes;  // optional trailing fields a packet may carry
   bool reversed_first_last;      // dual first+last sent last-first (XT series)
+  // QT128 (protocol 3.2): the header's flag byte says which optional parts the
+  // packet carries (confidence byte per unit, functional safety, UDP sequence,
+  // signature), so its layout is computed per packet (hesai_packet_layout).
+  bool flag_driven_layout;
+  // QT128: a year byte under 100 counts from 2000, else from 1900; a zero year
+  // byte means bytes 2..5 of the date-time hold Unix seconds, big-endian
+  // (Hesai SDK 2.0, udp_protocol_v3_2.h, GetMicroLidarTimeU64).
+  bool year_either_century;
 
   // Firing time of (block b, channel c) relative to the packet's timestamp:
   //   block_base_ns + block_step_ns * k + channel offset, with
@@ -70,5 +78,24 @@ struct HesaiDecoder::Spec {
 };
 
 const HesaiDecoder::Spec& hesai_spec(HesaiModel model);
+
+// Where the parts of one packet are. For a fixed layout it is the spec's; for a
+// flag-driven layout (QT128) it follows the header's flag byte. A packet too
+// short to hold the header gets the spec's (the size check rejects it).
+struct HesaiPacketLayout {
+  std::size_t unit_bytes = 0;
+  std::size_t block_bytes = 0;
+  std::size_t tail = 0;          // offset of the tail
+  std::size_t min_bytes = 0;     // the packet's size without optional trailing fields
+  std::size_t max_bytes = 0;     // with them
+  std::size_t sequence_at = 0;   // offset of the u32 UDP sequence, 0 when absent
+};
+HesaiPacketLayout hesai_packet_layout(const HesaiDecoder::Spec& spec, std::span<const std::uint8_t> packet);
+
+// QT128 header flag bits (Hesai SDK 2.0, udp_protocol_v3_2.h; QT128C2X manual, header "Flags").
+inline constexpr std::uint8_t kHesaiFlagSequence = 0x01;
+inline constexpr std::uint8_t kHesaiFlagFunctionalSafety = 0x04;
+inline constexpr std::uint8_t kHesaiFlagSignature = 0x08;
+inline constexpr std::uint8_t kHesaiFlagConfidence = 0x10;
 
 }  // namespace adit::drivers

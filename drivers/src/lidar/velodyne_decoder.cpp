@@ -33,18 +33,25 @@ struct ModelSpec {
   float distance_resolution_m;
   std::size_t blocks_per_group;  // blocks that share one azimuth and time base
   std::uint32_t group_ns;        // one firing group (sequence) to the next
+  // The packet's timestamp is this much after the first firing of its first group.
+  std::int32_t timestamp_after_first_firing_ns;
+  std::uint8_t other_product_id;  // a second product byte the model sends (0: none)
 };
 
 constexpr std::array<ModelSpec, 4> kModels{{
     // VLP-16: a block holds two 16-laser firing sequences of 55.296 µs; lasers 2.304 µs apart.
-    {VelodyneModel::vlp16, "VLP-16", 0x22, 16, 0.002F, 1, 110'592},
+    {VelodyneModel::vlp16, "VLP-16", 0x22, 16, 0.002F, 1, 110'592, 0, 0x24},  // 0x24: Puck Hi-Res
     // VLP-32C: one 55.296 µs sequence per block; lasers fire in pairs, 2.304 µs apart; 4 mm unit.
-    {VelodyneModel::vlp32c, "VLP-32C", 0x28, 32, 0.004F, 1, 55'296},
+    {VelodyneModel::vlp32c, "VLP-32C", 0x28, 32, 0.004F, 1, 55'296, 0, 0},
     // HDL-32E: one 46.08 µs sequence per block; lasers fire one by one, 1.152 µs apart.
-    {VelodyneModel::hdl32e, "HDL-32E", 0x21, 32, 0.002F, 1, 46'080},
+    {VelodyneModel::hdl32e, "HDL-32E", 0x21, 32, 0.002F, 1, 46'080, 0, 0},
     // VLS-128: a 53.3 µs sequence spans 4 blocks (banks of 32 lasers, flags FFEE/FFDD/FFCC/FFBB);
-    // 8 lasers fire together every 2.665 µs, with one idle slot after each 8 groups; 4 mm unit.
-    {VelodyneModel::vls128, "VLS-128", 0xA1, 128, 0.004F, 4, 53'300},
+    // 8 lasers fire together every 2.665 µs, with one idle slot after each 8 groups; 4 mm unit
+    // (manual 63-9483 §9.3.1.3, whatever a calibration file says: ROS velodyne and nebula also
+    // use a fixed 0.004). "ExactPointTime = Timestamp + TimeOffset - 8.7 µs" (§9.5; nebula's
+    // offset_packet_time = 8.7 µs). Product byte 0xA1 (ROS velodyne VLS128_MODEL_ID = 161,
+    // Alpha Prime) or 0x63 (VLP-16/VLS-128 manuals' table 9-2 "Factory Byte Values").
+    {VelodyneModel::vls128, "VLS-128", 0xA1, 128, 0.004F, 4, 53'300, 8'700, 0x63},
 }};
 
 const ModelSpec& spec(VelodyneModel model) { return kModels[static_cast<std::size_t>(model)]; }
@@ -113,9 +120,8 @@ std::optional<VelodyneModel> velodyne_model_from_name(std::string_view name) {
 std::optional<VelodyneModel> velodyne_model_from_packet(std::span<const std::uint8_t> payload) {
   if (payload.size() != kVelodyneDataPacketSize || payload[0] != 0xFF || payload[1] != 0xEE) return std::nullopt;
   const std::uint8_t product = payload[kProductAt];
-  if (product == 0x24) return VelodyneModel::vlp16;  // VLP-16 Hi-Res: the VLP-16's packet and timing
   for (const ModelSpec& m : kModels) {
-    if (m.product_id == product) return m.model;
+    if (m.product_id == product || (m.other_product_id != 0 && m.other_product_id == product)) return m.model;
   }
   return std::nullopt;
 }
@@ -155,8 +161,10 @@ VelodyneDecoder::VelodyneDecoder(VelodyneModel model, VelodyneCalibration calibr
                      "lists " + std::to_string(calibration_.lasers.size()) + " lasers, the " + std::string(m.name) +
                          " has " + std::to_string(m.lasers));
   }
-  distance_resolution_m_ =
-      calibration_.distance_resolution_m > 0 ? static_cast<float>(calibration_.distance_resolution_m) : m.distance_resolution_m;
+  // The VLS-128's unit is fixed by its protocol; older models' files may state theirs.
+  distance_resolution_m_ = calibration_.distance_resolution_m > 0 && model != VelodyneModel::vls128
+                               ? static_cast<float>(calibration_.distance_resolution_m)
+                               : m.distance_resolution_m;
   blocks_per_group_ = m.blocks_per_group;
   group_ns_ = m.group_ns;
 
@@ -300,13 +308,15 @@ DecodedPacket VelodyneDecoder::decode_data(std::span<const std::uint8_t> payload
     }
   }
   if (p[kProductAt] != 0 && p[kProductAt] != spec(model_).product_id &&
-      !(model_ == VelodyneModel::vlp16 && p[kProductAt] == 0x24)) {
+      !(spec(model_).other_product_id != 0 && p[kProductAt] == spec(model_).other_product_id)) {
     ++model_mismatches_;
   }
   return_mode_ = dual ? VelodyneReturnMode::dual
                       : (mode_byte == 0x38 ? VelodyneReturnMode::last : VelodyneReturnMode::strongest);
 
-  const std::int64_t packet_ns = clock_.resolve(us_past_hour, host_time_ns);
+  // The first firing of the packet: the stamp less the model's lead (VLS-128: 8.7 µs).
+  const std::int64_t packet_ns =
+      clock_.resolve(us_past_hour, host_time_ns) - spec(model_).timestamp_after_first_firing_ns;
   out.sensor_time_ns = packet_ns;
   // Blocks of one firing group: 1 or the VLS-128's 4 banks, doubled in dual mode.
   const std::size_t step = layout.step;

@@ -5,9 +5,10 @@
 // the wheels' motion prior from the CAN feed and the accelerometer's gravity
 // from the IMU source (CAN or Ouster, imu_source.hpp) when configured
 // (slam/motion_history.hpp, slam/gravity.hpp), then slam::Odometry. The
-// gravity prior needs the wheels' acceleration to remove: without wheels the
-// IMU's readings are kept in its history (with the gyroscope's) but give no
-// prior yet. Thread-free: it runs on its caller's thread and waits only for
+// gravity prior needs the wheels' acceleration to remove. Without wheels, an
+// IMU with a gyroscope makes the odometry LiDAR-inertial: its readings from
+// the previous scan to past the sweep go with the scan (ScanInput::imu).
+// Thread-free: it runs on its caller's thread and waits only for
 // a replayed CAN log or pcap's IMU to catch up with the scan. No allocation
 // per scan after construction.
 
@@ -78,6 +79,8 @@ class ScanOdometry {
   double gravity_sigma_rad_;
   std::function<bool()> idle_;
   double previous_stamp_s_ = 0.0;
+  double previous_scan_s_ = 0.0;  // the last scan's start, for the IMU's readings since
+  std::vector<slam::ImuSample> imu_samples_;  // reserved only with a gyroscope
   std::vector<Eigen::Vector3f> body_points_;
   std::vector<float> body_times_;
   slam::OdometryResult result_;

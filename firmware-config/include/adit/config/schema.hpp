@@ -35,12 +35,12 @@ struct Names {
   std::span<const std::pair<std::string_view, E>> table;
 };
 
-// The LiDAR models the drivers decode. Ouster names follow "OS<range>-<beams>".
-inline constexpr std::array<std::string_view, 22> kLidarModels{
+// The LiDAR models the drivers decode. Ouster names follow "OS<range>-<beams>"; Livox: Mid-360 (SDK2), Avia (SDK1).
+inline constexpr std::array<std::string_view, 24> kLidarModels{
     "VLP-16",     "VLP-32C",     "HDL-32E",      "VLS-128",     "RS-16",     "Helios16P",
     "PandarXT16", "PandarXT32",  "PandarXT32M",  "PandarQT64",  "PandarQT128", "Pandar40P",
     "Pandar64",   "OS0-32",      "OS0-64",       "OS0-128",     "OS1-32",    "OS1-64",
-    "OS1-128",    "OS2-32",      "OS2-64",       "OS2-128"};
+    "OS1-128",    "OS2-32",      "OS2-64",       "OS2-128",     "Mid-360",   "Avia"};
 
 inline constexpr std::array<std::string_view, 3> kCanPresets{"", "canopen_tpdo", "odrive"};
 

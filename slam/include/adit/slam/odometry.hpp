@@ -107,11 +107,14 @@ struct OdometryConfig {
   // With a gyroscope (ScanInput::imu), LiDAR-inertial odometry: the IMU
   // predicts and deskews, the scan corrects (inertial_filter.hpp).
   InertialConfig inertial;
-  // σ of one point-to-plane residual against the IMU's prediction.
-  // LiDAR-only, registration.point_sigma_m is set loose (1 m) so that the
-  // wheels keep a drift's axis; an IMU is no such prior: FAST-LIO2 weighs
-  // its points at 0.001 m² (Xu et al. 2022, its released configuration).
-  double inertial_point_sigma_m = 0.0316;
+  // σ of one point-to-plane residual against the IMU's prediction: between
+  // LiDAR-only's 1 m (registration.point_sigma_m, which lets the wheels keep
+  // a drift's axis) and FAST-LIO2's 0.0316 m (0.001 m², its released
+  // configuration). Tighter, a drift's biased axis (decision 010) drags the
+  // filter's velocity and gravity with it; looser, the scan is too weak to
+  // teach the filter its gyroscope's bias. 0.03–0.3 m track every drive of
+  // docs/decisions/020-lio-noise-and-scan-weight.md; 0.1 m in their middle.
+  double inertial_point_sigma_m = 0.1;
 };
 
 // Body motion since the previous scan from wheel odometry, with its

@@ -5,7 +5,7 @@
 // Models and UDP protocols (Hesai user manuals):
 //   PandarXT16, PandarXT32, PandarXT32M   protocol 6.1  (pre-header 0xEE 0xFF 6 1)
 //   PandarQT64                            protocol 3.x  (pre-header 0xEE 0xFF 3 x)
-//   PandarQT128 (QT128C2X)                protocol 1.4  (pre-header 0xEE 0xFF 1 4)
+//   PandarQT128 (QT128C2X)                protocol 3.2  (pre-header 0xEE 0xFF 3 2; optional parts by header flags)
 //   Pandar64                              legacy: 8-byte header 0xEE 0xFF, no version
 //   Pandar40P                             legacy: no header, blocks start with 0xFF 0xEE
 // Points come out in our frame (x forward, y left, z up). Hesai's own frame is
