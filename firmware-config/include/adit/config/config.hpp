@@ -184,7 +184,7 @@ struct MapSection {
   // The exported map follows the graph: each point moves by the correction
   // at its scan's time. Off by default: with one closure per drive the graph
   // spreads the gap evenly along the route, and on the 300 s mine drives the
-  // map's drift sat in the last 60 m, so the map lost 5-22 points of 100
+  // map's drift sat in the last 60 m, so the map lost 5-23 points of 100
   // within 5 cm on two drives of three (docs/LOOPS.md, "Measured").
   bool loops_move_map = false;
 };
