@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "printed_figure.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -16,15 +17,7 @@ namespace {
 using adit::test::CommandRun;
 CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
 
-// The number after `key` in the line that starts with `line`; NaN when absent.
-double figure(const std::string& output, const std::string& line, const std::string& key) {
-  const std::size_t at = output.find(line);
-  if (at == std::string::npos) return std::nan("");
-  const std::size_t end = output.find('\n', at);
-  const std::size_t k = output.find(key, at);
-  if (k == std::string::npos || k > end) return std::nan("");
-  return std::stod(output.substr(k + key.size()));
-}
+using adit::test::printed_figure;
 
 std::filesystem::path simulated_drive() {
   const auto dir = adit::test::binary_dir() / "test-sessions" / "bench-attitude";
@@ -43,10 +36,10 @@ TEST(CmdBenchAttitude, RegistrationAgainstTheTrueMapRecoversTheTilt) {
   ASSERT_EQ(run.status, 0) << run.output;
   const std::string baseline = "  against the true map (baseline):";
   // Measured 0.022 / 0.012 deg rms (roll / pitch) on this drive.
-  EXPECT_LT(figure(run.output, baseline, "roll error rms "), 0.06) << run.output;
-  EXPECT_LT(figure(run.output, baseline, "pitch rms "), 0.06) << run.output;
+  EXPECT_LT(printed_figure(run.output, baseline, "roll error rms "), 0.06) << run.output;
+  EXPECT_LT(printed_figure(run.output, baseline, "pitch rms "), 0.06) << run.output;
   for (const std::string line : {"  against the previous scan alone:", "  against its own map:"}) {
-    const double roll = figure(run.output, line, "roll error rms ");
+    const double roll = printed_figure(run.output, line, "roll error rms ");
     EXPECT_TRUE(std::isfinite(roll)) << line << "\n" << run.output;
     EXPECT_LT(roll, 1.0) << line << "\n" << run.output;  // a registration gone astray, not a tilt error
   }

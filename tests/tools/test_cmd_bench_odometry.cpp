@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "printed_figure.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -16,15 +17,7 @@ namespace {
 using adit::test::CommandRun;
 CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
 
-// The number after `key` in the line that contains `line`; NaN when absent.
-double figure(const std::string& output, const std::string& line, const std::string& key) {
-  const std::size_t at = output.find(line);
-  if (at == std::string::npos) return std::nan("");
-  const std::size_t end = output.find('\n', at);
-  const std::size_t k = output.find(key, at);
-  if (k == std::string::npos || k > end) return std::nan("");
-  return std::stod(output.substr(k + key.size()));
-}
+using adit::test::printed_figure;
 
 std::filesystem::path simulated_walk() {
   const auto dir = adit::test::binary_dir() / "test-sessions" / "bench-odometry-handheld";
@@ -47,8 +40,8 @@ TEST(CmdBenchOdometry, TheImuCarriesAHandheldWalkThatLidarAloneLoses) {
   const CommandRun lio = bench(d, "on");
   ASSERT_EQ(lio.status, 0) << lio.output;
   EXPECT_NE(lio.output.find("CAN IMU"), std::string::npos) << lio.output;
-  const double lio_ape = figure(lio.output, "adit odometry: APE", "rmse ");
-  const double lio_attitude = figure(lio.output, "adit odometry: APE", "attitude rmse ");
+  const double lio_ape = printed_figure(lio.output, "adit odometry: APE", "rmse ");
+  const double lio_attitude = printed_figure(lio.output, "adit odometry: APE", "attitude rmse ");
   // Measured 2026-11-26: 0.009 m and 0.12° rms; LiDAR only 2.2 m and 64°.
   EXPECT_LT(lio_ape, 0.03) << lio.output;
   EXPECT_LT(lio_attitude, 0.3) << lio.output;
@@ -56,7 +49,7 @@ TEST(CmdBenchOdometry, TheImuCarriesAHandheldWalkThatLidarAloneLoses) {
   const CommandRun lidar = bench(d, "off");
   ASSERT_EQ(lidar.status, 0) << lidar.output;
   EXPECT_EQ(lidar.output.find("CAN IMU"), std::string::npos) << lidar.output;
-  const double lidar_ape = figure(lidar.output, "adit odometry: APE", "rmse ");
+  const double lidar_ape = printed_figure(lidar.output, "adit odometry: APE", "rmse ");
   EXPECT_TRUE(std::isfinite(lidar_ape)) << lidar.output;
   EXPECT_GT(lidar_ape, 3.0 * lio_ape) << lio.output << lidar.output;
 }
