@@ -44,8 +44,10 @@ void OdometryStage::loop() {
     // The map starts from a full revolution: a stream joined mid-turn gives a
     // first scan that covers part of the view, and the next registration
     // against so small a map can settle tens of centimetres off, which a
-    // LiDAR-inertial filter then takes for velocity.
-    if (first_stamp_ns_ == 0 && !slot->scan.stats.complete) {
+    // LiDAR-inertial filter then takes for velocity. Only the first scan is
+    // passed over: on a lossy link no scan may ever be complete.
+    if (first_stamp_ns_ == 0 && !slot->scan.stats.complete &&
+        stats_.skipped_start_scans.load(std::memory_order_relaxed) == 0) {
       stats_.skipped_start_scans.fetch_add(1, std::memory_order_relaxed);
       scans_.release(slot);
       continue;

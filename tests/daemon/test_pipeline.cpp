@@ -41,7 +41,7 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   ASSERT_TRUE(pipeline.drained());
   const PipelineStats& s = pipeline.stats();
   EXPECT_GE(s.scans.load(), 5U);  // 876 packets of an 11.7 Hz sensor: about 5 scans
-  // Every scan is a pose but incomplete ones before the first full one.
+  // Every scan is a pose but an incomplete first one.
   EXPECT_EQ(s.poses.load() + s.skipped_start_scans.load(), s.scans.load());
   EXPECT_LE(s.skipped_start_scans.load(), 1U);
   EXPECT_EQ(s.dropped_packets.load(), 0U);
@@ -103,7 +103,7 @@ TEST(Pipeline, RunsWithACanImuAndNoWheels) {
   ASSERT_TRUE(pipeline.drained());
   const PipelineStats& s = pipeline.stats();
   EXPECT_GE(s.scans.load(), 5U);
-  // Every scan is a pose but incomplete ones before the first full one.
+  // Every scan is a pose but an incomplete first one.
   EXPECT_EQ(s.poses.load() + s.skipped_start_scans.load(), s.scans.load());
   EXPECT_LE(s.skipped_start_scans.load(), 1U);
   // The IMU's readings reached the odometry (each scan waited for its own), with their gyroscope.

@@ -71,7 +71,7 @@ TEST_F(Replay, WritesOnePosePerScanAsFastAsItCan) {
   ASSERT_TRUE(j.is_object()) << run.output;
   const auto scans = j["scans"].get<std::uint64_t>();
   EXPECT_GE(scans, 95U) << run.output;  // 10 s at 10 Hz
-  const auto skipped = j["skipped_start_scans"].get<std::uint64_t>();  // incomplete before the first full one
+  const auto skipped = j["skipped_start_scans"].get<std::uint64_t>();  // an incomplete first scan
   EXPECT_LE(skipped, 1U);
   EXPECT_EQ(j["poses"].get<std::uint64_t>() + skipped, scans);
   EXPECT_EQ(j["invalid_poses"].get<std::uint64_t>(), 0U);
@@ -154,7 +154,7 @@ TEST_F(Replay, BenchPipelineReceivesTheWholeCaptureOverLoopback) {
   // it), and a busy machine may drop scans odometry cannot keep up with: each
   // is counted, every other one becomes a pose.
   EXPECT_GE(udp["scans"].get<std::uint64_t>() + 1, file["scans"].get<std::uint64_t>()) << run.output;
-  // An incomplete scan before the first full one is skipped (counted), not made a pose.
+  // An incomplete first scan is skipped (counted), not made a pose.
   const auto count = [](const nlohmann::json& run, const char* key) { return run[key].get<std::uint64_t>(); };
   EXPECT_EQ(count(udp, "poses") + count(udp, "dropped_scans") + count(udp, "skipped_start_scans"), count(udp, "scans"));
   EXPECT_EQ(count(file, "poses") + count(file, "skipped_start_scans"), count(file, "scans"));

@@ -160,7 +160,7 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
 
 std::string figures_text(const PipelineFigures& f, double from_fraction) {
   std::string text = fmt::format(
-      "scans {} ({} incomplete, {} skipped before the first full one), poses {} ({} invalid, {} degenerate); dropped {} packets, {} scans; {} bad packets\n"
+      "scans {} ({} incomplete, {} skipped: an incomplete first scan), poses {} ({} invalid, {} degenerate); dropped {} packets, {} scans; {} bad packets\n"
       "odometry per scan: median {:.2f} ms, p99 {:.2f} ms\n"
       "latency, last packet of a scan to its pose: median {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms "
       "(beyond odometry: median {:.2f} ms, p99 {:.2f} ms)\n"

@@ -42,7 +42,7 @@ struct PipelineFigures {
   std::uint64_t datagrams = 0;
   std::uint64_t scans = 0;
   std::uint64_t incomplete_scans = 0;
-  std::uint64_t skipped_start_scans = 0;  // incomplete before the first full one (no pose)
+  std::uint64_t skipped_start_scans = 0;  // 0 or 1: an incomplete first scan (no pose)
   std::uint64_t poses = 0;
   std::uint64_t invalid_poses = 0;
   std::uint64_t degenerate_poses = 0;

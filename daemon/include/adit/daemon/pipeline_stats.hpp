@@ -21,7 +21,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> scans{0};
   std::atomic<std::uint64_t> dropped_scans{0};     // live: dropped because odometry fell behind
   std::atomic<std::uint64_t> incomplete_scans{0};
-  std::atomic<std::uint64_t> skipped_start_scans{0};  // incomplete scans before the first full one: no map starts from them
+  std::atomic<std::uint64_t> skipped_start_scans{0};  // 0 or 1: an incomplete first scan, from which no map starts
   std::atomic<std::uint64_t> poses{0};
   std::atomic<std::uint64_t> invalid_poses{0};
   std::atomic<std::uint64_t> degenerate_poses{0};
