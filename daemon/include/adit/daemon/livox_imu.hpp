@@ -1,24 +1,21 @@
 #pragma once
 // A Livox LiDAR's own IMU (Mid-360: SDK2 packets to UDP 56401; Avia: SDK1
 // packets among its points) as an ImuSource: the adapter for a future
-// `imu.source: livox`. It is OusterImu's contract (ouster_imu.hpp) with the
-// Livox packet: readings decoded by drivers::decode_livox_imu (gyroscope
+// `imu.source: livox`. It is OusterImu's contract (ouster_imu.hpp, PacketImu) with
+// the Livox packet: readings decoded by drivers::decode_livox_imu (gyroscope
 // rad/s, accelerometer converted from g), checked by ImuMonitor, turned into
 // the body's axes by the mounting, stamped with the packet's timestamp (the
 // same sensor clock as the points) mapped to the host clock by the LiDAR
 // stream's own estimate, minus imu.time_offset_s. Not wired into LidarSource
 // yet (docs/LIDAR-LIVOX.md says how). No allocation, lock or log per packet.
 
-#include <atomic>
 #include <cstdint>
 #include <span>
 
 #include <Eigen/Geometry>
 
 #include "adit/config/config.hpp"
-#include "adit/daemon/handoff.hpp"
-#include "adit/daemon/imu_monitor.hpp"
-#include "adit/daemon/imu_source.hpp"
+#include "adit/daemon/packet_imu.hpp"
 #include "adit/drivers/lidar/sensor_clock.hpp"
 
 namespace adit::daemon {
@@ -27,35 +24,16 @@ namespace adit::daemon {
 // y 23.29, z −44.12 mm, axes parallel), then the LiDAR's extrinsics.
 ImuMounting livox_mid360_imu_mounting(const config::Transform& lidar_extrinsics);
 
-class LivoxImu final : public ImuSource {
+class LivoxImu final : public PacketImu {
  public:
   // `replay`: catch_up waits for the readings of a scan (pcap source).
   LivoxImu(const config::Config& config, const ImuMounting& mounting, bool replay);
 
-  static constexpr double kMaxFromLidarNs = 10e9;  // a stamp farther from the LiDAR's is a corrupt packet
-
   // Assembly thread: one IMU datagram received at `host_time_ns`; `lidar_clock` is the LiDAR stream's estimate.
   void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
             const drivers::ClockOffsetEstimator& lidar_clock);
-  void lidar_reached(double t) { lidar_t_.store(t, std::memory_order_release); }
-  void close() { readings_.close(); }
 
-  void catch_up(double until_t, const std::function<bool()>& idle) override;
-  const slam::ImuHistory& history() const override { return history_; }
-  const ImuMounting& mounting() const override { return mounting_; }
-  const ImuStats& imu_stats() const override { return stats_; }
   const char* imu_name() const override { return "livox"; }
-
- private:
-  ImuStats stats_;
-  ImuMounting mounting_;
-  ImuMonitor monitor_;
-  bool replay_;
-  double time_offset_s_;
-  Handoff<slam::ImuSample> readings_;
-  std::uint64_t packets_ = 0;
-  std::atomic<double> lidar_t_{-1e300};
-  slam::ImuHistory history_{kImuHistoryCapacity};
 };
 
 }  // namespace adit::daemon

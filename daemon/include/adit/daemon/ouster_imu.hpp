@@ -14,23 +14,16 @@
 //       scans' start_time_ns come from, drivers/lidar/sensor_clock.hpp) minus
 //       imu.time_offset_s. Readings before that estimate exists, or stamped
 //       more than 10 s from the LiDAR's newest packet (a corrupt packet), are
-//       dropped (counted `unclocked`).
-// The hand-off drops the oldest reading when full, in replay too: the
-// assembly thread must never wait for the odometry here, which waits for
-// the assembly's scans (a LiDAR that stops while the IMU goes on would
-// otherwise deadlock them); 1024 readings are 10 s at 100 Hz, far more than
-// a replay runs ahead. No allocation, lock or log per packet.
+//       dropped (counted `unclocked`). The hand-off to the odometry is
+//       PacketImu's (packet_imu.hpp). No allocation, lock or log per packet.
 
-#include <atomic>
 #include <cstdint>
 #include <span>
 
 #include <Eigen/Core>
 
 #include "adit/config/config.hpp"
-#include "adit/daemon/handoff.hpp"
-#include "adit/daemon/imu_monitor.hpp"
-#include "adit/daemon/imu_source.hpp"
+#include "adit/daemon/packet_imu.hpp"
 #include "adit/drivers/lidar/ouster_metadata.hpp"
 #include "adit/drivers/lidar/sensor_clock.hpp"
 
@@ -42,13 +35,11 @@ namespace adit::daemon {
 ImuMounting ouster_imu_mounting(const drivers::OusterMetadata& metadata, const config::Transform& lidar_extrinsics,
                                 const std::string& metadata_file);
 
-class OusterImu final : public ImuSource {
+class OusterImu final : public PacketImu {
  public:
   // `replay`: catch_up waits for the readings of a scan (pcap source).
   // Throws adit::InputError naming the metadata file when its IMU profile is not LEGACY.
   OusterImu(const config::Config& config, const drivers::OusterMetadata& metadata, bool replay);
-
-  static constexpr double kMaxFromLidarNs = 10e9;  // see `unclocked` above
 
   std::uint16_t port() const { return port_; }
 
@@ -56,31 +47,12 @@ class OusterImu final : public ImuSource {
   // `host_time_ns`; `lidar_clock` is the LiDAR stream's sensor-clock estimate.
   void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
             const drivers::ClockOffsetEstimator& lidar_clock);
-  // Assembly thread: the LiDAR stream has reached `t` (s, host clock): every
-  // IMU packet that arrived before it has been pushed (a replay's catch_up
-  // stops waiting once the LiDAR is 0.1 s past what it waits for).
-  void lidar_reached(double t) { lidar_t_.store(t, std::memory_order_release); }
-  // Assembly thread: no more packets.
-  void close() { readings_.close(); }
 
-  void catch_up(double until_t, const std::function<bool()>& idle) override;
-  const slam::ImuHistory& history() const override { return history_; }
-  const ImuMounting& mounting() const override { return mounting_; }
-  const ImuStats& imu_stats() const override { return stats_; }
   const char* imu_name() const override { return "ouster"; }
 
  private:
-  ImuStats stats_;
-  ImuMounting mounting_;
-  ImuMonitor monitor_;
   std::uint16_t port_;
-  bool replay_;
-  double time_offset_s_;
-  Handoff<slam::ImuSample> readings_;
   drivers::ClockOffsetEstimator packet_clock_;  // the IMU packets' own (system time, host time) pairs
-  std::uint64_t packets_ = 0;                   // assembly thread
-  std::atomic<double> lidar_t_{-1e300};
-  slam::ImuHistory history_{kImuHistoryCapacity};  // odometry thread
 };
 
 }  // namespace adit::daemon
