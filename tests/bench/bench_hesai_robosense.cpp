@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "../drivers/lidar_packet_builders.hpp"
+#include "decode_rate.hpp"
 #include "adit/drivers/lidar/hesai.hpp"
 #include "adit/drivers/lidar/robosense.hpp"
 #include "adit/drivers/pcap_reader.hpp"
@@ -17,8 +18,6 @@
 
 namespace adit::drivers {
 namespace {
-
-using Packets = std::vector<std::vector<std::uint8_t>>;
 
 Packets capture_or(const char* relative, const std::vector<std::uint8_t>& synthetic) {
   Packets packets;
@@ -40,20 +39,6 @@ HesaiAngleCorrection angles(int lasers) {
   return a;
 }
 
-void run(benchmark::State& state, LidarDecoder& decoder, const Packets& packets) {
-  std::size_t points = 0;
-  for (auto _ : state) {
-    for (const auto& p : packets) {
-      const DecodedPacket out = decoder.decode(p, 0);
-      points += out.points.size();
-      benchmark::DoNotOptimize(out.points.data());
-    }
-  }
-  state.counters["points_per_s"] = benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsRate);
-  state.counters["packets_per_s"] = benchmark::Counter(
-      static_cast<double>(packets.size()) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-}
-
 const test::HesaiLayout& layout(const char* model) {
   static const auto layouts = test::hesai_layouts();
   for (const auto& l : layouts) {
@@ -65,19 +50,19 @@ const test::HesaiLayout& layout(const char* model) {
 void BM_HesaiXT32(benchmark::State& state) {
   static const Packets packets = capture_or("lidar/hesai-xt32/capture.pcap", test::hesai_packet(layout("PandarXT32")));
   HesaiDecoder decoder(HesaiModel::pandar_xt32, angles(32));
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 void BM_HesaiQT64(benchmark::State& state) {
   static const Packets packets = capture_or("lidar/hesai-qt64/capture.pcap", test::hesai_packet(layout("PandarQT64")));
   HesaiDecoder decoder(HesaiModel::pandar_qt64, angles(64));
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 void BM_HesaiQT128Synthetic(benchmark::State& state) {
   const Packets packets(64, test::hesai_packet(layout("PandarQT128")));
   HesaiDecoder decoder(HesaiModel::pandar_qt128, angles(128));
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 void BM_RoboSenseHelios16P(benchmark::State& state) {
@@ -85,7 +70,7 @@ void BM_RoboSenseHelios16P(benchmark::State& state) {
   RoboSenseAngles a;
   for (int i = 0; i < 16; ++i) a.elevation_deg.push_back(-15.0F + 2.0F * i), a.azimuth_deg.push_back(i % 2 ? 3.6F : -4.0F);
   RoboSenseDecoder decoder(RoboSenseModel::helios16p, a, RoboSenseReturnMode::single);
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 // Baseline: the XT32 packets decoded field by field with trigonometry per point

@@ -9,13 +9,12 @@
 #include <random>
 #include <vector>
 
+#include "decode_rate.hpp"
 #include "adit/drivers/lidar/livox.hpp"
 #include "adit/drivers/lidar/livox_encoder.hpp"
 
 namespace adit::drivers {
 namespace {
-
-using Packets = std::vector<std::vector<std::uint8_t>>;
 
 std::vector<LivoxRawPoint> random_points(std::mt19937& rng) {
   std::vector<LivoxRawPoint> pts(96);
@@ -56,28 +55,16 @@ Packets avia_packets() {
   return out;
 }
 
-void run(benchmark::State& state, LidarDecoder& decoder, const Packets& packets) {
-  std::size_t points = 0;
-  for (auto _ : state) {
-    for (const auto& p : packets) {
-      const DecodedPacket out = decoder.decode(p, 0);
-      points += out.points.size();
-      benchmark::DoNotOptimize(out.points.data());
-    }
-  }
-  state.counters["points_per_s"] = benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsRate);
-}
-
 void BM_LivoxMid360(benchmark::State& state) {
   static const Packets packets = mid360_packets();
   LivoxDecoder decoder(LivoxModel::mid360);
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 void BM_LivoxAviaDual(benchmark::State& state) {
   static const Packets packets = avia_packets();
   LivoxDecoder decoder(LivoxModel::avia);
-  run(state, decoder, packets);
+  run_decode(state, decoder, packets);
 }
 
 #pragma pack(push, 1)

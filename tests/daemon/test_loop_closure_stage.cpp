@@ -13,12 +13,7 @@
 namespace adit::daemon {
 namespace {
 
-Eigen::Isometry3d at(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << x, y, 0.0;
-  return T;
-}
+using slam::test::pose_at;
 
 constexpr float kSide = 20.0F;
 
@@ -40,7 +35,7 @@ TEST(LoopClosureStage, ClosesLoopsInTheBackgroundAndPublishesTheCorrection) {
       const Eigen::Isometry3d truth = slam::test::ring_pose(kSide, k * step);
       if (k > 0) {
         const Eigen::Isometry3d motion = slam::test::ring_pose(kSide, (k - 1) * step).inverse() * truth;
-        odometry = odometry * motion * at(0.01 * motion.translation().norm(), 0.0, 0.05 * M_PI / 180 * step);
+        odometry = odometry * motion * pose_at(0.01 * motion.translation().norm(), 0.0, 0.05 * M_PI / 180 * step);
       }
       KeyframeItem item{static_cast<std::int64_t>(k) * 1'000'000'000, odometry,
                         slam::test::scan_of(world, truth, 300 + static_cast<unsigned>(k))};

@@ -11,6 +11,14 @@
 
 namespace adit::slam::test {
 
+// A pose on the floor plane: at (x, y), turned by `yaw` about z.
+inline Eigen::Isometry3d pose_at(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() << x, y, 0.0;
+  return T;
+}
+
 // A square ring of corridors, centreline from (0,0) to (L,0) to (L,L) to
 // (0,L), 4 m wide (|n| ≤ 2), floor at z = -1.5, ceiling at 2.0; `pillars`
 // cylinders of radius 0.3 m at 1.4 m beside the centreline at random places

@@ -10,12 +10,7 @@
 namespace adit::slam {
 namespace {
 
-Eigen::Isometry3d at(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << x, y, 0.0;
-  return T;
-}
+using test::pose_at;
 
 struct Drive {
   std::vector<Eigen::Isometry3d> truth;
@@ -28,7 +23,7 @@ Drive drive(const std::function<Eigen::Isometry3d(double)>& path, double length_
   d.odometry.push_back(d.truth.front());
   for (std::size_t k = 1; k < d.truth.size(); ++k) {
     const Eigen::Isometry3d motion = d.truth[k - 1].inverse() * d.truth[k];
-    const Eigen::Isometry3d bias = at(0.01 * motion.translation().norm(), 0.0, 0.05 * M_PI / 180 * step_m);
+    const Eigen::Isometry3d bias = pose_at(0.01 * motion.translation().norm(), 0.0, 0.05 * M_PI / 180 * step_m);
     d.odometry.push_back(d.odometry.back() * motion * bias);
   }
   return d;
@@ -90,7 +85,7 @@ TEST(LoopCloser, ClosesARingDrivenTwice) {
 // found at a half turn of the descriptor and closed.
 TEST(LoopCloser, ClosesAReverseRevisit) {
   const auto path = [](double s) {
-    return s <= 40.0 ? test::ring_pose(kSide, s) : test::ring_pose(kSide, 80.0 - s) * at(0, 0, M_PI);
+    return s <= 40.0 ? test::ring_pose(kSide, s) : test::ring_pose(kSide, 80.0 - s) * pose_at(0, 0, M_PI);
   };
   const Drive d = drive(path, 80.0, 2.0);
   const Outcome o = close_loops(ring_world(), d);
@@ -105,7 +100,7 @@ TEST(LoopCloser, ClosesAReverseRevisit) {
 // error along the axis as it is: no wrong information reaches the map.
 TEST(LoopCloser, AlongAPlainSymmetricTunnelNoLoopMovesTheAxis) {
   const std::vector<Eigen::Vector3f> tunnel = test::tunnel(150'000, 9, 200.0F);
-  const auto path = [](double s) { return s <= 40.0 ? at(s - 20.0, 0, 0) : at(60.0 - s, 0, M_PI); };
+  const auto path = [](double s) { return s <= 40.0 ? pose_at(s - 20.0, 0, 0) : pose_at(60.0 - s, 0, M_PI); };
   const Drive d = drive(path, 80.0, 2.0);
   LoopCloser closer;
   for (std::size_t k = 0; k < d.truth.size(); ++k)

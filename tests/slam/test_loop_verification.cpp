@@ -10,12 +10,7 @@
 namespace adit::slam {
 namespace {
 
-Eigen::Isometry3d at(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << x, y, 0.0;
-  return T;
-}
+using test::pose_at;
 
 // The candidate's submap: `world` seen from `candidate`, in its frame.
 VoxelHashMap submap_of(const std::vector<Eigen::Vector3f>& world, const Eigen::Isometry3d& candidate, unsigned seed) {
@@ -33,10 +28,10 @@ const std::vector<Eigen::Vector3f>& ring_world() {
 // A revisit 0.4 m and 4° from where the graph puts it: registered, accepted,
 // measured within 3 cm and 0.3°.
 TEST(LoopVerification, ARevisitWithPillarsIsAcceptedAndMeasured) {
-  const Eigen::Isometry3d candidate = at(12.0, 0.0, 0.0);
-  const Eigen::Isometry3d query = at(12.8, -0.4, 0.03);
+  const Eigen::Isometry3d candidate = pose_at(12.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = pose_at(12.8, -0.4, 0.03);
   const Eigen::Isometry3d truth = candidate.inverse() * query;
-  const Eigen::Isometry3d guess = truth * at(0.3, 0.25, 4.0 * M_PI / 180);
+  const Eigen::Isometry3d guess = truth * pose_at(0.3, 0.25, 4.0 * M_PI / 180);
   const LoopVerification v =
       verify_loop(test::scan_of(ring_world(), query, 21), submap_of(ring_world(), candidate, 30), std::span(&guess, 1));
   ASSERT_EQ(v.verdict, LoopVerdict::accepted) << to_string(v.verdict) << " inliers " << v.registration.inlier_ratio
@@ -54,10 +49,10 @@ TEST(LoopVerification, ARevisitWithPillarsIsAcceptedAndMeasured) {
 // along it carries no information, so it cannot reach the graph.
 TEST(LoopVerification, AWrongCandidateInAPlainTunnelSaysNothingAlongTheAxis) {
   const std::vector<Eigen::Vector3f> tunnel = test::tunnel(120'000, 3, 200.0F);
-  const Eigen::Isometry3d candidate = at(0.0, 0.0, 0.0);
-  const Eigen::Isometry3d query = at(10.0, 0.0, 0.0);
+  const Eigen::Isometry3d candidate = pose_at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = pose_at(10.0, 0.0, 0.0);
   const Eigen::Isometry3d truth = candidate.inverse() * query;
-  const std::vector<Eigen::Isometry3d> guesses{truth * at(-10.0, 0.1, 0.02)};  // "the same place", a little off
+  const std::vector<Eigen::Isometry3d> guesses{truth * pose_at(-10.0, 0.1, 0.02)};  // "the same place", a little off
   const std::vector<Eigen::Vector3f> scan = test::scan_of(tunnel, query, 41);
   const VoxelHashMap submap = submap_of(tunnel, candidate, 50);
   LoopVerificationConfig strict;
@@ -84,9 +79,9 @@ TEST(LoopVerification, AWrongCandidateInAPlainTunnelSaysNothingAlongTheAxis) {
 // unturned. Two readings that both pass: ambiguous, refused.
 TEST(LoopVerification, TwoReadingsThatBothFitAreAmbiguous) {
   const std::vector<Eigen::Vector3f> room = test::room(60'000, 5, 6.0F, 4.0F, 2.0F, false);
-  const Eigen::Isometry3d candidate = at(0.0, 0.0, 0.0);
-  const Eigen::Isometry3d query = at(0.2, 0.1, 0.05);
-  const std::vector<Eigen::Isometry3d> guesses{candidate.inverse() * query, at(0.2, 0.1, 0.05 + M_PI)};
+  const Eigen::Isometry3d candidate = pose_at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = pose_at(0.2, 0.1, 0.05);
+  const std::vector<Eigen::Isometry3d> guesses{candidate.inverse() * query, pose_at(0.2, 0.1, 0.05 + M_PI)};
   const LoopVerification v = verify_loop(test::scan_of(room, query, 61), submap_of(room, candidate, 70), guesses);
   EXPECT_EQ(v.passing_guesses, 2);
   EXPECT_EQ(v.verdict, LoopVerdict::ambiguous) << to_string(v.verdict);
@@ -94,9 +89,9 @@ TEST(LoopVerification, TwoReadingsThatBothFitAreAmbiguous) {
 
 // The query is elsewhere (the other side of the ring): little overlap.
 TEST(LoopVerification, AnotherPlaceHasNoOverlap) {
-  const Eigen::Isometry3d candidate = at(12.0, 0.0, 0.0);
-  const Eigen::Isometry3d query = at(12.0, 30.0, M_PI);
-  const Eigen::Isometry3d guess = at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d candidate = pose_at(12.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = pose_at(12.0, 30.0, M_PI);
+  const Eigen::Isometry3d guess = pose_at(0.0, 0.0, 0.0);
   const LoopVerification v =
       verify_loop(test::scan_of(ring_world(), query, 81), submap_of(ring_world(), candidate, 90), std::span(&guess, 1));
   EXPECT_NE(v.verdict, LoopVerdict::accepted) << to_string(v.verdict);
@@ -108,11 +103,11 @@ TEST(LoopGuard, LoopsNeedAWitnessAndAWrongOneIsRejected) {
   std::vector<Eigen::Isometry3d> poses;
   std::vector<double> variance;
   for (int k = 0; k < 100; ++k) {
-    poses.push_back(at(k < 50 ? k : 99 - k, 0.0, k < 50 ? 0.0 : M_PI));  // out 49 m and back
+    poses.push_back(pose_at(k < 50 ? k : 99 - k, 0.0, k < 50 ? 0.0 : M_PI));  // out 49 m and back
     variance.push_back(k * 1e-4);
   }
   auto loop = [&](std::size_t from, std::size_t to, double error_m) {
-    return LoopConstraint{from, to, poses[from].inverse() * poses[to] * at(error_m, 0, 0), 0.05};
+    return LoopConstraint{from, to, poses[from].inverse() * poses[to] * pose_at(error_m, 0, 0), 0.05};
   };
   LoopGuard guard;
   GuardDecision d = GuardDecision::accepted;
@@ -134,13 +129,13 @@ TEST(LoopGuard, PairwiseConsistencyScalesWithTheOdometryBetween) {
   std::vector<Eigen::Isometry3d> poses;
   std::vector<double> tight, loose;
   for (int k = 0; k < 200; ++k) {
-    poses.push_back(at(k, 0.0, 0.0));
+    poses.push_back(pose_at(k, 0.0, 0.0));
     tight.push_back(k * 1e-5);
     loose.push_back(k * 5e-3);
   }
   const LoopConstraint a{0, 100, poses[0].inverse() * poses[100], 0.05};
-  const LoopConstraint near{1, 101, poses[1].inverse() * poses[101] * at(0.5, 0, 0), 0.05};
-  const LoopConstraint far{40, 140, poses[40].inverse() * poses[140] * at(0.5, 0, 0), 0.05};
+  const LoopConstraint near{1, 101, poses[1].inverse() * poses[101] * pose_at(0.5, 0, 0), 0.05};
+  const LoopConstraint far{40, 140, poses[40].inverse() * poses[140] * pose_at(0.5, 0, 0), 0.05};
   EXPECT_FALSE(pairwise_consistent(a, near, poses, tight));
   EXPECT_FALSE(pairwise_consistent(a, far, poses, tight));
   EXPECT_TRUE(pairwise_consistent(a, far, poses, loose));

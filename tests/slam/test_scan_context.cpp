@@ -10,12 +10,7 @@
 namespace adit::slam {
 namespace {
 
-Eigen::Isometry3d at(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << x, y, 0.0;
-  return T;
-}
+using test::pose_at;
 
 double angle_diff(double a, double b) { return std::abs(std::remainder(a - b, 2 * M_PI)); }
 
@@ -41,8 +36,8 @@ TEST(ScanContext, BinsHoldTheHighestPointAndTheRingKeyItsOccupancy) {
 // The same place seen turned by 72° (12 sectors): the columns shift, the
 // match finds the yaw, and the ring key is unchanged.
 TEST(ScanContext, ATurnOnTheSpotIsAColumnShift) {
-  const Eigen::Isometry3d here = at(10.0, 0.3, 0.0);
-  const Eigen::Isometry3d turned = at(10.0, 0.3, 72.0 * M_PI / 180.0);
+  const Eigen::Isometry3d here = pose_at(10.0, 0.3, 0.0);
+  const Eigen::Isometry3d turned = pose_at(10.0, 0.3, 72.0 * M_PI / 180.0);
   const ScanContext a = make_scan_context(test::scan_of(ring_world(), here, 1));
   const ScanContext b = make_scan_context(test::scan_of(ring_world(), turned, 2));
   const ScanContextMatch m = compare(b, a);
@@ -54,8 +49,8 @@ TEST(ScanContext, ATurnOnTheSpotIsAColumnShift) {
 // A corridor driven back the other way, half a metre aside: the best shift
 // is 180°, and the distance is as small as for a revisit in the same direction.
 TEST(ScanContext, AReverseRevisitMatchesAtHalfATurn) {
-  const ScanContext forward = make_scan_context(test::scan_of(ring_world(), at(12.0, 0.0, 0.0), 3));
-  const ScanContext back = make_scan_context(test::scan_of(ring_world(), at(12.3, 0.5, M_PI), 4));
+  const ScanContext forward = make_scan_context(test::scan_of(ring_world(), pose_at(12.0, 0.0, 0.0), 3));
+  const ScanContext back = make_scan_context(test::scan_of(ring_world(), pose_at(12.3, 0.5, M_PI), 4));
   const ScanContextMatch m = compare(back, forward);
   EXPECT_LT(m.distance, 0.2);
   EXPECT_LT(angle_diff(m.yaw_rad, M_PI), 7.0 * M_PI / 180.0);
@@ -64,9 +59,9 @@ TEST(ScanContext, AReverseRevisitMatchesAtHalfATurn) {
 // Another stretch of the same ring, 12 m on, with other pillars: farther
 // than the revisits above.
 TEST(ScanContext, AnotherStretchIsFarther) {
-  const ScanContext a = make_scan_context(test::scan_of(ring_world(), at(6.0, 0.0, 0.0), 5));
-  const ScanContext same = make_scan_context(test::scan_of(ring_world(), at(6.2, 0.1, 0.0), 6));
-  const ScanContext other = make_scan_context(test::scan_of(ring_world(), at(18.0, 0.0, 0.0), 7));
+  const ScanContext a = make_scan_context(test::scan_of(ring_world(), pose_at(6.0, 0.0, 0.0), 5));
+  const ScanContext same = make_scan_context(test::scan_of(ring_world(), pose_at(6.2, 0.1, 0.0), 6));
+  const ScanContext other = make_scan_context(test::scan_of(ring_world(), pose_at(18.0, 0.0, 0.0), 7));
   EXPECT_LT(compare(same, a).distance + 0.05, compare(other, a).distance);
 }
 
@@ -74,10 +69,10 @@ TEST(ScanContext, AnotherStretchIsFarther) {
 // be: the same scan, far from the query by the graph, is not a candidate
 // until the accumulated variance says the graph could be that wrong.
 TEST(PlaceRecognition, TheGateFollowsTheGraphsUncertainty) {
-  const ScanContext place = make_scan_context(test::scan_of(ring_world(), at(6.0, 0.0, 0.0), 8));
-  const ScanContext other = make_scan_context(test::scan_of(ring_world(), at(20.0, 0.0, 0.0), 9));
+  const ScanContext place = make_scan_context(test::scan_of(ring_world(), pose_at(6.0, 0.0, 0.0), 8));
+  const ScanContext other = make_scan_context(test::scan_of(ring_world(), pose_at(20.0, 0.0, 0.0), 9));
   std::vector<ScanContext> descriptors{place, other, place};
-  std::vector<Eigen::Isometry3d> poses{at(0, 0, 0), at(20, 0, 0), at(10.0, 0.0, 0.0)};  // the query 10 m off by the graph
+  std::vector<Eigen::Isometry3d> poses{pose_at(0, 0, 0), pose_at(20, 0, 0), pose_at(10.0, 0.0, 0.0)};  // the query 10 m off by the graph
   std::vector<double> path{0.0, 40.0, 100.0};
   std::vector<double> tight{0.0, 0.1, 0.2};
   std::vector<double> loose{0.0, 5.0, 16.0};  // σ 4 m per axis between 0 and 2
@@ -88,9 +83,9 @@ TEST(PlaceRecognition, TheGateFollowsTheGraphsUncertainty) {
 }
 
 TEST(PlaceRecognition, NeighboursAlongThePathAreNotRevisits) {
-  const ScanContext place = make_scan_context(test::scan_of(ring_world(), at(6.0, 0.0, 0.0), 10));
+  const ScanContext place = make_scan_context(test::scan_of(ring_world(), pose_at(6.0, 0.0, 0.0), 10));
   std::vector<ScanContext> descriptors{place, place};
-  std::vector<Eigen::Isometry3d> poses{at(6, 0, 0), at(6.5, 0, 0)};
+  std::vector<Eigen::Isometry3d> poses{pose_at(6, 0, 0), pose_at(6.5, 0, 0)};
   std::vector<double> path{0.0, 10.0};
   std::vector<double> variance{0.0, 0.01};
   EXPECT_TRUE(find_loop_candidates(1, {descriptors, poses, path, variance}).empty());
