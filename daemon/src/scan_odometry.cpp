@@ -74,29 +74,26 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
   const double until = 1e-9 * static_cast<double>(scan.start_time_ns) + sweep_s + kSpeedHalfWindow_s;
   if (can_ != nullptr) can_->catch_up(until, idle_);
   if (imu_ != nullptr) imu_->catch_up(until, idle_);
-  const std::optional<slam::MotionPrior> prior = wheel_prior_for(scan.start_time_ns);
+  const double t = 1e-9 * static_cast<double>(scan.start_time_ns);
+  const double previous = previous_scan_s_;
+  previous_scan_s_ = t;
+  const std::optional<slam::MotionPrior> prior = wheel_prior_for(previous, t);
   const std::optional<slam::UpMeasurement> up = up_for(scan.start_time_ns, sweep_s);
   // With a gyroscope: its readings from the previous scan's start to past
   // this sweep's end, for the LiDAR-inertial step.
-  const double t = 1e-9 * static_cast<double>(scan.start_time_ns);
   imu_samples_.clear();
   if (imu_samples_.capacity() > 0)
-    imu_->history().copy_covering(previous_scan_s_ > 0.0 ? previous_scan_s_ : t, t + sweep_s, imu_samples_);
-  previous_scan_s_ = t;
+    imu_->history().copy_covering(previous > 0.0 ? previous : t, t + sweep_s, imu_samples_);
   const std::int64_t t0 = monotonic_ns();
   result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up, imu_samples_}, prior);
   registration_ms_ = 1e-6 * static_cast<double>(monotonic_ns() - t0);
   return result_;
 }
 
-// The wheels' motion since the previous scan, or nullopt (then odometry
-// predicts with constant velocity).
-std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(std::int64_t stamp_ns) {
-  if (!wheels_) return std::nullopt;
-  const double t = 1e-9 * static_cast<double>(stamp_ns);
-  const double previous = previous_stamp_s_;
-  previous_stamp_s_ = t;
-  if (previous <= 0.0) return std::nullopt;
+// The wheels' motion from the previous scan's start (0: none yet) to this
+// one's, or nullopt (then odometry predicts with constant velocity).
+std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(double previous, double t) {
+  if (!wheels_ || previous <= 0.0) return std::nullopt;
   std::optional<slam::MotionPrior> prior = can_->wheels().prior(previous, t);
   ++(prior ? counts_.wheel_priors : counts_.scans_without_wheels);
   return prior;

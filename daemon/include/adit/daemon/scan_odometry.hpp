@@ -66,7 +66,7 @@ class ScanOdometry {
   const ImuSource* imu() const { return imu_; }
 
  private:
-  std::optional<slam::MotionPrior> wheel_prior_for(std::int64_t stamp_ns);
+  std::optional<slam::MotionPrior> wheel_prior_for(double previous, double t);
   std::optional<slam::UpMeasurement> up_for(std::int64_t stamp_ns, float sweep_s);
 
   static constexpr double kSpeedHalfWindow_s = 0.05;  // the wheels' speed: central differences over ±50 ms
@@ -78,8 +78,7 @@ class ScanOdometry {
   ImuSource* imu_;
   double gravity_sigma_rad_;
   std::function<bool()> idle_;
-  double previous_stamp_s_ = 0.0;
-  double previous_scan_s_ = 0.0;  // the last scan's start, for the IMU's readings since
+  double previous_scan_s_ = 0.0;  // the last scan's start (s): the wheels' and the IMU's readings since
   std::vector<slam::ImuSample> imu_samples_;  // reserved only with a gyroscope
   std::vector<Eigen::Vector3f> body_points_;
   std::vector<float> body_times_;
