@@ -13,6 +13,7 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(embree 3 REQUIRED)
 # MD5 for the Ouster digest (libssl-dev): a vetted implementation beats our own.
 find_package(OpenSSL 3 REQUIRED COMPONENTS Crypto)
+find_package(ZLIB REQUIRED)  # CRC-32 of the session journal's records
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(PCAP REQUIRED IMPORTED_TARGET libpcap)
 pkg_check_modules(GPIODCXX REQUIRED IMPORTED_TARGET libgpiodcxx)

@@ -20,6 +20,7 @@ packages=(
   libgpiod-dev           # GPIO (libgpiod v1 C++ API)
   libsystemd-dev         # sd_notify
   libzstd-dev            # map tile compression
+  zlib1g-dev             # CRC-32 of the session journal's records
   libssl-dev             # MD5 for the Ouster field digests (OpenSSL EVP)
   liblcm-dev liblcm-bin libglib2.0-dev  # LCM messages and lcm-gen (lcm.pc needs glib)
   libembree-dev          # ray casting in the simulator

@@ -128,11 +128,13 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   // the scans before it (slam::MapRefiner says why).
   const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_) : slot.pose;
   map_trajectory_.write(slot.stamp_ns, map_pose);
+  if (journal_ != nullptr) journal_->map_pose(slot.stamp_ns, map_pose);
   const bool keyframe = keyframe_selector_.take(map_pose);
   if (keyframe) {
     keyframe_downsampler_.downsample(deskewed_, static_cast<float>(config_.keyframe_voxel_m), keyframe_points_);
     keyframes_.push_back({slot.stamp_ns, map_pose, keyframe_points_});
     if (loops_ != nullptr) loops_->push({slot.stamp_ns, map_pose, keyframe_points_});
+    if (journal_ != nullptr) journal_->keyframe(slot.stamp_ns, map_pose, keyframe_points_);
     keyframe_bytes_ += sizeof(slam::Keyframe) + keyframes_.back().points.capacity() * sizeof(Eigen::Vector3f);
     stats_.keyframes.store(keyframes_.size(), std::memory_order_relaxed);
     stats_.keyframe_bytes.store(keyframe_bytes_, std::memory_order_relaxed);
@@ -141,6 +143,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   for (Eigen::Vector3f& p : deskewed_) p = pose * p;
   if (spill_) restore_tiles(map_.evicted_hit_by(deskewed_));
   map_.add(deskewed_, intensities_, 1e-9 * static_cast<double>(slot.stamp_ns));
+  journal_new_points();  // before eviction: an evicted tile's points are all in the journal
   if (spill_ && keyframe) {
     const std::vector<slam::TileCoord> cold = eviction_.cold_tiles(map_, map_pose.translation().cast<float>());
     const std::vector<slam::TileCoord> crowded = eviction_.crowded_tiles(map_);
@@ -159,6 +162,19 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   stats_.resident_tiles.store(map_.resident_tile_count(), std::memory_order_relaxed);
   stats_.dropped_in_evicted.store(map_.dropped_in_evicted(), std::memory_order_relaxed);
   if (keyframe) stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+}
+
+// The points each resident tile confirmed since its last journal record.
+// tile() only grows until the tile is evicted (evict_tiles, compact_tiles
+// forget its count; a restored tile's tile() starts empty again).
+void MappingStage::journal_new_points() {
+  if (journal_ == nullptr) return;
+  for (const slam::TileCoord& coord : map_.tile_coords()) {
+    const std::span<const slam::MapSample> points = map_.tile(coord);
+    std::size_t& done = journaled_[coord];
+    if (points.size() > done) journal_->tile_points(coord, points.subspan(done));
+    done = points.size();
+  }
 }
 
 // The first file error is logged; every one is counted. What could not be
@@ -209,6 +225,7 @@ void MappingStage::compact_tiles(const std::vector<slam::TileCoord>& coords) {
       continue;
     }
     if (map_.evict(coord).changed && sink_) sink_(coord, tile_buffer);
+    journaled_.erase(coord);
     map_.restore(coord, tile_buffer);
     stats_.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
   }
@@ -248,6 +265,7 @@ void MappingStage::evict_tiles(const std::vector<slam::TileCoord>& coords) {
     }
     if (map_.evict(coord).changed && sink_ && spill_->whole_tile(map_, coord, tile_buffer).empty())
       sink_(coord, tile_buffer);
+    journaled_.erase(coord);
     stats_.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
   }
   stats_.lost_candidates.store(map_.lost_candidates(), std::memory_order_relaxed);

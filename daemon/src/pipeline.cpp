@@ -7,6 +7,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/lidar_source.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/mapping_stage.hpp"
@@ -80,6 +81,7 @@ struct Pipeline::Impl {
   OutputStage output;
   std::optional<MappingStage> mapping;
   std::optional<LoopClosureStage> loops;
+  std::optional<JournalWriter> journal;
   slam::TiledVoxelMap empty_map;  // map() without mapping
   std::vector<slam::Keyframe> no_keyframes;
   mutable std::mutex warnings_mutex;  // start() writes, the status reads: never per item
@@ -101,6 +103,11 @@ void Pipeline::start(const SessionFiles& files) {
   if (i.started) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.map_trajectory_file, files.record_file);
   if (i.mapping) i.mapping->spill_to(files.tiles_dir, files.keyframes_dir);
+  if (i.mapping && !files.journal_file.empty()) {
+    i.journal.emplace(files.journal_file, i.config.session.journal_sync_s, i.stop);
+    i.journal->start(files.journal_header);
+    i.mapping->journal_to(&*i.journal);
+  }
   if (i.can) i.can->start(files.can_record_file);
   if (i.config.threads.lock_memory) {
     std::vector<std::string> w = lock_memory();
@@ -126,6 +133,8 @@ void Pipeline::join() {
   i.odometry.join();
   i.output.join();
   if (i.mapping) i.mapping->join();
+  // Clean when the mapping ended by draining (a stop, the end of a replay), not by an abort.
+  if (i.journal) i.journal->close(!i.stop.load(std::memory_order_acquire));
   if (i.loops) i.loops->finish();  // drains the keyframes the mapping left, then a last optimisation
   if (i.can) i.can->stop();
   i.odometry.copy_imu_stats();  // the readings after the last scan too
@@ -169,6 +178,7 @@ std::vector<StageLoad> Pipeline::loads() const {
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }
 const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &*impl_->loops : nullptr; }
+const JournalWriter* Pipeline::journal() const { return impl_->journal ? &*impl_->journal : nullptr; }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

@@ -1,6 +1,10 @@
 #include "adit/daemon/sessions.hpp"
 
+#include <pthread.h>
+#include <sys/resource.h>
 #include <sys/statvfs.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -22,6 +26,10 @@
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"
+#include "adit/daemon/map_files.hpp"
+#include "adit/daemon/durable_file.hpp"
+#include "adit/daemon/journal_writer.hpp"
+#include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/tum.hpp"
 
@@ -89,6 +97,15 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
           {"events", events}};
 }
 
+// summary.json's "journal": what the crash-safety journal wrote (it is
+// removed once the summary is on the disk).
+nlohmann::json journal_summary(const JournalWriter* journal) {
+  if (journal == nullptr) return {{"enabled", false}};
+  const JournalStats& j = journal->stats();
+  return {{"enabled", true}, {"records", j.records.load()}, {"bytes", j.bytes.load()}, {"syncs", j.syncs.load()},
+          {"lost_records", j.lost_records.load()}, {"fault", journal->fault()}};
+}
+
 // The map follows the graph: each sample moves by the correction at its
 // scan's time (slam/correction_track.hpp).
 void correct(std::span<const slam::MapSample> in, const slam::CorrectionTrack& track, std::vector<slam::MapSample>& out) {
@@ -142,6 +159,25 @@ PoseSample pose_sample_of(const slam::OdometryResult& r) {
 Sessions::Sessions(const config::Config& config, Outputs outputs)
     : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {
   standby_ = build_pipeline();
+  if (!interrupted_sessions(root_).empty()) recoverer_ = std::thread([this] { recover_interrupted(); });
+}
+
+// Niced like the loop closure: a new session may start meanwhile and its
+// odometry comes first. Each session's report goes to the log and the status.
+void Sessions::recover_interrupted() {
+  constexpr int kNice = 10;
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kNice) != 0)
+    log::warn("recovery: cannot lower its priority");
+  pthread_setname_np(pthread_self(), "adit-recovery");
+  for (const std::filesystem::path& dir : interrupted_sessions(root_)) {
+    log::warn("session {}: was cut short (no summary.json): rebuilding it from its journal", dir.filename().string());
+    const RecoveryReport report = recover_session(dir, config_.session.exports, config_.map.tile_size_m);
+    const std::string text = describe(report);
+    if (report.recovered) log::warn("{}", text);
+    else log::error("{}", text);
+    const std::lock_guard lock(mutex_);
+    recovery_notice_ = text;
+  }
 }
 
 std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
@@ -157,7 +193,10 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
   return std::make_unique<Pipeline>(config_, options);
 }
 
-Sessions::~Sessions() { stop_and_wait(); }
+Sessions::~Sessions() {
+  stop_and_wait();
+  if (recoverer_.joinable()) recoverer_.join();
+}
 
 std::string Sessions::start() {
   const std::lock_guard lock(mutex_);
@@ -191,6 +230,16 @@ std::string Sessions::start_locked() {
   files.keyframes_dir = dir / "keyframes";  // and the scans of keyframes it has left
   if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
+  if (config_.session.journal) {
+    files.journal_file = dir / "journal.adj";
+    files.journal_header = nlohmann::json{{"session", id},
+                                          {"tile_size_m", config_.map.tile_size_m},
+                                          {"voxel_m", config_.map.voxel_m},
+                                          {"min_hits", config_.map.min_hits},
+                                          {"lidar", config_.lidar.model},
+                                          {"started_utime", realtime_us()}}
+                               .dump();
+  }
   try {
     if (!pipeline) pipeline = build_pipeline();  // the last one could not be built ahead
     pipeline->start(files);
@@ -205,6 +254,7 @@ std::string Sessions::start_locked() {
   pipeline_ = std::move(pipeline);
   id_ = id;
   dir_ = dir;
+  recovery_notice_.clear();
   stop_requested_ = false;
   end_reported_ = false;
   last_sample_ns_ = 0;
@@ -275,35 +325,21 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     const std::vector<slam::TileCoord> evicted = map.evicted_coords();
     coords.insert(coords.end(), evicted.begin(), evicted.end());
     std::sort(coords.begin(), coords.end());
-    std::array<double, 3> corner{0, 0, 0};  // the lowest tile corner: at or below every point
-    for (std::size_t i = 0; i < coords.size(); ++i) {
-      const std::array<double, 3> c{coords[i].x * config_.map.tile_size_m, coords[i].y * config_.map.tile_size_m,
-                                    coords[i].z * config_.map.tile_size_m};
-      for (std::size_t a = 0; a < 3; ++a) corner[a] = i == 0 ? c[a] : std::min(corner[a], c[a]);
-    }
     // With loop closure the map's points move by the graph's correction
     // (only when a loop was accepted: otherwise the correction is identity).
     const LoopClosureStage* loops = pipeline->loop_closure();
     const slam::CorrectionTrack track = loops != nullptr ? loops->correction() : slam::CorrectionTrack{};
     const bool corrected = loops != nullptr && config_.map.loops_move_map && loops->closer().stats().accepted > 0;
-    if (corrected) {  // the corner stays at or below every moved point
+    double margin = 0.0;  // the corner stays at or below every moved point
+    if (corrected) {
       double reach = 0.0;
       for (const slam::TileCoord& c : coords)
         reach = std::max(reach, config_.map.tile_size_m * (std::abs(c.x) + std::abs(c.y) + std::abs(c.z) + 3.0));
-      const double margin = track.max_translation_m() + track.max_rotation_rad() * reach + 1.0;
-      for (double& v : corner) v -= margin;
-    }
-    for (double& v : corner) v = std::floor(v);
-    std::vector<protocol::MapFileWriter> writers;
-    writers.reserve(config_.session.exports.size());
-    for (const std::string& name : config_.session.exports) {
-      const std::filesystem::path file = dir / ("map." + name);
-      writers.emplace_back(file, *protocol::parse_map_format(name), map.size(), corner);
-      files.push_back(file.filename().string());
+      margin = track.max_translation_m() + track.max_rotation_rad() * reach + 1.0;
     }
     std::vector<slam::MapSample> read_back;
     std::vector<slam::MapSample> moved;
-    for (const slam::TileCoord& c : coords) {
+    const auto read_tile = [&](const slam::TileCoord& c, std::vector<protocol::MapPoint>& points) {
       std::span<const slam::MapSample> samples = map.tile(c);
       if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
         const bool rewritten = !map.is_evicted(c) && !map.tile(c).empty();
@@ -317,10 +353,11 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         correct(samples, track, moved);
         samples = moved;
       }
-      const std::vector<protocol::MapPoint> points = map_points_of(samples);
-      for (protocol::MapFileWriter& w : writers) w.write(points);
-    }
-    for (protocol::MapFileWriter& w : writers) w.finish();
+      points = map_points_of(samples);
+    };
+    for (std::string& name : write_map_files(dir, config_.session.exports, map.size(),
+                                             map_corner(coords, config_.map.tile_size_m, margin), coords, read_tile))
+      files.push_back(std::move(name));
     slam::Trajectory keyframes;  // the graph's poses with loop closure (the same keyframes, in order)
     const std::vector<Eigen::Isometry3d>* graph = loops != nullptr ? &loops->closer().poses() : nullptr;
     for (std::size_t i = 0; i < pipeline->keyframes().size(); ++i) {
@@ -331,6 +368,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
     if (s.spilled_keyframes.load() > 0) files.push_back("keyframes/");
+    const JournalWriter* journal = pipeline->journal();
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
     if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {
@@ -347,6 +385,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},
         {"loops", loops_summary(loops, track, corrected)},
+        {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
@@ -360,7 +399,12 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                     {"latency_ms_p99", quantile(t.latency_ms, 0.99)},
                     {"sensor_span_s", t.sensor_span_s}, {"duration_s", t.duration_s}}},
         {"files", files}};
-    std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
+    // Whole or not at all: a summary.json is what says the session is complete.
+    write_durably(dir / "summary.json", summary.dump(2) + "\n");
+    if (journal != nullptr) {  // the files hold all it held now
+      std::error_code ec;
+      std::filesystem::remove(journal->file(), ec);
+    }
     log::info("session {}: stopped; {} poses, {} map points in {} tiles; files in {}", id, s.poses.load(), map.size(),
               map.tile_count(), dir.string());
     if (config_.imu.enabled) {
@@ -399,6 +443,12 @@ std::vector<std::string> Sessions::list() const {
   for (const auto& entry : std::filesystem::directory_iterator(root_, ec))
     if (entry.is_directory()) out.push_back(entry.path().filename().string());
   std::sort(out.begin(), out.end());
+  for (std::string& id : out) {
+    std::ifstream summary(root_ / id / "summary.json");
+    if (!summary) continue;
+    const nlohmann::json j = nlohmann::json::parse(summary, nullptr, false);
+    if (j.is_object() && j.contains("recovered")) id += " recovered";
+  }
   return out;
 }
 
@@ -434,7 +484,10 @@ StatusSample Sessions::status_sample() {
   sample.utime = realtime_us();
   sample.disk_free_bytes = disk_free_bytes(std::filesystem::exists(root_) ? root_ : std::filesystem::path(config_.payload.state_dir));
   const std::lock_guard lock(mutex_);
-  if (!pipeline_) return sample;
+  if (!pipeline_) {
+    sample.fault = recovery_notice_;  // a session rebuilt after a crash, until the next one starts
+    return sample;
+  }
   const PipelineStats& s = pipeline_->stats();
   const std::int64_t now = monotonic_ns();
   const double dt = last_sample_ns_ == 0 ? 0.0 : 1e-9 * static_cast<double>(now - last_sample_ns_);
@@ -474,7 +527,9 @@ StatusSample Sessions::status_sample() {
   last_datagrams_ = datagrams;
   const std::int64_t last_packet_ns = s.last_packet_realtime_ns.load();
   const double silent_s = 1e-9 * static_cast<double>(realtime_us() * 1000 - last_packet_ns);
+  const JournalWriter* journal = pipeline_->journal();
   if (pipeline_->drained()) sample.fault = "the recording has ended";
+  else if (journal != nullptr && !journal->fault().empty()) sample.fault = journal->fault();  // disk full
   else if (last_packet_ns == 0) sample.fault = "no LiDAR packets yet";
   else if (silent_s > 1.0) sample.fault = fmt::format("no LiDAR packets for {:.0f} s", silent_s);
   else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)

@@ -17,11 +17,13 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <vector>
 
 #include "adit/config/config.hpp"
 #include "adit/daemon/handoff.hpp"
+#include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/keyframe_queue.hpp"
 #include "adit/daemon/pipeline_items.hpp"
 #include "adit/daemon/pipeline_stats.hpp"
@@ -51,6 +53,9 @@ class MappingStage {
   void spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir);
   // Before start(): each keyframe also goes to `loops` (the loop-closure stage's queue).
   void feed_loops(KeyframeQueue* loops) { loops_ = loops; }
+  // Before start(): each mapped scan's pose, the points each tile confirms and
+  // each keyframe also go to the session journal.
+  void journal_to(JournalWriter* journal) { journal_ = journal; }
   void start();
   void join() { thread_.join(); }
 
@@ -69,6 +74,7 @@ class MappingStage {
   void restore_tiles(const std::vector<slam::TileCoord>& coords);
   void evict_tiles(const std::vector<slam::TileCoord>& coords);
   void flush_tiles();
+  void journal_new_points();
   void tile_file_error(const std::string& problem);
 
   const config::MapSection config_;
@@ -86,6 +92,8 @@ class MappingStage {
   std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
   std::uint64_t keyframe_bytes_ = 0;
   KeyframeQueue* loops_ = nullptr;
+  JournalWriter* journal_ = nullptr;
+  std::map<slam::TileCoord, std::size_t> journaled_;  // per resident tile: points of tile() already journaled
   slam::KeyframeSelector keyframe_selector_;
   std::vector<slam::Keyframe> keyframes_;
   slam::VoxelDownsampler keyframe_downsampler_;

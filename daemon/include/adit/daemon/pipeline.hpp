@@ -29,6 +29,7 @@
 namespace adit::daemon {
 
 class LoopClosureStage;
+class JournalWriter;
 
 struct PipelineOptions {
   std::filesystem::path trajectory_file;  // TUM, written as poses arrive; empty = none
@@ -55,6 +56,11 @@ struct SessionFiles {
   // Where the scans of keyframes the sensor has left are written
   // (<stamp_ns>.ply, body frame) so that only their poses stay in RAM; empty = all stay.
   std::filesystem::path keyframes_dir;
+  // The session journal (journal_writer.hpp): map poses, tile points and
+  // keyframes appended as they are made, so a crash loses at most ~1 s of
+  // the map; empty = none. `journal_header` is its header record (JSON).
+  std::filesystem::path journal_file;
+  std::string journal_header;
 };
 
 class Pipeline {
@@ -94,6 +100,8 @@ class Pipeline {
   const std::vector<slam::Keyframe>& keyframes() const;
   // The loop-closure stage (map.loop_closure), complete after join(); null without it.
   const LoopClosureStage* loop_closure() const;
+  // The session journal's writer (SessionFiles::journal_file), closed after join(); null without it.
+  const JournalWriter* journal() const;
 
  private:
   struct Impl;

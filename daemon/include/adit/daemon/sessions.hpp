@@ -14,6 +14,12 @@
 //   keyframes.tum    keyframe poses; keyframes/<stamp_ns>.ply the scans of older keyframes
 //   summary.json     counts, timings, files; config.yaml the effective configuration
 //   lidar.pcap       raw packets, when session.record_lidar is true
+//   journal.adj      while mapping (session.journal): the map as it is made,
+//                    durable within session.journal_sync_s; removed once
+//                    summary.json is on the disk. A folder with a journal and
+//                    no summary was cut short (a crash, a pulled battery): the
+//                    constructor starts rebuilding each such session on a
+//                    background thread (session_recovery.hpp).
 
 #include <atomic>
 #include <exception>
@@ -68,7 +74,9 @@ class Sessions {
   void stop_and_wait();
 
   bool running() const;  // a pipeline exists (mapping or being finished)
-  std::vector<std::string> list() const;  // sessions on disk, oldest first
+  // Sessions on disk, oldest first: "<id>", or "<id> recovered" for one
+  // rebuilt from its journal after a crash.
+  std::vector<std::string> list() const;
   std::filesystem::path folder(const std::string& id) const;
   // Fills `into` with a stored session's tiles (tiles/*.adt); "" or why not.
   // `id` comes from the network: only a plain session name is accepted.
@@ -85,6 +93,7 @@ class Sessions {
   std::string start_locked();
   std::unique_ptr<Pipeline> build_pipeline() const;
   void finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::filesystem::path dir);
+  void recover_interrupted();  // the recovery thread's body
 
   config::Config config_;
   Outputs outputs_;
@@ -104,6 +113,10 @@ class Sessions {
   std::int64_t last_sample_ns_ = 0;
   std::uint64_t last_datagrams_ = 0;
   std::vector<double> last_cpu_s_;
+  // Sessions cut short, rebuilt at start-up off the main thread; what the
+  // status says about them while idle (until the next session starts).
+  std::thread recoverer_;
+  std::string recovery_notice_;  // under mutex_
 };
 
 }  // namespace adit::daemon

@@ -194,6 +194,11 @@ struct SessionSection {
   bool autostart = false;                // start mapping at launch (payloads without a tablet)
   bool record_lidar = false;             // write the raw LiDAR packets to <session>/lidar.pcap
   std::vector<std::string> exports{"ply", "las"};  // map files written when a session stops
+  // The session journal (<session>/journal.adj): what mapping makes reaches
+  // the disk as it is made, so that aditd rebuilds a session's map after a
+  // crash (docs/SESSIONS.md); fdatasync at most every journal_sync_s.
+  bool journal = true;
+  double journal_sync_s = 0.5;
 };
 
 struct LcmSection {

@@ -212,6 +212,8 @@ void describe(V& v, SessionSection& s) {
   v.optional("autostart", s.autostart);
   v.optional("record_lidar", s.record_lidar);
   v.optional("exports", s.exports, OneOf{kMapFormats});
+  v.optional("journal", s.journal);
+  v.optional("journal_sync_s", s.journal_sync_s, Range<double>{0.05, 10.0});
 }
 
 template <typename V>

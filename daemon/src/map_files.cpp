@@ -1,0 +1,42 @@
+// A session's map files, tile by tile (map_files.hpp).
+#include "adit/daemon/map_files.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "adit/protocol/map_export.hpp"
+
+namespace adit::daemon {
+
+std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m) {
+  std::array<double, 3> corner{0, 0, 0};
+  for (std::size_t i = 0; i < coords.size(); ++i) {
+    const std::array<double, 3> c{coords[i].x * tile_size_m, coords[i].y * tile_size_m, coords[i].z * tile_size_m};
+    for (std::size_t a = 0; a < 3; ++a) corner[a] = i == 0 ? c[a] : std::min(corner[a], c[a]);
+  }
+  for (double& v : corner) v = std::floor(v - margin_m);
+  return corner;
+}
+
+std::vector<std::string> write_map_files(
+    const std::filesystem::path& dir, const std::vector<std::string>& formats, std::uint64_t n_points,
+    const std::array<double, 3>& corner, const std::vector<slam::TileCoord>& coords,
+    const std::function<void(const slam::TileCoord&, std::vector<protocol::MapPoint>&)>& read) {
+  std::vector<protocol::MapFileWriter> writers;
+  std::vector<std::string> names;
+  writers.reserve(formats.size());
+  for (const std::string& name : formats) {
+    const std::filesystem::path file = dir / ("map." + name);
+    writers.emplace_back(file, *protocol::parse_map_format(name), n_points, corner);
+    names.push_back(file.filename().string());
+  }
+  std::vector<protocol::MapPoint> points;
+  for (const slam::TileCoord& c : coords) {
+    read(c, points);
+    for (protocol::MapFileWriter& w : writers) w.write(points);
+  }
+  for (protocol::MapFileWriter& w : writers) w.finish();
+  return names;
+}
+
+}  // namespace adit::daemon
