@@ -25,6 +25,8 @@
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
+#include "daemon_process.hpp"
+#include "pose_counter.hpp"
 #include "map_readers.hpp"
 #include "pcl_load.hpp"
 #include "run_program.hpp"
@@ -34,76 +36,6 @@ namespace adit::test {
 namespace {
 
 using namespace std::chrono_literals;
-
-// A child process with its output in a log file, stopped with SIGTERM.
-class Daemon {
- public:
-  Daemon(const std::vector<std::string>& argv, const std::filesystem::path& log) {
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, STDOUT_FILENO);
-      ::dup2(fd, STDERR_FILENO);
-      std::vector<char*> args;
-      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      ::execv(args[0], args.data());
-      ::_exit(127);
-    }
-  }
-  ~Daemon() {
-    if (pid_ > 0) stop();
-  }
-  // SIGTERM, then the exit status (-1 if it did not exit within 30 s).
-  int stop() {
-    ::kill(pid_, SIGTERM);
-    int status = 0;
-    for (int i = 0; i < 300; ++i) {
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-    ::kill(pid_, SIGKILL);
-    ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
-
-// Counts pose_t messages of one payload on its own LCM socket.
-class PoseCounter {
- public:
-  PoseCounter(const std::string& url, const std::string& payload) : lcm_(url) {
-    lcm_.subscribe(protocol::channel_name(payload, protocol::Channel::pose), &PoseCounter::on_pose, this);
-    thread_ = std::thread([this] {
-      while (running_) lcm_.handleTimeout(50);
-    });
-  }
-  ~PoseCounter() {
-    running_ = false;
-    thread_.join();
-  }
-  std::size_t count() const { return count_; }
-  std::size_t valid() const { return valid_; }
-
- private:
-  void on_pose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    pose_t pose;
-    if (!protocol::checked_decode(rbuf->data, rbuf->data_size, pose)) return;
-    ++count_;
-    if (pose.flags & pose_t::FLAG_VALID) ++valid_;
-  }
-  lcm::LCM lcm_;
-  std::atomic<bool> running_{true};
-  std::atomic<std::size_t> count_{0};
-  std::atomic<std::size_t> valid_{0};
-  std::thread thread_;
-};
 
 // A 12 s simulated drive through the mine, generated once per build tree.
 std::filesystem::path simulated_session() {
@@ -126,20 +58,9 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 7) % 30000);
   // The simulator's own session.yaml (LiDAR, CAN wheel encoders and accelerometer, extrinsics),
   // with this test's payload id, state folder, LCM port and exports.
-  std::ifstream sim_config(session / "session.yaml");
-  std::string yaml((std::istreambuf_iterator<char>(sim_config)), std::istreambuf_iterator<char>());
-  const auto replace = [&yaml](const std::string& from, const std::string& to) {
-    const std::size_t at = yaml.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    yaml.replace(at, from.size(), to);
-  };
-  replace("  id: sim-mine-7", "  id: " + payload);
-  replace("  state_dir: state", "  state_dir: " + (work / "state").string());
-  replace("  pcap: lidar.pcap", "  pcap: " + (session / "lidar.pcap").string());
-  replace("  calibration: VLP16.yaml", "  calibration: " + (session / "VLP16.yaml").string());
-  replace("  log: can.log", "  log: " + (session / "can.log").string());
-  replace("udpm://239.255.76.67:7667?ttl=0", url);
-  yaml += "session:\n  exports: [ply, pcd, las]\nthreads:\n  lock_memory: false\n";
+  const std::string yaml = aditd_yaml_for(
+      session, work / "state",
+      {payload, url, false, "session:\n  exports: [ply, pcd, las]\nthreads:\n  lock_memory: false\n"});
   const std::filesystem::path config = work / "aditd.yaml";
   std::ofstream(config) << yaml;
 
