@@ -3,6 +3,8 @@
 // or lock per pose. (output_stage.hpp)
 #include "adit/daemon/output_stage.hpp"
 
+#include "adit/common/clock.hpp"
+
 namespace adit::daemon {
 
 OutputStage::OutputStage(const config::Config& config, Handoff<PoseSlot>& poses, PipelineSinks::PoseSink sink,
@@ -33,6 +35,12 @@ void OutputStage::loop() {
     if (sink_) sink_(r);
     if (r.valid) trajectory_.write(r.stamp_ns, r.pose);
     poses_.release(slot);
+    // Once a second to the kernel (one write of ~10 lines): a crash then
+    // loses at most a second of the trajectory, not a whole stdio buffer.
+    if (const std::int64_t now = monotonic_ns(); now - last_flush_ns_ >= 1'000'000'000) {
+      trajectory_.flush();
+      last_flush_ns_ = now;
+    }
   }
   trajectory_.flush();
 }

@@ -6,7 +6,8 @@
 //       trajectory file (TUM, valid poses), the pose counts and each scan's
 //       latency from its last packet to its pose.
 // Thread "output": no allocation or lock per pose; the sink must be quick and
-// must not throw; the trajectory is buffered stdio.
+// must not throw; the trajectory is buffered stdio, handed to the kernel
+// once a second (a crash loses at most that much of it).
 
 #include <atomic>
 #include <filesystem>
@@ -42,6 +43,7 @@ class OutputStage {
   PipelineTimings& timings_;
   StageThread thread_;
   slam::TumWriter trajectory_;
+  std::int64_t last_flush_ns_ = 0;  // of trajectory_, monotonic
 };
 
 }  // namespace adit::daemon
