@@ -107,6 +107,7 @@ void JournalWriter::loop() {
     }
   }
   if (clean_ && !failed_) {
+    buffer_.clear();  // it still holds the last batch, written already
     protocol::append_journal_record(buffer_, protocol::JournalRecordType::end, {});
     write_bytes(buffer_);
     buffer_.clear();

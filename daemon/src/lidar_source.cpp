@@ -50,6 +50,7 @@ struct LidarSource::Impl {
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
         receiver("receiver", c.threads.receiver, stop_flag),
         assembly("assembly", c.threads.receiver, stop_flag) {
+    record_budget_bytes = static_cast<std::uint64_t>(c.session.record_budget_mb * 1e6);
     if (c.lidar.source == config::LidarSource::scan_dir) {
       scan_directory.emplace(c.lidar.scan_dir);
       return;
@@ -126,13 +127,24 @@ struct LidarSource::Impl {
     std::memcpy(packet->data.data(), payload.data(), packet->size);
     packet->received_mono_ns = monotonic_ns();
     stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
-    if (recorder) {
+    if (recorder && stats.recording_stopped.load(std::memory_order_relaxed) == 0) {
       // Buffered file output on the receiver: a copy and no allocation per packet.
       const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, from_imu ? imu_port : data_port};
-      if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload))
+      if (record_budget_bytes > 0 && recorder->bytes() + payload.size() + kRecordOverhead > record_budget_bytes) {
+        stop_recording(RecordingStop::budget);
+      } else if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload)) {
         stats.recorded_datagrams.fetch_add(1, std::memory_order_relaxed);
+        stats.recorded_bytes.store(recorder->bytes(), std::memory_order_relaxed);
+      }
+      if (recorder->failed()) stop_recording(RecordingStop::write_failed);
     }
     packets.publish(packet);
+  }
+
+  // The first reason wins; the status names it, the mapping goes on.
+  void stop_recording(RecordingStop why) {
+    int recording = 0;
+    stats.recording_stopped.compare_exchange_strong(recording, static_cast<int>(why), std::memory_order_relaxed);
   }
 
   void receiver_loop() {
@@ -180,6 +192,7 @@ struct LidarSource::Impl {
       try {
         recorder->flush();
       } catch (const InputError& e) {
+        stop_recording(RecordingStop::write_failed);
         log::error("{}: {}", e.where(), e.reason());
       }
     }
@@ -232,6 +245,8 @@ struct LidarSource::Impl {
   std::optional<drivers::ScanAssembler> assembler;
   std::optional<drivers::DecodeStream> stream;
   std::optional<drivers::PcapWriter> recorder;
+  std::uint64_t record_budget_bytes = 0;  // 0: none
+  static constexpr std::size_t kRecordOverhead = 128;  // pcap, Ethernet, IP and UDP headers of one datagram
   std::optional<OusterImu> imu;           // imu.source ouster
   std::uint16_t imu_port = 0;
   std::optional<drivers::UdpReceiver> imu_udp;

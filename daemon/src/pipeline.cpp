@@ -126,6 +126,10 @@ void Pipeline::start(const SessionFiles& files) {
 
 void Pipeline::request_stop() { impl_->stop.store(true, std::memory_order_release); }
 void Pipeline::end_source() { impl_->source.end(); }
+void Pipeline::stop_recording(RecordingStop why) {
+  int recording = 0;
+  impl_->stats.recording_stopped.compare_exchange_strong(recording, static_cast<int>(why), std::memory_order_relaxed);
+}
 
 void Pipeline::join() {
   Impl& i = *impl_;

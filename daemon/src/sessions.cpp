@@ -228,7 +228,8 @@ std::string Sessions::start_locked() {
   files.map_trajectory_file = dir / "map_trajectory.tum";  // the poses the map was built at
   files.tiles_dir = dir / "tiles";          // tiles the sensor has left go there during the session
   files.keyframes_dir = dir / "keyframes";  // and the scans of keyframes it has left
-  if (config_.session.record_lidar) files.record_file = dir / "lidar.pcap";
+  if (config_.session.record_lidar && config_.lidar.source != config::LidarSource::scan_dir)
+    files.record_file = dir / "lidar.pcap";  // a directory of scans has no packets to record
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
   if (config_.session.journal) {
     files.journal_file = dir / "journal.adj";
@@ -375,7 +376,10 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"session", id},
         {"lidar", {{"model", config_.lidar.model}, {"datagrams", s.datagrams.load()},
                    {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
-                   {"recorded_datagrams", s.recorded_datagrams.load()}}},
+                   {"recorded_datagrams", s.recorded_datagrams.load()}, {"recorded_bytes", s.recorded_bytes.load()},
+                   {"recording_stopped", s.recording_stopped.load() == 0
+                                             ? nlohmann::json(nullptr)
+                                             : nlohmann::json(to_string(static_cast<RecordingStop>(s.recording_stopped.load())))}}},
         {"scans", {{"total", s.scans.load()}, {"incomplete", s.incomplete_scans.load()},
                    {"dropped", s.dropped_scans.load()}, {"skipped_at_start", s.skipped_start_scans.load()}}},
         {"poses", {{"total", s.poses.load()}, {"invalid", s.invalid_poses.load()},
@@ -401,7 +405,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"files", files}};
     // Whole or not at all: a summary.json is what says the session is complete.
     write_durably(dir / "summary.json", summary.dump(2) + "\n");
-    if (journal != nullptr) {  // the files hold all it held now
+    if (journal != nullptr && !config_.session.keep_journal) {  // the files hold all it held now
       std::error_code ec;
       std::filesystem::remove(journal->file(), ec);
     }
@@ -527,9 +531,16 @@ StatusSample Sessions::status_sample() {
   last_datagrams_ = datagrams;
   const std::int64_t last_packet_ns = s.last_packet_realtime_ns.load();
   const double silent_s = 1e-9 * static_cast<double>(realtime_us() * 1000 - last_packet_ns);
+  // The recording stops before the disk is full, so the journal and the map files still fit.
+  const double reserve = config_.session.record_min_free_mb * 1e6;
+  if (sample.disk_free_bytes >= 0 && static_cast<double>(sample.disk_free_bytes) < reserve)
+    pipeline_->stop_recording(RecordingStop::low_disk);
+  const auto recording = static_cast<RecordingStop>(s.recording_stopped.load());
   const JournalWriter* journal = pipeline_->journal();
   if (pipeline_->drained()) sample.fault = "the recording has ended";
   else if (journal != nullptr && !journal->fault().empty()) sample.fault = journal->fault();  // disk full
+  else if (recording != RecordingStop::recording)
+    sample.fault = fmt::format("raw recording stopped: {}; the mapping goes on", to_string(recording));
   else if (last_packet_ns == 0) sample.fault = "no LiDAR packets yet";
   else if (silent_s > 1.0) sample.fault = fmt::format("no LiDAR packets for {:.0f} s", silent_s);
   else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)

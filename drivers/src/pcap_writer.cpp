@@ -58,6 +58,7 @@ void PcapWriter::write_record(std::int64_t time_ns, std::span<const std::uint8_t
   out_.write(reinterpret_cast<const char*>(r.data()), r.size());
   out_.write(reinterpret_cast<const char*>(frame.data()), static_cast<std::streamsize>(frame.size()));
   ++records_;
+  bytes_ += r.size() + frame.size();
 }
 
 bool PcapWriter::write_udp(std::int64_t time_ns, const UdpEndpoints& e, std::span<const std::uint8_t> payload) {

@@ -39,8 +39,9 @@ class Cursor {
 std::uint32_t crc_of(std::span<const std::uint8_t> head, std::span<const std::uint8_t> payload) {
   uLong crc = crc32(0L, Z_NULL, 0);
   crc = crc32(crc, head.data(), static_cast<uInt>(head.size()));
-  // zlib's length is 32-bit: payloads are below kJournalMaxPayload.
-  crc = crc32(crc, payload.data(), static_cast<uInt>(payload.size()));
+  // zlib's length is 32-bit: payloads are below kJournalMaxPayload. An empty
+  // payload adds nothing (and zlib would take a null pointer for "start over").
+  if (!payload.empty()) crc = crc32(crc, payload.data(), static_cast<uInt>(payload.size()));
   return static_cast<std::uint32_t>(crc);
 }
 

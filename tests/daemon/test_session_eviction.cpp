@@ -21,10 +21,13 @@
 #include <unistd.h>
 
 #include "adit/config/load.hpp"
+#include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "adit/daemon/tile_store.hpp"
 #include "adit/protocol/tile_codec.hpp"
+#include "daemon_process.hpp"
 #include "map_readers.hpp"
+#include "point_match.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -57,23 +60,15 @@ struct SessionRun {
 SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels,
                        double keyframe_distance_m = 1.0, double keyframe_angle_deg = 10.0) {
   const std::filesystem::path session = driving_session();
-  std::ifstream sim_config(session / "session.yaml");
-  std::string yaml((std::istreambuf_iterator<char>(sim_config)), std::istreambuf_iterator<char>());
-  const auto replace = [&yaml](const std::string& from, const std::string& to) {
-    const std::size_t at = yaml.find(from);
-    if (at != std::string::npos) yaml.replace(at, from.size(), to);
-    EXPECT_NE(at, std::string::npos) << from;
-  };
-  replace("  state_dir: state", "  state_dir: " + (work / "state").string());
-  replace("  pcap: lidar.pcap", "  pcap: " + (session / "lidar.pcap").string());
-  replace("  calibration: VLP16.yaml", "  calibration: " + (session / "VLP16.yaml").string());
-  replace("  log: can.log", "  log: " + (session / "can.log").string());
-  replace("  replay_speed: 1.0", "  replay_speed: 0");  // as fast as possible: a replay waits, nothing is dropped
-  yaml += fmt::format(
-      "map:\n  tile_size_m: 5\n  max_range_m: 5\n  evict_margin_m: 1\n  evict_after_keyframes: {}\n"
-      "  compact_tile_voxels: {}\n  keyframe_distance_m: {}\n  keyframe_angle_deg: {}\n"
-      "session:\n  exports: [ply, las]\nthreads:\n  lock_memory: false\n",
-      evict_after_keyframes, compact_tile_voxels, keyframe_distance_m, keyframe_angle_deg);
+  // As fast as possible: a replay waits, nothing is dropped. The journal is
+  // kept, so that the map can be rebuilt from it too (expect_every_point_everywhere).
+  const std::string yaml = test::aditd_yaml_for(
+      session, work / "state",
+      {"", "", true,
+       fmt::format("map:\n  tile_size_m: 5\n  max_range_m: 5\n  evict_margin_m: 1\n  evict_after_keyframes: {}\n"
+                   "  compact_tile_voxels: {}\n  keyframe_distance_m: {}\n  keyframe_angle_deg: {}\n"
+                   "session:\n  exports: [ply, las]\n  keep_journal: true\nthreads:\n  lock_memory: false\n",
+                   evict_after_keyframes, compact_tile_voxels, keyframe_distance_m, keyframe_angle_deg)});
   std::filesystem::create_directories(work);
   const std::filesystem::path config_file = work / "aditd.yaml";
   std::ofstream(config_file) << yaml;
@@ -93,35 +88,6 @@ SessionRun map_session(const std::filesystem::path& work, int evict_after_keyfra
   run.folder = sessions.folder(id);
   run.summary = nlohmann::json::parse(std::ifstream(run.folder / "summary.json"));
   return run;
-}
-
-// How many of `points` have no point of `reference` within `tolerance_m`
-// (a hash of 1 cm cells, each point checked against its cell's neighbours).
-std::size_t unmatched(const std::vector<test::XyzI>& points, const std::vector<test::XyzI>& reference,
-                      double tolerance_m) {
-  const auto cell = [](double v) { return static_cast<std::int64_t>(std::floor(v / 0.01)); };
-  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return (x & 0x1FFFFF) << 42 | (y & 0x1FFFFF) << 21 | (z & 0x1FFFFF);
-  };
-  std::unordered_multimap<std::int64_t, std::size_t> grid;
-  for (std::size_t i = 0; i < reference.size(); ++i)
-    grid.emplace(key(cell(reference[i].x), cell(reference[i].y), cell(reference[i].z)), i);
-  std::size_t missing = 0;
-  for (const test::XyzI& p : points) {
-    bool found = false;
-    for (int dx = -1; dx <= 1 && !found; ++dx)
-      for (int dy = -1; dy <= 1 && !found; ++dy)
-        for (int dz = -1; dz <= 1 && !found; ++dz) {
-          const auto [begin, end] = grid.equal_range(key(cell(p.x) + dx, cell(p.y) + dy, cell(p.z) + dz));
-          for (auto it = begin; it != end && !found; ++it) {
-            const test::XyzI& q = reference[it->second];
-            found = std::abs(p.x - q.x) <= tolerance_m && std::abs(p.y - q.y) <= tolerance_m &&
-                    std::abs(p.z - q.z) <= tolerance_m;
-          }
-        }
-    missing += found ? 0 : 1;
-  }
-  return missing;
 }
 
 // Every point of the session's map is in its exports, in its tiles/ (what a
@@ -150,6 +116,22 @@ void expect_every_point_everywhere(const SessionRun& run, const std::filesystem:
     EXPECT_EQ(it->second, static_cast<std::size_t>(tile.n_points)) << "tile " << id;
   }
   EXPECT_EQ(run.published.size(), non_empty);
+
+  // The session's journal holds the same map through every eviction, reload
+  // and compaction: rebuilt from it alone, as after a crash, it has every point.
+  const std::filesystem::path copy = run.folder.parent_path().parent_path() / "recovered" / run.folder.filename();
+  std::filesystem::remove_all(copy);
+  std::filesystem::create_directories(copy);
+  std::filesystem::copy_file(run.folder / "journal.adj", copy / "journal.adj");
+  const RecoveryReport recovery = recover_session(copy, {"ply"}, 20.0);
+  ASSERT_TRUE(recovery.recovered) << recovery.problem;
+  EXPECT_TRUE(recovery.ended_cleanly);
+  EXPECT_EQ(recovery.points, points);
+  EXPECT_EQ(recovery.tiles, map["tiles"].get<std::size_t>());
+  const std::vector<test::XyzI> original = test::read_ply(run.folder / "map.ply");
+  const std::vector<test::XyzI> rebuilt = test::read_ply(copy / "map.ply");
+  EXPECT_EQ(test::unmatched(rebuilt, original, 0.0006), 0U);  // the tile files keep 1 mm
+  EXPECT_EQ(test::unmatched(original, rebuilt, 0.0006), 0U);
 }
 
 struct Comparison {
@@ -161,7 +143,7 @@ struct Comparison {
 Comparison compare_maps(const SessionRun& kept, const SessionRun& other) {
   const std::vector<test::XyzI> a = test::read_ply(kept.folder / "map.ply");
   const std::vector<test::XyzI> b = test::read_ply(other.folder / "map.ply");
-  const Comparison c{unmatched(a, b, 0.0006), unmatched(b, a, 0.0006)};
+  const Comparison c{test::unmatched(a, b, 0.0006), test::unmatched(b, a, 0.0006)};
   const nlohmann::json& map = other.summary["map"];
   fmt::print("{} map points ({} with every tile in RAM); {} evictions, {} reloads, {} compactions, {} unconfirmed "
              "voxels lost; {} points of the all-in-RAM map missing, {} points not in it\n",

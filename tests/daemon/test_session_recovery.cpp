@@ -29,7 +29,8 @@ struct Written {
 // A session folder with a journal of `scans` scans (a pose, a few tiles' new
 // points, a keyframe every 5th) written through JournalWriter, and a
 // trajectory.tum that goes `extra_s` further (what the odometry saw after).
-Written write_session(const std::filesystem::path& dir, int scans, double extra_s, std::uint32_t seed) {
+Written write_session(const std::filesystem::path& dir, int scans, double extra_s, std::uint32_t seed,
+                      bool clean = false) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   Written w;
@@ -64,7 +65,7 @@ Written write_session(const std::filesystem::path& dir, int scans, double extra_
   }
   for (double t = 0.1; t <= extra_s + 1e-9; t += 0.1)
     trajectory << fmt::format("{:.9f} 0 0 0 0 0 0 1\n", 1.7e9 + 0.1 * (scans - 1) + t);
-  journal.close(false);  // cut short: no end record
+  journal.close(clean);  // cut short: no end record
   EXPECT_EQ(journal.fault(), "");
   EXPECT_EQ(journal.stats().lost_records.load(), 0U);
   return w;
@@ -99,6 +100,19 @@ TEST(SessionRecovery, AnInterruptedSessionIsFoundAndItsMapRebuiltWhole) {
   EXPECT_FALSE(std::filesystem::exists(dir / "journal.adj"));  // its content is in the files now
   EXPECT_TRUE(interrupted_sessions(dir.parent_path()).empty());
   EXPECT_NE(describe(r).find("recovered"), std::string::npos);
+}
+
+// A journal closed cleanly (the crash came while the files were written)
+// ends with its end record, and holds each point once.
+TEST(SessionRecovery, ACleanlyClosedJournalEndsWithItsEndRecordAndEachPointOnce) {
+  const std::filesystem::path dir = work_dir("clean");
+  const Written w = write_session(dir, 25, 0.0, 4, true);
+  const RecoveryReport r = recover_session(dir, {"ply"}, 20.0);
+  ASSERT_TRUE(r.recovered) << r.problem;
+  EXPECT_TRUE(r.ended_cleanly);
+  EXPECT_EQ(r.cut_bytes, 0U);
+  EXPECT_EQ(r.points, w.points);
+  EXPECT_EQ(r.map_poses, w.poses);
 }
 
 // Wherever the crash cut the journal, what came before the cut is recovered

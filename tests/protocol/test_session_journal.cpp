@@ -41,6 +41,8 @@ std::vector<std::uint8_t> journal(std::vector<std::size_t>& ends) {
     append_journal_record(out, JournalRecordType::tile_points, payload);
     ends.push_back(out.size());
   }
+  append_journal_record(out, JournalRecordType::end, {});  // an empty payload (from a null span)
+  ends.push_back(out.size());
   return out;
 }
 

@@ -16,6 +16,7 @@
 #include "adit/daemon/pipeline.hpp"
 #include "commands.hpp"
 #include "pipeline_run.hpp"
+#include "replay_session.hpp"
 
 namespace adit::tools {
 namespace {
@@ -29,6 +30,8 @@ struct ReplayOptions {
   double memory_from = 0.1;
   std::string session_dir;  // empty: a temporary folder, removed at the end
   std::string memory_csv;   // empty: none
+  std::string session;      // a stored session to map again (replay_session.hpp)
+  std::string out_dir;      // where its new session goes
 };
 
 // A fresh folder under the system's temporary directory, removed when done.
@@ -56,6 +59,8 @@ const std::string& source_of(const config::Config& c) {
 }
 
 int replay(const ReplayOptions& o) {
+  if (!o.session.empty())
+    return replay_session(o.session, o.out_dir.empty() ? std::filesystem::path(o.session) / "replayed" : std::filesystem::path(o.out_dir));
   const config::Config config = load_pipeline_config(o.inputs);
   if (config.lidar.source == config::LidarSource::scan_dir && (o.realtime || o.speed > 0.0))
     throw InputError(config.lidar.scan_dir, o.realtime ? "--realtime" : "--speed",
@@ -128,6 +133,14 @@ void register_replay_commands(CLI::App& app, int& status) {
                     ->check(CLI::Range(0.0, 1e6));
   realtime->excludes(speed);
   cmd->add_flag("--json", o->json, "Print the figures as JSON (for scripts)");
+  auto* session = cmd->add_option("--session", o->session,
+                  "Map a stored session again from its raw recordings (lidar.pcap, can.log) with its own config.yaml, "
+                  "as aditd does: a new session folder with map, trajectory and summary (under --out-dir)")
+      ->check(CLI::ExistingDirectory);
+  session->excludes(pcap)->excludes(scans);
+  cmd->add_option("--out-dir", o->out_dir,
+                  "With --session: the state folder of the new session (<out-dir>/sessions/<id>/). Default: "
+                  "<session>/replayed");
   cmd->add_option("--session-dir", o->session_dir,
                   "Where the mapping thread writes what the sensor has left, as a session does: tiles/<id>.adt and "
                   "keyframes/<stamp>.ply (map.evict_after_keyframes: 0 keeps all in RAM). Default: a temporary "

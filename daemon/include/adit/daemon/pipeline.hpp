@@ -80,6 +80,8 @@ class Pipeline {
   // Stops reading the source; what was read is still processed, so drained()
   // becomes true once every stage has caught up (the end of a session).
   void end_source();
+  // Stops the raw recording (low disk space); the pipeline goes on. Any thread.
+  void stop_recording(RecordingStop why);
   // Waits until a replay source is exhausted and every stage has drained, or
   // until request_stop(); then joins the threads.
   void join();

@@ -3,6 +3,7 @@
 // by the session (status, summary.json) and the tools.
 
 #include <atomic>
+#include <string_view>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -13,6 +14,22 @@
 namespace adit::daemon {
 
 // Statistics, readable while running (atomics) and complete after join().
+enum class RecordingStop : int {
+  recording = 0,
+  budget = 1,       // session.record_budget_mb reached
+  write_failed = 2, // the disk refused a write (full)
+  low_disk = 3,     // free space fell below session.record_min_free_mb
+};
+constexpr std::string_view to_string(RecordingStop why) {
+  switch (why) {
+    case RecordingStop::recording: return "recording";
+    case RecordingStop::budget: return "the session's recording budget (session.record_budget_mb) is used up";
+    case RecordingStop::write_failed: return "the disk refused a write (full?)";
+    case RecordingStop::low_disk: return "free disk space fell below session.record_min_free_mb";
+  }
+  return "unknown";
+}
+
 struct PipelineStats {
   std::atomic<std::uint64_t> datagrams{0};         // received from the source
   std::atomic<std::uint64_t> foreign_datagrams{0}; // not on the data port
@@ -29,6 +46,10 @@ struct PipelineStats {
   std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
   std::atomic<std::int64_t> clock_offset_ns{0};          // host − sensor clock, per scan (drivers/lidar/sensor_clock.hpp)
   std::atomic<std::uint64_t> recorded_datagrams{0};
+  std::atomic<std::uint64_t> recorded_bytes{0};
+  // Why the raw recording stopped before the session did (RecordingStop);
+  // the mapping goes on either way.
+  std::atomic<int> recording_stopped{0};
   std::atomic<std::uint64_t> mapped_scans{0};
   std::atomic<std::uint64_t> dropped_map_scans{0};      // live: mapping fell behind
   std::atomic<std::uint64_t> map_points{0};

@@ -34,6 +34,8 @@ class PcapWriter {
   void flush();
 
   std::uint64_t datagrams() const { return datagrams_; }
+  std::uint64_t bytes() const { return bytes_; }   // the file's size once flushed
+  bool failed() const { return !out_; }            // a write failed (disk full): later ones do nothing
   std::uint64_t records() const { return records_; }
 
  private:
@@ -44,6 +46,7 @@ class PcapWriter {
   std::uint16_t ip_id_ = 0;
   std::uint64_t datagrams_ = 0;
   std::uint64_t records_ = 0;
+  std::uint64_t bytes_ = 24;  // the global header
 };
 
 }  // namespace adit::drivers

@@ -78,7 +78,7 @@ struct CanSection {
   std::string dbc;                       // a DBC file with the signals (or inline signals)
   std::string preset;                    // "", canopen_tpdo, odrive
   int node_id = 1;                       // presets: CANopen / ODrive node
-  bool record = false;                   // write the bus to the session folder
+  bool record = true;                    // write the bus to the session folder (can.log, candump -L)
   std::vector<CanSignal> signals;
 };
 
@@ -192,13 +192,21 @@ struct MapSection {
 // Sessions: what is kept in the session folder and how a session begins.
 struct SessionSection {
   bool autostart = false;                // start mapping at launch (payloads without a tablet)
-  bool record_lidar = false;             // write the raw LiDAR packets to <session>/lidar.pcap
+  // The raw LiDAR packets (the Ouster's IMU packets with them) to
+  // <session>/lidar.pcap, so that a session can be mapped again (`adit
+  // replay --session`); packet sources only. The recording stops (and the
+  // status says so; the mapping goes on) when it reaches record_budget_mb
+  // (0 = no budget) or free disk space falls below record_min_free_mb.
+  bool record_lidar = true;
+  double record_budget_mb = 16000.0;
+  double record_min_free_mb = 1000.0;
   std::vector<std::string> exports{"ply", "las"};  // map files written when a session stops
   // The session journal (<session>/journal.adj): what mapping makes reaches
   // the disk as it is made, so that aditd rebuilds a session's map after a
   // crash (docs/SESSIONS.md); fdatasync at most every journal_sync_s.
   bool journal = true;
   double journal_sync_s = 0.5;
+  bool keep_journal = false;  // after a clean stop (the map files hold it all then): for audits and tests
 };
 
 struct LcmSection {

@@ -211,9 +211,12 @@ template <typename V>
 void describe(V& v, SessionSection& s) {
   v.optional("autostart", s.autostart);
   v.optional("record_lidar", s.record_lidar);
+  v.optional("record_budget_mb", s.record_budget_mb, Range<double>{0.0, 1e9});
+  v.optional("record_min_free_mb", s.record_min_free_mb, Range<double>{0.0, 1e9});
   v.optional("exports", s.exports, OneOf{kMapFormats});
   v.optional("journal", s.journal);
   v.optional("journal_sync_s", s.journal_sync_s, Range<double>{0.05, 10.0});
+  v.optional("keep_journal", s.keep_journal);
 }
 
 template <typename V>
