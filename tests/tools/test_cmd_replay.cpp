@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -164,6 +165,49 @@ TEST_F(Replay, BenchPipelineReceivesTheWholeCaptureOverLoopback) {
   // Latency covers the scan's odometry: paired per scan, the rest is never negative.
   EXPECT_GE(file["latency_beyond_odometry_ms"]["median"].get<double>(), 0.0);
   EXPECT_GE(udp["latency_beyond_odometry_ms"]["median"].get<double>(), 0.0);
+}
+
+}  // namespace
+
+namespace {
+
+// A session aditd recorded (raw recording is on by default) is mapped again
+// from its own recordings and configuration: the same map.
+TEST_F(Replay, AStoredSessionIsMappedAgainFromItsRecordings) {
+  const fs::path work = dir_ / "stored";
+  const std::string yaml = adit::test::aditd_yaml_for(session_, work / "state",
+                                                      {"", "", true, "threads:\n  lock_memory: false\n"});
+  fs::create_directories(work);
+  std::ofstream(work / "aditd.yaml") << yaml;
+  {
+    adit::test::Daemon once({(adit::test::binary_dir() / "bin/aditd").string(), "--config", (work / "aditd.yaml").string(),
+                             "--once"},
+                            work / "aditd.log");
+    ASSERT_EQ(once.wait_exit(120), 0) << "aditd --once failed (" << (work / "aditd.log").string() << ")";
+  }
+  std::vector<fs::path> sessions;
+  for (const auto& e : fs::directory_iterator(work / "state" / "sessions")) sessions.push_back(e.path());
+  ASSERT_EQ(sessions.size(), 1U);
+  const fs::path stored = sessions[0];
+  ASSERT_TRUE(fs::exists(stored / "lidar.pcap"));  // recorded by default
+  ASSERT_TRUE(fs::exists(stored / "can.log"));
+  const nlohmann::json first = nlohmann::json::parse(std::ifstream(stored / "summary.json"));
+  EXPECT_TRUE(first["lidar"]["recording_stopped"].is_null());
+  EXPECT_EQ(first["lidar"]["recorded_datagrams"], first["lidar"]["datagrams"]);
+
+  const CommandRun again = adit("replay --session " + stored.string() + " --out-dir " + (work / "again").string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  std::vector<fs::path> replayed;
+  for (const auto& e : fs::directory_iterator(work / "again" / "sessions")) replayed.push_back(e.path());
+  ASSERT_EQ(replayed.size(), 1U);
+  const nlohmann::json second = nlohmann::json::parse(std::ifstream(replayed[0] / "summary.json"));
+  EXPECT_EQ(second["poses"]["total"], first["poses"]["total"]);
+  EXPECT_EQ(second["map"]["points"], first["map"]["points"]);
+  EXPECT_NE(again.output.find(first["map"]["points"].dump() + " map points"), std::string::npos) << again.output;
+
+  const CommandRun not_a_session = adit("replay --session " + work.string());
+  EXPECT_EQ(not_a_session.status, 2);
+  EXPECT_NE(not_a_session.output.find("config.yaml"), std::string::npos) << not_a_session.output;
 }
 
 }  // namespace
