@@ -90,7 +90,11 @@ struct LidarSource::Impl {
         imu_udp.emplace(udp_config);
       }
     }
-    // The packet period is learnt from the first packet by the family; 0 = by sequence only.
+    // The packet period is learnt from the first data packet by the family
+    // (learn_packet_period); until then, and for families without one, loss
+    // is counted by sequence only.
+    model = c.lidar.model;
+    lidar_family = family;
     assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
     stream.emplace(*decoder, *assembler, [this](drivers::LidarScan& scan) { hand_on(scan); });
   }
@@ -107,6 +111,13 @@ struct LidarSource::Impl {
         stats.clock_offset_ns.store(clock->offset_ns, std::memory_order_relaxed);
     }
     if (!scan.stats.complete) stats.incomplete_scans.fetch_add(1, std::memory_order_relaxed);
+    if (assembler) {
+      const drivers::ScanAssemblerTotals& t = assembler->totals();
+      stats.missing_packets.store(t.missing_packets, std::memory_order_relaxed);
+      stats.duplicate_packets.store(t.duplicate_packets, std::memory_order_relaxed);
+      stats.late_packets.store(t.out_of_order_packets, std::memory_order_relaxed);
+      stats.resyncs.store(t.resyncs, std::memory_order_relaxed);
+    }
     ScanSlot* slot = scans->acquire_or_wait([this] { return assembly.idle(); });
     if (slot == nullptr) return;
     std::swap(slot->scan, scan);
@@ -210,6 +221,13 @@ struct LidarSource::Impl {
     scans->close();
   }
 
+  // Once, from the first data packet (its return mode sets the period).
+  void learn_packet_period(std::span<const std::uint8_t> payload) {
+    period_learnt = true;
+    if (const std::int64_t period = lidar_family->packet_period_ns(model, payload); period > 0)
+      assembler->set_packet_period_ns(period);
+  }
+
   void assembly_loop() {
     if (scan_directory) return;
     // A stop drops what is queued; an ended source is drained.
@@ -222,6 +240,7 @@ struct LidarSource::Impl {
         imu->push(payload, packet->host_time_ns, stream->clock());
       } else {
         current_packet_mono_ns = packet->received_mono_ns;
+        if (!period_learnt) learn_packet_period(payload);
         stream->push(payload, packet->host_time_ns);
       }
       packets.release(packet);
@@ -245,6 +264,9 @@ struct LidarSource::Impl {
   std::optional<drivers::ScanAssembler> assembler;
   std::optional<drivers::DecodeStream> stream;
   std::optional<drivers::PcapWriter> recorder;
+  const drivers::LidarFamily* lidar_family = nullptr;
+  std::string model;
+  bool period_learnt = false;  // assembly thread
   std::uint64_t record_budget_bytes = 0;  // 0: none
   static constexpr std::size_t kRecordOverhead = 128;  // pcap, Ethernet, IP and UDP headers of one datagram
   std::optional<OusterImu> imu;           // imu.source ouster

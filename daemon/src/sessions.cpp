@@ -376,6 +376,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"session", id},
         {"lidar", {{"model", config_.lidar.model}, {"datagrams", s.datagrams.load()},
                    {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
+                   {"missing_packets", s.missing_packets.load()}, {"duplicate_packets", s.duplicate_packets.load()},
+                   {"late_packets", s.late_packets.load()}, {"resyncs", s.resyncs.load()},
                    {"recorded_datagrams", s.recorded_datagrams.load()}, {"recorded_bytes", s.recorded_bytes.load()},
                    {"recording_stopped", s.recording_stopped.load() == 0
                                              ? nlohmann::json(nullptr)
@@ -499,7 +501,8 @@ StatusSample Sessions::status_sample() {
   SensorHealth lidar;
   lidar.name = "lidar " + config_.lidar.model;
   lidar.packet_rate_hz = dt > 0 ? static_cast<float>(static_cast<double>(datagrams - last_datagrams_) / dt) : 0.0F;
-  lidar.packets_dropped = static_cast<std::int64_t>(s.dropped_packets.load() + s.bad_packets.load());
+  lidar.packets_dropped =
+      static_cast<std::int64_t>(s.dropped_packets.load() + s.bad_packets.load() + s.missing_packets.load());
   lidar.last_seen_utime = s.last_packet_realtime_ns.load() / 1000;
   lidar.time_offset_s = static_cast<float>(1e-9 * static_cast<double>(s.clock_offset_ns.load()));
   sample.sensors.push_back(lidar);
@@ -546,6 +549,13 @@ StatusSample Sessions::status_sample() {
   else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
     sample.fault = fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
                                s.dropped_scans.load());
+  else if (const std::uint64_t lost = s.missing_packets.load() + s.duplicate_packets.load() + s.late_packets.load();
+           lost > 0)
+    sample.fault = fmt::format("LiDAR link: {} packets missing ({:.1f} %), {} repeated, {} late (skipped)",
+                               s.missing_packets.load(),
+                               100.0 * static_cast<double>(s.missing_packets.load()) /
+                                   static_cast<double>(std::max<std::uint64_t>(1, datagrams + s.missing_packets.load())),
+                               s.duplicate_packets.load(), s.late_packets.load());
   else if (config_.imu.enabled && imu.samples.load() == 0 && s.scans.load() > 10)
     sample.fault = fmt::format("no IMU readings ({}) after {} scans", imu_source, s.scans.load());
   else if (config_.imu.enabled)

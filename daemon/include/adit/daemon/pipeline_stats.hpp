@@ -43,6 +43,13 @@ struct PipelineStats {
   std::atomic<std::uint64_t> invalid_poses{0};
   std::atomic<std::uint64_t> degenerate_poses{0};
   std::atomic<std::uint64_t> bad_packets{0};
+  // The link as the scan assembler sees it (drivers/lidar/scan_assembler.hpp):
+  // packets missing from the sequence, repeated, arriving late (skipped), and
+  // jumps too large to be loss (a sensor restart, a clock step).
+  std::atomic<std::uint64_t> missing_packets{0};
+  std::atomic<std::uint64_t> duplicate_packets{0};
+  std::atomic<std::uint64_t> late_packets{0};
+  std::atomic<std::uint64_t> resyncs{0};
   std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
   std::atomic<std::int64_t> clock_offset_ns{0};          // host − sensor clock, per scan (drivers/lidar/sensor_clock.hpp)
   std::atomic<std::uint64_t> recorded_datagrams{0};

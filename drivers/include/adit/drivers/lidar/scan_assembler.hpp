@@ -54,6 +54,9 @@ class ScanAssembler {
 
   const ScanAssemblerTotals& totals() const { return totals_; }
   const ScanAssemblerConfig& config() const { return config_; }
+  // The packet period learnt from the first packet (a live source does not
+  // know its return mode before it): turns on time-based loss counting.
+  void set_packet_period_ns(std::int64_t period_ns) { config_.packet_period_ns = period_ns; }
 
   // Loss thresholds: a sequence or time jump beyond this many packets is a resync, not loss.
   static constexpr std::uint64_t kMaxCountedGap = 100'000;
