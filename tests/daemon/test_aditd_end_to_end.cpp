@@ -30,6 +30,7 @@
 #include "map_readers.hpp"
 #include "pcl_load.hpp"
 #include "run_program.hpp"
+#include "sim_sessions.hpp"
 #include "shared_data.hpp"
 
 namespace adit::test {
@@ -37,19 +38,9 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// A 12 s simulated drive through the mine, generated once per build tree.
-std::filesystem::path simulated_session() {
-  const std::filesystem::path dir = binary_dir() / "e2e-session-imu";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim = run_adit(fmt::format(
-        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
 
 TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces) {
-  const std::filesystem::path session = simulated_session();
+  const std::filesystem::path session = mine_drive_12s();
   ASSERT_TRUE(std::filesystem::exists(session / "lidar.pcap"));
   const std::filesystem::path work = binary_dir() / fmt::format("e2e-{}", ::getpid());
   std::filesystem::remove_all(work);

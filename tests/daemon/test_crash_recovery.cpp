@@ -22,6 +22,7 @@
 #include "point_match.hpp"
 #include "pose_counter.hpp"
 #include "run_program.hpp"
+#include "sim_sessions.hpp"
 #include "shared_data.hpp"
 
 namespace adit::test {
@@ -30,16 +31,6 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-// The end-to-end test's 12 s simulated drive (generated once per build tree).
-std::filesystem::path simulated_session() {
-  const std::filesystem::path dir = binary_dir() / "e2e-session-imu";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim = run_adit(fmt::format(
-        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
 
 std::string session_id_in(const std::string& start_output) {
   const std::size_t at = start_output.find("session ");
@@ -65,7 +56,7 @@ TEST(CrashRecovery, KilledAtRandomInstantsEverySessionIsRecoveredWholeToWithinOn
 #else
   const int kills = 20;
 #endif
-  const std::filesystem::path session = simulated_session();
+  const std::filesystem::path session = mine_drive_12s();
   ASSERT_TRUE(std::filesystem::exists(session / "lidar.pcap"));
   const std::filesystem::path work = binary_dir() / fmt::format("crash-{}", ::getpid());
   std::filesystem::remove_all(work);

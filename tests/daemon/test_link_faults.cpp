@@ -18,21 +18,12 @@
 #include "adit/drivers/pcap_writer.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
+#include "sim_sessions.hpp"
 #include "shared_data.hpp"
 
 namespace adit::daemon {
 namespace {
 
-// The end-to-end tests' 12 s simulated mine drive (generated once per build tree).
-std::filesystem::path simulated_session() {
-  const std::filesystem::path dir = test::binary_dir() / "e2e-session-imu";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const test::CommandRun sim = test::run_adit(fmt::format(
-        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
 
 struct Faults {
   std::uint64_t packets = 0, cable_out = 0, lost = 0, repeated = 0, late = 0;
@@ -93,7 +84,7 @@ struct LinkRun {
 };
 
 LinkRun map_with(const std::filesystem::path& pcap, const std::filesystem::path& work) {
-  const std::filesystem::path session = simulated_session();
+  const std::filesystem::path session = test::mine_drive_12s();
   std::filesystem::create_directories(work);
   const std::filesystem::path file = work / "aditd.yaml";
   std::ofstream(file) << test::aditd_yaml_for(session, work / "state", {"", "", true, "threads:\n  lock_memory: false\n"});
@@ -119,7 +110,7 @@ TEST(LinkFaults, LostRepeatedLateAndCutPacketsAreCountedAndTheTrajectoryHolds) {
   const std::filesystem::path work = test::binary_dir() / fmt::format("link-faults-{}", ::getpid());
   std::filesystem::remove_all(work);
   std::filesystem::create_directories(work);
-  const std::filesystem::path session = simulated_session();
+  const std::filesystem::path session = test::mine_drive_12s();
   const LinkRun clean = map_with(session / "lidar.pcap", work / "clean");
   EXPECT_EQ(clean.missing + clean.duplicate + clean.late, 0U);
 

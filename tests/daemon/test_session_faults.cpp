@@ -17,6 +17,7 @@
 #include "adit/daemon/sessions.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
+#include "sim_sessions.hpp"
 #include "shared_data.hpp"
 
 namespace adit::daemon {
@@ -24,21 +25,11 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// The end-to-end tests' 12 s simulated mine drive (generated once per build tree).
-std::filesystem::path simulated_session() {
-  const std::filesystem::path dir = test::binary_dir() / "e2e-session-imu";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const test::CommandRun sim = test::run_adit(fmt::format(
-        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
 
 config::Config session_config(const std::filesystem::path& work, const std::string& extra) {
   std::filesystem::create_directories(work);
   const std::filesystem::path file = work / "aditd.yaml";
-  std::ofstream(file) << test::aditd_yaml_for(simulated_session(), work / "state",
+  std::ofstream(file) << test::aditd_yaml_for(test::mine_drive_12s(), work / "state",
                                               {"", "", true, "threads:\n  lock_memory: false\n" + extra});
   return config::load_config(file);
 }

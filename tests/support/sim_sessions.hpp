@@ -1,0 +1,25 @@
+#pragma once
+// Simulated sessions the daemon's tests share, generated once per build tree.
+
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "run_program.hpp"
+#include "shared_data.hpp"
+
+namespace adit::test {
+
+// A 12 s drive of the wheeled robot through the mine with a VLP-16, CAN wheels and accelerometer (seed 7).
+inline std::filesystem::path mine_drive_12s() {
+  const std::filesystem::path dir = binary_dir() / "e2e-session-imu";
+  if (!std::filesystem::exists(dir / "lidar.pcap")) {
+    const CommandRun sim = run_adit(fmt::format(
+        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
+    EXPECT_EQ(sim.status, 0) << sim.output;
+  }
+  return dir;
+}
+
+}  // namespace adit::test
