@@ -17,6 +17,7 @@
 
 #include "daemon_process.hpp"
 #include "run_program.hpp"
+#include "shared_data.hpp"
 
 namespace adit::test {
 namespace {
@@ -52,7 +53,7 @@ TEST(JavaClient, StatusWatchAndSignedStartStopAgainstAditd) {
   // that see no packets, which is all the commands need.
   const std::filesystem::path config = work / "aditd.yaml";
   std::ofstream(config) << fmt::format(
-      "payload:\n  id: {}\n  state_dir: {}\nlidar:\n  model: VLP-16\n  source: udp\n  address: 127.0.0.1\n"
+      "payload:\n  id: {}\n  state_dir: {}\nlidar:\n  model: Mid-360\n  source: udp\n  address: 127.0.0.1\n"
       "  port: {}\nlcm:\n  url: {}\n  key_file: {}\nthreads:\n  lock_memory: false\n",
       java.payload, (work / "state").string(), 30000 + ::getpid() % 20000, java.url, key);
   Daemon aditd({(binary_dir() / "bin/aditd").string(), "--config", config.string()}, work / "aditd.log");

@@ -423,9 +423,6 @@ TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {
   EXPECT_EQ(r.exit_status, 2) << r.err;
 }
 
-}  // namespace
-}  // namespace adit::daemon
-
 // --- authenticated commands (docs/PROTOCOL.md) ------------------------------
 
 namespace auth {
@@ -539,7 +536,10 @@ TEST(LcmEndpointAuth, TamperedStaleOtherPayloadAndReplayedChangeNoState) {
   ASSERT_EQ(s.send(signed_command(h, 25, "STOP", key)).accepted, true);
   h.endpoint->session_stopped();
   ASSERT_TRUE(h.wait_for(SessionState::idle));
-  s.send(start);
+  s.lcm.publish(s.channel, &start);
+  for (int i = 0; i < 100 && s.sniffer.acks_for(24).size() < 2; ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(s.sniffer.acks_for(24).size(), 2u);
+  EXPECT_TRUE(s.sniffer.acks_for(24).back().accepted) << "the stored ack, sent again";
   EXPECT_EQ(h.endpoint->counters().commands_replayed.load(), 1u);
   EXPECT_EQ(h.endpoint->state(), SessionState::idle) << "a replayed START must not start a session";
   ASSERT_TRUE(s.send(signed_command(h, 26, "PING", key)).accepted);
@@ -653,3 +653,6 @@ TEST(LcmEndpointAuth, KeygenWritesAKeyOnlyItsOwnerMayRead) {
 }
 
 }  // namespace auth
+
+}  // namespace
+}  // namespace adit::daemon
