@@ -13,12 +13,15 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -114,6 +117,46 @@ TEST(Systemd, SecurityExposureIsAtMostThree) {
   const double exposure = std::stod(out.substr(at + marker.size()));
   std::printf("systemd-analyze security --offline=true systemd/aditd.service: exposure %.1f\n", exposure);
   EXPECT_LE(exposure, 3.0) << out;
+}
+
+// LoadCredential=command-key:… hands aditd its key in $CREDENTIALS_DIRECTORY;
+// lcm.key_file names it so. Without the variable, aditd refuses to start.
+TEST(Systemd, AditdReadsTheCommandKeyFromASystemdCredential) {
+  const std::filesystem::path work = binary_dir() / fmt::format("credential-{}", getpid());
+  std::filesystem::remove_all(work);
+  std::filesystem::create_directories(work / "credentials");
+  const ProgramResult keygen =
+      run_program({(binary_dir() / "bin/adit").string(), "keygen", "--out", (work / "credentials/command-key").string()});
+  ASSERT_EQ(keygen.exit_status, 0) << keygen.err;
+  std::filesystem::permissions(work / "credentials/command-key", std::filesystem::perms::owner_read);  // as systemd hands it
+  const std::string config = (work / "aditd.yaml").string();
+  std::ofstream(config) << fmt::format(
+      "payload:\n  id: cred{}\n  state_dir: {}\nlidar:\n  model: Mid-360\n  source: udp\n  address: 127.0.0.1\n"
+      "  port: {}\nlcm:\n  url: udpm://239.255.76.67:{}?ttl=0\n  key_file: $CREDENTIALS_DIRECTORY/command-key\n"
+      "threads:\n  lock_memory: false\n",
+      getpid(), (work / "state").string(), 30000 + getpid() % 20000, 20000 + (getpid() + 13) % 30000);
+
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  const ProgramResult refused = run_program({(binary_dir() / "bin/aditd").string(), "--config", config});
+  EXPECT_EQ(refused.exit_status, 2);
+  EXPECT_NE(refused.err.find("CREDENTIALS_DIRECTORY is not set"), std::string::npos) << refused.err;
+
+  ::setenv("CREDENTIALS_DIRECTORY", (work / "credentials").c_str(), 1);
+  std::string log;
+  {
+    Daemon aditd({(binary_dir() / "bin/aditd").string(), "--config", config}, work / "aditd.log");
+    ::unsetenv("CREDENTIALS_DIRECTORY");
+    for (int i = 0; i < 100 && log.find("LCM: ") == std::string::npos; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::ifstream in(work / "aditd.log");
+      log.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    EXPECT_EQ(aditd.stop(), 0);
+  }
+  EXPECT_NE(log.find(fmt::format("signed commands only, 1 key(s) from {}", (work / "credentials/command-key").string())),
+            std::string::npos)
+      << log;
+  std::filesystem::remove_all(work);
 }
 
 }  // namespace
