@@ -7,7 +7,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sodium.h>
+
+#include <fmt/format.h>
 
 #include "adit/common/error.hpp"
 #include "adit/protocol/command_auth.hpp"
@@ -190,6 +193,20 @@ TEST(CommandAuth, RotationAcceptsEveryListedKey) {
   EXPECT_EQ(inspect(gate, signed_with(make(3, "PING"), key_of(1))).reason.rfind("bad tag:", 0), 0u);
   gate.set_keys({}, kWindow);  // no keys: not authenticated
   EXPECT_EQ(inspect(gate, make(4, "PING")).kind, GateResult::Kind::execute);
+}
+
+// The fuzz target's signed seeds must stay valid, or it fuzzes only the tag
+// check: each verifies with the key of 32 bytes 0x07 at the target's clock.
+TEST(CommandAuth, FuzzSeedsAreSignedCommandsTheKeyedGateExecutes) {
+  CommandGate gate = keyed_gate();
+  for (int i = 0; i < 3; ++i) {
+    const auto path = std::filesystem::path(ADIT_SOURCE_DIR) / fmt::format("tests/fuzz/seeds/protocol/signed_{}.bin", i);
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_FALSE(bytes.empty()) << path;
+    const auto r = gate.inspect(bytes.data(), bytes.size(), kNow);
+    EXPECT_EQ(r.kind, GateResult::Kind::execute) << path << ": " << r.reason;
+  }
 }
 
 class KeyFile : public ::testing::Test {
