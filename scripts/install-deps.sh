@@ -22,7 +22,9 @@ packages=(
   libzstd-dev            # map tile compression
   zlib1g-dev             # CRC-32 of the session journal's records
   libssl-dev             # MD5 for the Ouster field digests (OpenSSL EVP)
+  libsodium-dev          # command authentication: HMAC-SHA-256 tags (docs/decisions/022-command-authentication.md)
   liblcm-dev liblcm-bin libglib2.0-dev  # LCM messages and lcm-gen (lcm.pc needs glib)
+  liblcm-java openjdk-17-jdk-headless  # the Java bindings and client for tablet apps (protocol/java)
   libembree-dev          # ray casting in the simulator
   libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI)
   # tests and benchmarks

@@ -2,6 +2,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <chrono>
 #include <mutex>
@@ -18,6 +20,7 @@
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
+#include "adit/protocol/command_auth.hpp"
 #include "adit/protocol/command_gate.hpp"
 #include "adit/common/clock.hpp"
 #include "adit/status_t.hpp"
@@ -52,6 +55,32 @@ bool take_from(Handoff<T>& handoff, T& out) {
   return true;
 }
 
+// What tells a key file changed: a rewrite in place changes size or mtime, a
+// rename over it (the safe way to rotate) changes the inode, chmod the ctime.
+struct FileIdentity {
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  off_t size = 0;
+  std::int64_t mtime_ns = 0;
+  std::int64_t ctime_ns = 0;  // chmod/chown
+  bool operator==(const FileIdentity&) const = default;
+};
+
+FileIdentity identity_of(const std::filesystem::path& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {};
+  return {true, st.st_dev, st.st_ino, st.st_size,
+          static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec,
+          static_cast<std::int64_t>(st.st_ctim.tv_sec) * 1'000'000'000 + st.st_ctim.tv_nsec};
+}
+
+std::string key_ids(const std::vector<protocol::CommandKey>& keys) {
+  std::string out;
+  for (const protocol::CommandKey& k : keys) out += (out.empty() ? "" : ", ") + protocol::key_id_hex(k.id());
+  return out;
+}
+
 TilePublisherOptions publisher_options(const EndpointOptions& o,
                                        std::function<std::string(const std::string&, TileStore&)> load) {
   return {o.payload_id, o.tiles, o.tile_period_s, o.chunk_bytes_per_s, o.drop_chunk_fraction, o.drop_seed,
@@ -77,6 +106,10 @@ struct LcmEndpoint::Impl final : TileSink {
   TilePublisher publisher;
   std::int64_t pose_seq = 0;
   EndpointCounters counters;
+  FileIdentity key_identity;
+  Clock::time_point next_key_check{};
+  std::uint64_t auth_rejections_logged = 0;
+  Clock::time_point next_auth_log{};
   std::atomic<bool> running{true};
   std::thread thread;
   // Reused message buffers: no allocation per pose once warmed up.
@@ -101,6 +134,7 @@ struct LcmEndpoint::Impl final : TileSink {
     if (const std::string problem = protocol::tile_params_problem(options.tiles); !problem.empty())
       throw InputError("tile parameters", "tiles", problem);
     if (!lcm.good()) throw std::runtime_error(fmt::format("LCM cannot open '{}'", options.lcm_url));
+    load_keys();
     for (int c = 0; c < 7; ++c) channels[c] = protocol::channel_name(options.payload_id, static_cast<Channel>(c));
     lcm.subscribe(channel(Channel::command), &Impl::on_command, this);
     lcm.subscribe(channel(Channel::tile_request), &Impl::on_tile_request, this);
@@ -129,9 +163,59 @@ struct LcmEndpoint::Impl final : TileSink {
   void send(const tile_segment_t& segment) override { send(Channel::tile, segment); }
   void send(const tile_index_t& index) override { send(Channel::tile_index, index); }
 
+  // --- keys ---------------------------------------------------------------
+
+  // At start: a configured key file that cannot be used is an error (aditd
+  // exits 2), never a silent fall-back to unauthenticated commands.
+  void load_keys() {
+    if (options.key_file.empty()) {
+      log::warn("commands are not authenticated: no lcm.key_file is configured, so anyone on the network can "
+                "START/STOP this payload (docs/PROTOCOL.md, threat model)");
+      return;
+    }
+    key_identity = identity_of(options.key_file);
+    std::vector<protocol::CommandKey> keys = protocol::read_key_file(options.key_file);
+    log::info("commands: signed commands only, {} key(s) from {} (key id {}), window ±{:.0f} s", keys.size(),
+              options.key_file.string(), key_ids(keys), options.command_window_s);
+    gate.set_keys(std::move(keys), static_cast<std::int64_t>(options.command_window_s * 1e6));
+    counters.commands_authenticated = true;
+  }
+
+  // Key rotation without a restart: re-read the file when it changed. A file
+  // that vanished or went bad keeps the keys in force (logged once per change).
+  void check_key_file() {
+    if (options.key_file.empty() || Clock::now() < next_key_check) return;
+    next_key_check = Clock::now() + std::chrono::microseconds(static_cast<std::int64_t>(options.key_check_period_s * 1e6));
+    const FileIdentity now = identity_of(options.key_file);
+    if (now == key_identity) return;
+    key_identity = now;
+    try {
+      std::vector<protocol::CommandKey> keys = protocol::read_key_file(options.key_file);
+      log::info("commands: key file {} changed: now {} key(s) (key id {})", options.key_file.string(), keys.size(),
+                key_ids(keys));
+      gate.set_keys(std::move(keys), gate.window_us());
+      ++counters.key_reloads;
+    } catch (const std::exception& e) {
+      ++counters.key_reload_errors;
+      log::error("commands: the changed key file is refused, the previous keys stay in force: {}", e.what());
+    }
+  }
+
+  void log_auth_rejections() {
+    const protocol::GateCounts& n = gate.counts();
+    const std::uint64_t total = n.unsigned_commands + n.bad_tag + n.stale + n.replay_rejected + n.other_payload;
+    if (total == auth_rejections_logged || Clock::now() < next_auth_log) return;
+    auth_rejections_logged = total;
+    next_auth_log = Clock::now() + std::chrono::seconds(5);  // a flood is summed, not logged per message
+    log::warn("commands rejected so far: {} unsigned, {} bad tag, {} stale, {} replayed, {} for another payload",
+              n.unsigned_commands, n.bad_tag, n.stale, n.replay_rejected, n.other_payload);
+  }
+
   void run() {
     while (running) {
       lcm.handleTimeout(2);
+      check_key_file();
+      log_auth_rejections();
       drain_events();
       drain_poses();
       drain_status();
@@ -156,7 +240,13 @@ struct LcmEndpoint::Impl final : TileSink {
   // --- commands -----------------------------------------------------------
 
   void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-    protocol::GateResult r = gate.inspect(rbuf->data, rbuf->data_size);
+    protocol::GateResult r = gate.inspect(rbuf->data, rbuf->data_size, realtime_us());
+    const protocol::GateCounts& n = gate.counts();
+    counters.commands_unsigned = n.unsigned_commands;
+    counters.commands_bad_tag = n.bad_tag;
+    counters.commands_stale = n.stale;
+    counters.commands_replay_rejected = n.replay_rejected;
+    counters.commands_other_payload = n.other_payload;
     using Kind = protocol::GateResult::Kind;
     if (r.kind == Kind::malformed) {
       ++counters.commands_malformed;
@@ -188,7 +278,7 @@ struct LcmEndpoint::Impl final : TileSink {
     (ack.accepted ? counters.commands_executed : counters.commands_rejected)++;
     ack.state = static_cast<std::int8_t>(machine.state());
     ack.session_id = session_id;
-    gate.remember(ack);
+    if (r.remember) gate.remember(ack);
     send(Channel::ack, ack);
   }
 

@@ -5,7 +5,9 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <cstdlib>
 #include <optional>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -29,9 +31,25 @@ std::string_view source_name(config::LidarSource source) {
   return "?";
 }
 
+// lcm.key_file may name a systemd credential (LoadCredential= in the unit):
+// "$CREDENTIALS_DIRECTORY/NAME", the directory known only at run time.
+std::filesystem::path key_file_path(const std::string& configured) {
+  for (const std::string_view prefix : {"$CREDENTIALS_DIRECTORY/", "${CREDENTIALS_DIRECTORY}/"}) {
+    if (configured.rfind(prefix, 0) != 0) continue;
+    const char* dir = std::getenv("CREDENTIALS_DIRECTORY");
+    if (dir == nullptr || *dir == '\0')
+      throw InputError("lcm.key_file", "key_file",
+                       "names a systemd credential but CREDENTIALS_DIRECTORY is not set (LoadCredential= in the unit)");
+    return std::filesystem::path(dir) / configured.substr(prefix.size());
+  }
+  return configured;
+}
+
 EndpointOptions endpoint_options(const config::Config& c) {
   EndpointOptions o;
   o.lcm_url = c.lcm.url;
+  o.key_file = key_file_path(c.lcm.key_file);
+  o.command_window_s = c.lcm.command_window_s;
   o.payload_id = c.payload.id;
   o.tiles.tile_size_m = c.map.tile_size_m;
   o.tile_period_s = c.map.publish_period_s;
@@ -42,6 +60,14 @@ std::string status_line(protocol::SessionState state, const StatusSample& s, con
   std::string line = fmt::format("{}", protocol::state_name(state));
   for (const SensorHealth& h : s.sensors) line += fmt::format("; {} {:.0f} packets/s", h.name, h.packet_rate_hz);
   line += fmt::format("; poses {} published", c.poses_published.load());
+  line += fmt::format("; commands {} executed, {} rejected", c.commands_executed.load(), c.commands_rejected.load());
+  const std::uint64_t refused = c.commands_unsigned + c.commands_bad_tag + c.commands_stale +
+                                c.commands_replay_rejected + c.commands_other_payload;
+  if (refused > 0)
+    line += fmt::format(" ({} unsigned, {} bad tag, {} stale, {} replayed, {} other payload)", c.commands_unsigned.load(),
+                        c.commands_bad_tag.load(), c.commands_stale.load(), c.commands_replay_rejected.load(),
+                        c.commands_other_payload.load());
+  if (!c.commands_authenticated) line += ", not authenticated";
   if (!s.fault.empty()) line += "; " + s.fault;
   return line;
 }

@@ -133,6 +133,8 @@ Config parse_config(std::string_view yaml, const std::string& name, const std::f
   for (std::string* path : {&config.lidar.pcap, &config.lidar.scan_dir, &config.lidar.calibration,
                             &config.can.log, &config.can.dbc, &config.payload.state_dir})
     resolve(*path, base_dir);
+  // "$CREDENTIALS_DIRECTORY/…" is a systemd credential, resolved by aditd at run time.
+  if (!config.lcm.key_file.starts_with('$')) resolve(config.lcm.key_file, base_dir);
   return config;
 }
 

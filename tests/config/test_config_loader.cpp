@@ -213,6 +213,16 @@ TEST(ConfigLoader, RelativePathsAreResolvedAgainstTheConfigFolder) {
   EXPECT_EQ(c.lidar.pcap, "/sessions/a.pcap");
 }
 
+TEST(ConfigLoader, KeyFileIsResolvedAgainstTheConfigFolderUnlessACredential) {
+  Config c = parse(std::string(kMinimal) + "lcm:\n  key_file: ../keys/command.key\n");
+  EXPECT_EQ(c.lcm.key_file, "/keys/command.key");
+  EXPECT_EQ(c.lcm.command_window_s, 30.0);
+  c = parse(std::string(kMinimal) + "lcm:\n  key_file: $CREDENTIALS_DIRECTORY/command-key\n  command_window_s: 5\n");
+  EXPECT_EQ(c.lcm.key_file, "$CREDENTIALS_DIRECTORY/command-key");
+  EXPECT_EQ(c.lcm.command_window_s, 5.0);
+  EXPECT_EQ(parse(kMinimal).lcm.key_file, "") << "no key by default: commands are not authenticated";
+}
+
 TEST(ConfigLoader, EffectiveYamlReadsBackToTheSameConfiguration) {
   const std::filesystem::path file = test::source_dir() / "firmware-config/templates/vlp16-diffdrive-robot.yaml";
   const Config original = load_config(file);

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <lcm/lcm-cpp.hpp>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -18,7 +22,10 @@
 
 #include "adit/command_ack_t.hpp"
 #include "adit/command_t.hpp"
+#include "adit/common/clock.hpp"
+#include "adit/common/error.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/protocol/command_auth.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/tile_segment_t.hpp"
@@ -73,12 +80,15 @@ struct Harness {
   std::atomic<int> stops{0};
   std::unique_ptr<LcmEndpoint> endpoint;
 
-  explicit Harness(double drop = 0.0) {
+  explicit Harness(double drop = 0.0, const std::filesystem::path& key_file = {}, std::size_t command_window = 1024) {
     EndpointOptions o;
     o.lcm_url = url;
     o.payload_id = payload;
     o.drop_chunk_fraction = drop;
     o.drop_seed = 7;
+    o.key_file = key_file;
+    o.key_check_period_s = 0.1;
+    o.command_window = command_window;
     SessionHooks hooks;
     hooks.start = [this] { return fmt::format("s{}", ++starts); };
     // The daemon flushes elsewhere and calls session_stopped() when done
@@ -412,6 +422,237 @@ TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {
   r = test::run_program({adit, "status", "--payload", "bad/id", "--lcm-url", url});
   EXPECT_EQ(r.exit_status, 2) << r.err;
 }
+
+// --- authenticated commands (docs/PROTOCOL.md) ------------------------------
+
+namespace auth {
+
+struct KeyDir {
+  std::filesystem::path dir = test::binary_dir() / fmt::format("auth-keys-{}", ::getpid());
+  KeyDir() {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  ~KeyDir() { std::filesystem::remove_all(dir); }
+  std::filesystem::path write(const std::string& name, const protocol::CommandKey& key, bool replace = false) const {
+    protocol::write_key_file(dir / name, key, replace);
+    return dir / name;
+  }
+};
+
+// Publishes raw commands and waits for their acks.
+struct Sender {
+  Sniffer sniffer;
+  lcm::LCM lcm;
+  std::string channel;
+  explicit Sender(const Harness& h)
+      : sniffer(h.url), lcm(h.url), channel(protocol::channel_name(h.payload, Channel::command)) {
+    std::this_thread::sleep_for(50ms);
+  }
+  command_ack_t send(const command_t& c) {
+    lcm.publish(channel, &c);
+    for (int i = 0; i < 100 && sniffer.acks_for(c.request_id).empty(); ++i) std::this_thread::sleep_for(10ms);
+    const auto acks = sniffer.acks_for(c.request_id);
+    return acks.empty() ? command_ack_t{} : acks.back();
+  }
+};
+
+command_t signed_command(const Harness& h, std::int64_t id, const std::string& verb, const protocol::CommandKey& key,
+                         std::int64_t utime = realtime_us()) {
+  command_t c = command(h, id, verb);
+  c.utime = utime;
+  protocol::sign_command(c, key);
+  return c;
+}
+
+TEST(LcmEndpointAuth, UnsignedAndWronglySignedAreRejectedSignedAreExecuted) {
+  const KeyDir keys;
+  const protocol::CommandKey key = protocol::CommandKey::generate();
+  const auto key_file = keys.write("payload.key", key);
+  const auto wrong_file = keys.write("wrong.key", protocol::CommandKey::generate());
+  Harness h(0.0, key_file);
+  EXPECT_TRUE(h.endpoint->counters().commands_authenticated.load());
+
+  auto r = h.adit({"start"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("START rejected: unsigned: this payload accepts only signed commands"), std::string::npos)
+      << r.err;
+  r = h.adit({"start", "--key", wrong_file.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("START rejected: bad tag: signed with key id"), std::string::npos) << r.err;
+  EXPECT_EQ(h.endpoint->state(), SessionState::idle);
+  EXPECT_EQ(h.starts, 0);
+
+  r = h.adit({"start", "--key", key_file.string()});
+  ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("state MAPPING, session s1"), std::string::npos) << r.out;
+  r = h.adit({"sessions", "--key", key_file.string()});
+  EXPECT_EQ(r.out, "s0\ns1\n");
+  r = h.adit({"ping", "--key", key_file.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  r = h.adit({"stop"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_EQ(h.endpoint->state(), SessionState::mapping);
+  r = h.adit({"stop", "--key", key_file.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(h.endpoint->state(), SessionState::stopping);
+  const EndpointCounters& n = h.endpoint->counters();
+  EXPECT_EQ(n.commands_unsigned.load(), 2u);
+  EXPECT_EQ(n.commands_bad_tag.load(), 1u);
+  EXPECT_EQ(n.commands_executed.load(), 4u);
+}
+
+TEST(LcmEndpointAuth, TamperedStaleOtherPayloadAndReplayedChangeNoState) {
+  const KeyDir keys;
+  const protocol::CommandKey key = protocol::CommandKey::generate();
+  Harness h(0.0, keys.write("payload.key", key), 2);
+  Sender s(h);
+
+  command_t tampered = signed_command(h, 21, "PING", key);
+  tampered.verb = "START";
+  auto ack = s.send(tampered);
+  EXPECT_FALSE(ack.accepted);
+  EXPECT_EQ(ack.reason, "bad tag: the tag does not match the command's content");
+
+  ack = s.send(signed_command(h, 22, "START", key, realtime_us() - 60'000'000));
+  EXPECT_FALSE(ack.accepted);
+  EXPECT_EQ(ack.reason.rfind("stale: signed at", 0), 0u) << ack.reason;
+
+  command_t elsewhere = command(h, 23, "START");
+  elsewhere.payload_id = "another-payload";
+  elsewhere.utime = realtime_us();
+  protocol::sign_command(elsewhere, key);
+  ack = s.send(elsewhere);
+  EXPECT_FALSE(ack.accepted);
+  EXPECT_EQ(ack.reason.rfind("other payload: addressed to payload 'another-payload'", 0), 0u) << ack.reason;
+  EXPECT_EQ(h.starts, 0);
+  EXPECT_EQ(h.endpoint->state(), SessionState::idle);
+
+  // A signed START, captured and sent again: answered with the stored ack,
+  // not executed; once its answer is forgotten (window of 2 ids), refused.
+  const command_t start = signed_command(h, 24, "START", key);
+  ack = s.send(start);
+  ASSERT_TRUE(ack.accepted) << ack.reason;
+  ASSERT_EQ(s.send(signed_command(h, 25, "STOP", key)).accepted, true);
+  h.endpoint->session_stopped();
+  ASSERT_TRUE(h.wait_for(SessionState::idle));
+  s.lcm.publish(s.channel, &start);
+  for (int i = 0; i < 100 && s.sniffer.acks_for(24).size() < 2; ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(s.sniffer.acks_for(24).size(), 2u);
+  EXPECT_TRUE(s.sniffer.acks_for(24).back().accepted) << "the stored ack, sent again";
+  EXPECT_EQ(h.endpoint->counters().commands_replayed.load(), 1u);
+  EXPECT_EQ(h.endpoint->state(), SessionState::idle) << "a replayed START must not start a session";
+  ASSERT_TRUE(s.send(signed_command(h, 26, "PING", key)).accepted);
+  ASSERT_TRUE(s.send(signed_command(h, 27, "PING", key)).accepted);
+  s.lcm.publish(s.channel, &start);
+  for (int i = 0; i < 100 && s.sniffer.acks_for(24).size() < 3; ++i) std::this_thread::sleep_for(10ms);
+  const auto acks = s.sniffer.acks_for(24);
+  ASSERT_EQ(acks.size(), 3u);
+  EXPECT_FALSE(acks.back().accepted);
+  EXPECT_EQ(acks.back().reason, "replayed: this signed request id was executed before");
+  EXPECT_EQ(h.starts, 1);
+  EXPECT_EQ(h.endpoint->state(), SessionState::idle);
+
+  const EndpointCounters& n = h.endpoint->counters();
+  EXPECT_EQ(n.commands_bad_tag.load(), 1u);
+  EXPECT_EQ(n.commands_stale.load(), 1u);
+  EXPECT_EQ(n.commands_other_payload.load(), 1u);
+  EXPECT_EQ(n.commands_replay_rejected.load(), 1u);
+}
+
+TEST(LcmEndpointAuth, SignedAcksArriveWithin100ms) {
+  const KeyDir keys;
+  const protocol::CommandKey key = protocol::CommandKey::generate();
+  Harness h(0.0, keys.write("payload.key", key));
+  Sender s(h);
+  std::vector<double> ms;
+  for (std::int64_t id = 300; id < 320; ++id) {
+    const command_t c = signed_command(h, id, "PING", key);
+    const auto sent = std::chrono::steady_clock::now();
+    s.lcm.publish(s.channel, &c);
+    while (s.sniffer.acks_for(id).empty() && std::chrono::steady_clock::now() - sent < 1s) std::this_thread::sleep_for(100us);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - sent).count());
+    ASSERT_FALSE(s.sniffer.acks_for(id).empty());
+    EXPECT_TRUE(s.sniffer.acks_for(id).back().accepted) << s.sniffer.acks_for(id).back().reason;
+    EXPECT_LT(ms.back(), 100.0);
+  }
+  std::sort(ms.begin(), ms.end());
+  double sum = 0;
+  for (double v : ms) sum += v;
+  std::printf("signed PING ack latency over %zu commands: mean %.2f ms, median %.2f ms, worst %.2f ms\n", ms.size(),
+              sum / static_cast<double>(ms.size()), ms[ms.size() / 2], ms.back());
+}
+
+TEST(LcmEndpointAuth, KeyRotationWithoutRestartAndABadNewFileKeepsTheOldKey) {
+  const KeyDir keys;
+  const protocol::CommandKey first = protocol::CommandKey::generate();
+  const protocol::CommandKey second = protocol::CommandKey::generate();
+  const auto key_file = keys.write("payload.key", first);
+  const auto first_file = keys.write("first.key", first);
+  const auto second_file = keys.write("second.key", second);
+  Harness h(0.0, key_file);
+  EXPECT_EQ(h.adit({"ping", "--key", first_file.string()}).exit_status, 0);
+  EXPECT_EQ(h.adit({"ping", "--key", second_file.string()}).exit_status, 1);
+
+  keys.write("payload.key", second, true);  // written aside, renamed over: what an operator's tool does
+  for (int i = 0; i < 50 && h.endpoint->counters().key_reloads.load() == 0; ++i) std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(h.endpoint->counters().key_reloads.load(), 1u);
+  auto r = h.adit({"ping", "--key", first_file.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("bad tag"), std::string::npos) << r.err;
+  EXPECT_EQ(h.adit({"ping", "--key", second_file.string()}).exit_status, 0);
+
+  // A key file others may read is refused; the key in force stays.
+  ASSERT_EQ(::chmod(key_file.c_str(), 0644), 0);
+  for (int i = 0; i < 50 && h.endpoint->counters().key_reload_errors.load() == 0; ++i) std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(h.endpoint->counters().key_reload_errors.load(), 1u);
+  EXPECT_EQ(h.adit({"ping", "--key", second_file.string()}).exit_status, 0);
+  EXPECT_EQ(h.adit({"ping"}).exit_status, 1) << "still authenticated";
+}
+
+TEST(LcmEndpointAuth, BadKeyFilesAreRefusedAtStartAndByTheClient) {
+  const KeyDir keys;
+  const auto open_file = keys.write("open.key", protocol::CommandKey::generate());
+  ASSERT_EQ(::chmod(open_file.c_str(), 0640), 0);
+  try {
+    Harness h(0.0, open_file);
+    ADD_FAILURE() << "a group-readable key file was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), open_file.string());
+    EXPECT_NE(e.reason().find("mode 0640"), std::string::npos) << e.reason();
+  }
+  EXPECT_THROW(Harness(0.0, keys.dir / "missing.key"), InputError);
+  const auto garbage = keys.dir / "garbage.key";
+  { std::ofstream(garbage) << "adit-command-key-v1 not-hex\n"; }
+  ::chmod(garbage.c_str(), 0600);
+  EXPECT_THROW(Harness(0.0, garbage), InputError);
+
+  Harness h;  // no key: commands are not authenticated, as before keys existed
+  EXPECT_FALSE(h.endpoint->counters().commands_authenticated.load());
+  auto r = h.adit({"ping", "--key", open_file.string()});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find(open_file.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("chmod 600"), std::string::npos) << r.err;
+  EXPECT_EQ(h.adit({"ping"}).exit_status, 0);
+}
+
+TEST(LcmEndpointAuth, KeygenWritesAKeyOnlyItsOwnerMayRead) {
+  const KeyDir keys;
+  const auto path = keys.dir / "new.key";
+  auto r = test::run_program({(test::binary_dir() / "bin" / "adit").string(), "keygen", "--out", path.string()});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("(mode 0600)"), std::string::npos) << r.out;
+  struct stat st {};
+  ASSERT_EQ(::stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0600u);
+  const auto key = protocol::read_key_file(path);
+  EXPECT_NE(r.out.find(protocol::key_id_hex(key.at(0).id())), std::string::npos);
+  r = test::run_program({(test::binary_dir() / "bin" / "adit").string(), "keygen", "--out", path.string()});
+  EXPECT_EQ(r.exit_status, 2) << "an existing key is not overwritten";
+  EXPECT_EQ(protocol::read_key_file(path).at(0).id(), key.at(0).id());
+}
+
+}  // namespace auth
 
 }  // namespace
 }  // namespace adit::daemon

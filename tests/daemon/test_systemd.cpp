@@ -9,13 +9,19 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 
@@ -87,6 +93,70 @@ TEST(Systemd, UnitIsTypeNotifyWithWatchdogRestartLimitsAndStateDirectory) {
   // These two would break real time and GPIO (see FIELD-NOTES): they must not be set.
   EXPECT_EQ(text.str().find("\nRestrictRealtime=yes"), std::string::npos);
   EXPECT_EQ(text.str().find("\nPrivateDevices=yes"), std::string::npos);
+  for (const char* line : {"\nUser=adit", "\nCapabilityBoundingSet=\n", "\nNoNewPrivileges=yes", "\nProtectSystem=strict",
+                           "\nPrivateTmp=yes", "\nDeviceAllow=char-gpiochip rw"})
+    EXPECT_NE(text.str().find(line), std::string::npos) << line;
+}
+
+// systemd's own judgement of the unit's sandbox (issue 21: exposure <= 3.0;
+// it was 5.7 before the hardening).
+TEST(Systemd, SecurityExposureIsAtMostThree) {
+  if (std::system("command -v systemd-analyze >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "systemd-analyze is not installed: the exposure is not measured";
+  const std::string command =
+      "systemd-analyze security --offline=true --no-pager " + (source_dir() / "systemd/aditd.service").string() + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+  ::pclose(pipe);
+  const std::string marker = "Overall exposure level for aditd.service: ";
+  const std::size_t at = out.find(marker);
+  ASSERT_NE(at, std::string::npos) << out;
+  const double exposure = std::stod(out.substr(at + marker.size()));
+  std::printf("systemd-analyze security --offline=true systemd/aditd.service: exposure %.1f\n", exposure);
+  EXPECT_LE(exposure, 3.0) << out;
+}
+
+// LoadCredential=command-key:… hands aditd its key in $CREDENTIALS_DIRECTORY;
+// lcm.key_file names it so. Without the variable, aditd refuses to start.
+TEST(Systemd, AditdReadsTheCommandKeyFromASystemdCredential) {
+  const std::filesystem::path work = binary_dir() / fmt::format("credential-{}", getpid());
+  std::filesystem::remove_all(work);
+  std::filesystem::create_directories(work / "credentials");
+  const ProgramResult keygen =
+      run_program({(binary_dir() / "bin/adit").string(), "keygen", "--out", (work / "credentials/command-key").string()});
+  ASSERT_EQ(keygen.exit_status, 0) << keygen.err;
+  std::filesystem::permissions(work / "credentials/command-key", std::filesystem::perms::owner_read);  // as systemd hands it
+  const std::string config = (work / "aditd.yaml").string();
+  std::ofstream(config) << fmt::format(
+      "payload:\n  id: cred{}\n  state_dir: {}\nlidar:\n  model: Mid-360\n  source: udp\n  address: 127.0.0.1\n"
+      "  port: {}\nlcm:\n  url: udpm://239.255.76.67:{}?ttl=0\n  key_file: $CREDENTIALS_DIRECTORY/command-key\n"
+      "threads:\n  lock_memory: false\n",
+      getpid(), (work / "state").string(), 30000 + getpid() % 20000, 20000 + (getpid() + 13) % 30000);
+
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  const ProgramResult refused = run_program({(binary_dir() / "bin/aditd").string(), "--config", config});
+  EXPECT_EQ(refused.exit_status, 2);
+  EXPECT_NE(refused.err.find("CREDENTIALS_DIRECTORY is not set"), std::string::npos) << refused.err;
+
+  ::setenv("CREDENTIALS_DIRECTORY", (work / "credentials").c_str(), 1);
+  std::string log;
+  {
+    Daemon aditd({(binary_dir() / "bin/aditd").string(), "--config", config}, work / "aditd.log");
+    ::unsetenv("CREDENTIALS_DIRECTORY");
+    for (int i = 0; i < 100 && log.find("LCM: ") == std::string::npos; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::ifstream in(work / "aditd.log");
+      log.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    EXPECT_EQ(aditd.stop(), 0);
+  }
+  EXPECT_NE(log.find(fmt::format("signed commands only, 1 key(s) from {}", (work / "credentials/command-key").string())),
+            std::string::npos)
+      << log;
+  std::filesystem::remove_all(work);
 }
 
 }  // namespace

@@ -26,9 +26,11 @@ command_t make(std::int64_t id, std::string verb, std::string payload = "rig1") 
   return c;
 }
 
+constexpr std::int64_t kNow = 1'795'000'000'000'000;  // the payload's clock in these tests (µs)
+
 GateResult inspect(CommandGate& gate, const command_t& c) {
   const auto bytes = encoded(c);
-  return gate.inspect(bytes.data(), bytes.size());
+  return gate.inspect(bytes.data(), bytes.size(), kNow);
 }
 
 TEST(CommandGate, PassesKnownVerbsForThisPayload) {
@@ -49,23 +51,25 @@ TEST(CommandGate, RejectsUnknownVerbsAndOtherPayloadsWithAReason) {
   r = inspect(gate, make(2, "START", "rig2"));
   EXPECT_EQ(r.kind, GateResult::Kind::reject);
   EXPECT_NE(r.reason.find("'rig2'"), std::string::npos) << r.reason;
+  EXPECT_EQ(gate.counts().rejected, 2u);
+  EXPECT_EQ(gate.counts().other_payload, 1u);
+  // A payload without keys does not authenticate: a tag is not checked.
   auto with_auth = make(3, "START");
   with_auth.auth = {1, 2, 3};
   with_auth.auth_size = 3;
-  EXPECT_EQ(inspect(gate, with_auth).kind, GateResult::Kind::reject);
-  EXPECT_EQ(gate.counts().rejected, 3u);
+  EXPECT_EQ(inspect(gate, with_auth).kind, GateResult::Kind::execute);
 }
 
 TEST(CommandGate, MalformedBytesAreCountedNotAnswered) {
   CommandGate gate("rig1");
   const std::vector<std::uint8_t> junk{1, 2, 3, 4, 5};
-  EXPECT_EQ(gate.inspect(junk.data(), junk.size()).kind, GateResult::Kind::malformed);
+  EXPECT_EQ(gate.inspect(junk.data(), junk.size(), kNow).kind, GateResult::Kind::malformed);
   auto bytes = encoded(make(9, "START"));
   bytes.pop_back();  // truncated
-  EXPECT_EQ(gate.inspect(bytes.data(), bytes.size()).kind, GateResult::Kind::malformed);
+  EXPECT_EQ(gate.inspect(bytes.data(), bytes.size(), kNow).kind, GateResult::Kind::malformed);
   bytes = encoded(make(9, "START"));
   bytes.push_back(0);  // trailing garbage
-  EXPECT_EQ(gate.inspect(bytes.data(), bytes.size()).kind, GateResult::Kind::malformed);
+  EXPECT_EQ(gate.inspect(bytes.data(), bytes.size(), kNow).kind, GateResult::Kind::malformed);
   EXPECT_EQ(inspect(gate, make(0, "START")).kind, GateResult::Kind::malformed);  // id 0 is reserved
   EXPECT_EQ(gate.counts().malformed, 4u);
 }

@@ -21,6 +21,8 @@ inline void add_client_options(CLI::App& command, ClientOptions& options) {
   command.add_option("--timeout", options.timeout_s, "Seconds to wait for the payload to answer")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  command.add_option("--key", options.key_file,
+                     "Key file (adit keygen, mode 0600): sign every command for a payload that requires it");
 }
 
 }  // namespace adit::tools

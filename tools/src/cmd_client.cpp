@@ -1,10 +1,11 @@
-// adit status | watch | start | stop | sessions | ping: talk to a running aditd
+// adit status | watch | start | stop | export | sessions | ping: talk to a running aditd
 // over LCM (docs/PROTOCOL.md).
 
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -28,9 +29,10 @@ int no_answer(const ClientOptions& o) {
 }
 
 // Sends one command and prints its ack; exit 0 only when accepted.
-int run_command(const ClientOptions& options, const std::string& verb, bool print_detail) {
+int run_command(const ClientOptions& options, const std::string& verb, bool print_detail,
+                const std::vector<std::string>& args = {}) {
   LcmClient client(options);
-  const auto ack = client.command(verb);
+  const auto ack = client.command(verb, args);
   if (!ack) return no_answer(options);
   if (!ack->accepted) {
     fmt::print(stderr, "adit: {} rejected: {} (state {})\n", verb, ack->reason, state_text(ack->state));
@@ -154,6 +156,17 @@ void register_verb(CLI::App& app, int& status, const std::string& name, const st
   sub->callback([options, &status, verb, print_detail] { status = run_command(*options, verb, print_detail); });
 }
 
+void register_export(CLI::App& app, int& status) {
+  auto options = std::make_shared<ClientOptions>();
+  auto session = std::make_shared<std::string>();
+  CLI::App* sub = app.add_subcommand("export", "Print where a stored session's map files are on the payload");
+  add_client_options(*sub, *options);
+  sub->add_option("--session", *session, "Session id (default: the current or last session)");
+  sub->callback([options, session, &status] {
+    status = run_command(*options, "EXPORT", true, session->empty() ? std::vector<std::string>{} : std::vector{*session});
+  });
+}
+
 }  // namespace
 
 void register_client_commands(CLI::App& app, int& status) {
@@ -161,6 +174,7 @@ void register_client_commands(CLI::App& app, int& status) {
   register_watch(app, status);
   register_verb(app, status, "start", "START", "Start a mapping session", false);
   register_verb(app, status, "stop", "STOP", "Stop the mapping session (the payload flushes, then goes idle)", false);
+  register_export(app, status);
   register_verb(app, status, "sessions", "SESSIONS", "List the sessions stored on the payload", true);
   register_verb(app, status, "ping", "PING", "Check that the payload answers commands", false);
 }

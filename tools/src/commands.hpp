@@ -16,8 +16,10 @@ void register_eval_commands(CLI::App& app, int& status);
 void register_can_commands(CLI::App& app, int& status);
 void register_calibrate_wheels_commands(CLI::App& app, int& status);
 
-// status, watch, start, stop, sessions, ping (the tablet protocol)
+// status, watch, start, stop, export, sessions, ping (the tablet protocol)
 void register_client_commands(CLI::App& app, int& status);
+// keygen: a key file for signed commands
+void register_keygen_commands(CLI::App& app, int& status);
 
 void register_download_commands(CLI::App& app, int& status);
 void register_sim_commands(CLI::App& app, int& status);

@@ -12,6 +12,7 @@
 #include "adit/command_t.hpp"
 #include "adit/common/error.hpp"
 #include "adit/protocol/channels.hpp"
+#include "adit/protocol/command_auth.hpp"
 #include "adit/protocol/checked_decode.hpp"
 #include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
@@ -62,10 +63,12 @@ struct LcmClient::Impl {
   std::mt19937_64 rng{std::random_device{}()};
   Clock::time_point last_send{};
   double last_round_trip_ms = 0.0;
+  std::vector<protocol::CommandKey> keys;  // the first signs
 
   explicit Impl(ClientOptions o) : options(std::move(o)), lcm(options.lcm_url) {
     if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
       throw InputError("--payload", "payload", problem);
+    if (!options.key_file.empty()) keys = protocol::read_key_file(options.key_file);
     if (!lcm.good()) throw InputError("--lcm-url", "lcm-url", fmt::format("LCM cannot open '{}'", options.lcm_url));
   }
 
@@ -93,6 +96,8 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   c.args = args;
   c.n_args = static_cast<std::int32_t>(args.size());
   c.auth_size = 0;
+  c.utime = realtime_us();
+  if (!impl_->keys.empty()) protocol::sign_command(c, impl_->keys.front());
   std::optional<command_ack_t> answer;
   const Listen acks(impl_->lcm, impl_->channel(Channel::ack), [&](const lcm::ReceiveBuffer* rbuf) {
     auto ack = decode<command_ack_t>(rbuf);
@@ -105,7 +110,6 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   impl_->last_send = start - std::chrono::seconds(1);
   while (!answer && seconds_since(start) < impl_->options.timeout_s) {
     if (seconds_since(impl_->last_send) >= 0.25) {
-      c.utime = realtime_us();
       impl_->last_send = Clock::now();
       impl_->lcm.publish(impl_->channel(Channel::command), &c);
     }

@@ -22,16 +22,19 @@ struct ClientOptions {
   std::string lcm_url;
   std::string payload_id;
   double timeout_s = 5;
+  // A key file (`adit keygen`): every command is signed with its first key.
+  std::string key_file;
 };
 
 class LcmClient {
  public:
-  // Throws InputError for a bad payload id and runtime_error when LCM fails.
+  // Throws InputError for a bad payload id or key file and when LCM fails.
   explicit LcmClient(ClientOptions options);
   ~LcmClient();
 
-  // Sends `verb` and waits for its ack, resending with the same request id
-  // every 250 ms (the daemon answers replays without executing them again).
+  // Sends `verb` and waits for its ack, resending the same bytes (same request
+  // id, time and tag) every 250 ms: the daemon answers replays without
+  // executing them again. Signed when a key file was given.
   std::optional<command_ack_t> command(const std::string& verb, const std::vector<std::string>& args = {});
   // Milliseconds from the last send of the last command() to its ack (the
   // daemon's answer time plus the network's; a retry restarts the clock).

@@ -85,6 +85,13 @@ struct EndpointOptions {
   double chunk_bytes_per_s = 4.0e6;    // pacing of tile chunks (broadcast and answers)
   std::size_t queue_capacity = 256;    // per hand-off queue
   std::size_t command_window = 1024;   // request ids remembered for replays
+  // Command authentication (docs/PROTOCOL.md): a key file readable only by
+  // the service; empty = commands are not authenticated. The file is checked
+  // for changes every `key_check_period_s` and re-read (key rotation without
+  // a restart); a file that has become unreadable or bad keeps the old keys.
+  std::filesystem::path key_file;
+  double command_window_s = 30;        // a signed command's time may differ this much from ours
+  double key_check_period_s = 1.0;
   // Test hook: this fraction of tile chunks is silently not sent.
   double drop_chunk_fraction = 0;
   std::uint32_t drop_seed = 1;
@@ -105,6 +112,15 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> commands_rejected{0};
   std::atomic<std::uint64_t> commands_replayed{0};
   std::atomic<std::uint64_t> commands_malformed{0};
+  // Rejections by reason (each also in commands_rejected); see GateCounts.
+  std::atomic<std::uint64_t> commands_unsigned{0};
+  std::atomic<std::uint64_t> commands_bad_tag{0};
+  std::atomic<std::uint64_t> commands_stale{0};
+  std::atomic<std::uint64_t> commands_replay_rejected{0};
+  std::atomic<std::uint64_t> commands_other_payload{0};
+  std::atomic<bool> commands_authenticated{false};  // a key file is in force
+  std::atomic<std::uint64_t> key_reloads{0};        // key file re-read after a change
+  std::atomic<std::uint64_t> key_reload_errors{0};  // a changed key file refused (old keys kept)
   std::atomic<std::uint64_t> tile_requests{0};
   std::atomic<std::uint64_t> tile_requests_malformed{0};
   std::atomic<std::uint64_t> largest_message_bytes{0};

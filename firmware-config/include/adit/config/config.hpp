@@ -211,6 +211,11 @@ struct SessionSection {
 
 struct LcmSection {
   std::string url = "udpm://239.255.76.67:7667?ttl=1";
+  // Command authentication (docs/PROTOCOL.md): a key file readable only by
+  // aditd (`adit keygen`); "" = commands are not authenticated. A path that
+  // starts with $CREDENTIALS_DIRECTORY/ names a systemd credential.
+  std::string key_file;
+  double command_window_s = 30;  // a signed command's time may differ this much from the payload's clock
 };
 
 enum class SchedPolicy { other, fifo };

@@ -222,6 +222,8 @@ void describe(V& v, SessionSection& s) {
 template <typename V>
 void describe(V& v, LcmSection& s) {
   v.optional("url", s.url);
+  v.optional("key_file", s.key_file);
+  v.optional("command_window_s", s.command_window_s, Range<double>{1.0, 3600.0});
 }
 
 template <typename V>
