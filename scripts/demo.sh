@@ -105,6 +105,9 @@ echo "demo: map        $folder/download.ply (as the tablet downloaded it)"
 echo "demo: trajectory $folder/trajectory.tum (the odometry's, as published), $folder/map_trajectory.tum (the map's poses)"
 echo "demo: plots      $folder/trajectory-plan.svg, $folder/trajectory-ape.svg"
 echo "demo: truth      $session/truth_body.tum, scene $session/scene.ply, targets $session/targets.csv"
+if $console_up && ! $keep_console; then
+  echo "demo: console    http://127.0.0.1:$port/ while the demo ran (scripts/demo.sh --console keeps it running)"
+fi
 if $keep_console && $console_up; then
   echo
   echo "demo: aditd and the console keep running: http://127.0.0.1:$port/ (Ctrl-C stops them)"

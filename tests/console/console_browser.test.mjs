@@ -147,8 +147,17 @@ try {
   assert.ok(after.lastSeq > before.lastSeq, 'poses flow again after reconnecting');
 
   step('Stop by clicking');
-  // Stop by clicking: STOPPING, then IDLE.
+  // Stop by clicking. The restarted console holds no tokens (they live in its
+  // memory): the page is refused, shows the passphrase field again, and stops
+  // once unlocked anew.
   await page.click('#stop');
+  await waitFor('the refusal of a stale token', async () => (await text(page, '#command-message')).startsWith('Refused'));
+  assert.equal(await page.$eval('#lock', (e) => e.hidden), false, 'the passphrase field is back');
+  await page.type('#passphrase', passphrase);
+  await page.click('#unlock');
+  await waitFor('unlocking again', async () => (await text(page, '#command-message')) === 'Control unlocked');
+  await page.click('#stop');
+  await waitFor('STOP accepted', async () => (await text(page, '#command-message')).startsWith('STOP: '));
   await waitFor('IDLE after STOP', async () => (await text(page, '#state')) === 'IDLE', 30000);
   const lat = (await metrics(page)).latencies;
   figures.latency_ms_p50 = quantile(lat, 0.5);

@@ -202,7 +202,8 @@ async function command(verb) {
     } else if (!r.ok) {
       say(`${verb} refused: ${answer.error || answer.reason}`, false);
     } else {
-      say(`${verb}: ${answer.reason}${answer.session ? ` (session ${answer.session})` : ''}`, true);
+      const session = answer.session && !answer.reason.includes(answer.session) ? ` (session ${answer.session})` : '';
+      say(`${verb}: ${answer.reason}${session}`, true);
     }
   } catch (e) {
     say(`${verb} failed: the console did not answer (${e.message})`, false);

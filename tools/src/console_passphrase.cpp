@@ -4,6 +4,7 @@
 #include <openssl/evp.h>
 #include <openssl/rand.h>
 
+#include <charconv>
 #include <fstream>
 #include <stdexcept>
 #include <vector>
@@ -66,32 +67,25 @@ std::string format_hash(const PassphraseHash& h) {
   return fmt::format("pbkdf2-sha256${}${}${}", h.iterations, to_hex(h.salt), to_hex(h.hash));
 }
 
-PassphraseHash read_hash_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "passphrase-file", "cannot be read");
-  std::string line;
-  std::getline(in, line);
-  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-  const auto bad = [&](const std::string& why) {
-    return InputError(fmt::format("{}:1", file.string()), "passphrase-file", why);
-  };
+PassphraseHash parse_hash_line(std::string_view line, const std::string& where) {
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
+  const auto bad = [&](const std::string& why) { return InputError(where, "passphrase-file", why); };
   std::vector<std::string> parts;
   std::size_t start = 0;
-  for (std::size_t at = line.find('$'); at != std::string::npos; at = line.find('$', start)) {
-    parts.push_back(line.substr(start, at - start));
+  for (std::size_t at = line.find('$'); at != std::string_view::npos; at = line.find('$', start)) {
+    parts.emplace_back(line.substr(start, at - start));
     start = at + 1;
   }
-  parts.push_back(line.substr(start));
+  parts.emplace_back(line.substr(start));
   if (parts.size() != 4 || parts[0] != "pbkdf2-sha256")
     throw bad("not a 'pbkdf2-sha256$<iterations>$<salt hex>$<hash hex>' line (adit console --hash-passphrase)");
   PassphraseHash h;
-  try {
-    const unsigned long n = std::stoul(parts[1]);
-    if (n < 1000 || n > 100'000'000) throw bad(fmt::format("iterations {} outside 1000..100000000", n));
-    h.iterations = static_cast<std::uint32_t>(n);
-  } catch (const std::logic_error&) {
+  unsigned long n = 0;
+  const auto [end, error] = std::from_chars(parts[1].data(), parts[1].data() + parts[1].size(), n);
+  if (error != std::errc() || end != parts[1].data() + parts[1].size() || parts[1].empty())
     throw bad(fmt::format("iterations '{}' is not a number", parts[1]));
-  }
+  if (n < 1000 || n > 100'000'000) throw bad(fmt::format("iterations {} outside 1000..100000000", n));
+  h.iterations = static_cast<std::uint32_t>(n);
   const auto salt = from_hex(parts[2]);
   const auto hash = from_hex(parts[3]);
   if (!salt || salt->size() < 8) throw bad("the salt is not at least 8 bytes of hex");
@@ -99,6 +93,14 @@ PassphraseHash read_hash_file(const std::filesystem::path& file) {
   h.salt = *salt;
   h.hash = *hash;
   return h;
+}
+
+PassphraseHash read_hash_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string(), "passphrase-file", "cannot be read");
+  std::string line;
+  std::getline(in, line);
+  return parse_hash_line(line, fmt::format("{}:1", file.string()));
 }
 
 bool passphrase_matches(const PassphraseHash& h, const std::string& passphrase) {

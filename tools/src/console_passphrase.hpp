@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace adit::tools::console {
 
@@ -24,7 +25,9 @@ struct PassphraseHash {
 // A new hash of `passphrase` with a random salt.
 PassphraseHash hash_passphrase(const std::string& passphrase, std::uint32_t iterations = 200000);
 std::string format_hash(const PassphraseHash& h);
-// Throws InputError naming `file` (and line 1) when it is not one such line.
+// Throws InputError naming `where` when `line` is not one such line.
+PassphraseHash parse_hash_line(std::string_view line, const std::string& where);
+// Its first line; throws InputError naming `file` (and line 1) when it is not one.
 PassphraseHash read_hash_file(const std::filesystem::path& file);
 // Compares in constant time.
 bool passphrase_matches(const PassphraseHash& h, const std::string& passphrase);
