@@ -324,8 +324,8 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
     log::error("adit console: cannot listen on {}:{}", options.host, options.port);
     return 2;
   }
-  log::info("adit console: http://{}:{}/ (payload '{}', {}control {})", options.host, options.port,
-            options.client.payload_id, "", gate.locked() ? "locked by a passphrase" : "open to any browser");
+  log::info("adit console: http://{}:{}/ (payload '{}', control {})", options.host, options.port,
+            options.client.payload_id, gate.locked() ? "locked by a passphrase" : "open to any browser");
   std::atomic<bool> ended{false};  // the server returned by itself (a socket error)
   std::thread stopper([&] {
     while (!stop && !ended) std::this_thread::sleep_for(100ms);
