@@ -98,7 +98,8 @@ async function fetchTile(id) {
   }
   if (view.tileVersion(id) > v) return;  // an answer overtaken by a newer one
   view.setTile(id, v, every, from, nSegments, segments);
-  el('map-text').textContent = `${view.pointCount().toLocaleString()} of ${mapPoints.toLocaleString()} points drawn`;
+  const drawn = view.pointCount();  // the status's count can lag the tiles by a moment
+  el('map-text').textContent = `${drawn.toLocaleString()} of ${Math.max(mapPoints, drawn).toLocaleString()} points drawn`;
 }
 
 // ---- the event stream

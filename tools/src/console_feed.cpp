@@ -11,6 +11,7 @@ namespace {
 constexpr std::int64_t kLinkSilentMs = 2000;    // no status for this long: the payload stopped answering
 constexpr std::int64_t kQuietBeforeAskMs = 300;  // as `adit download`: ask once the stream is quiet
 constexpr std::int64_t kAskEveryMs = 500;
+constexpr std::int64_t kAskIndexEveryMs = 2000;  // until the full index comes (a payload down at first)
 constexpr std::int64_t kTilesEventEveryMs = 250;
 constexpr double kPathStepM = 0.05;       // the path keeps a point per 5 cm travelled
 constexpr std::size_t kPathMax = 20000;   // then every other one is dropped
@@ -99,7 +100,7 @@ void LiveFeed::switch_session(const std::string& session) {
   changes_.clear();
   pending_event_.clear();
   path_.clear();
-  index_asked_ = false;
+  index_received_ = false;
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
 }
 
@@ -151,6 +152,7 @@ void LiveFeed::on_index(const tile_index_t& m) {
   const std::lock_guard lock(mutex_);
   if (session_.empty()) switch_session(m.session_id);
   if (m.session_id != session_) return;
+  if (m.full) index_received_ = true;
   for (std::size_t i = 0; i < m.tile_ids.size(); ++i) tiles_.note_index(m.tile_ids[i], m.versions[i], m.n_chunks[i]);
 }
 
@@ -179,10 +181,10 @@ void LiveFeed::tick() {
       link_lost = true;
     }
     if (!session_.empty() && now - last_segment_ms_ > kQuietBeforeAskMs && now - last_request_ms_ > kAskEveryMs) {
-      auto missing = tiles_.missing(3000);
-      if (!index_asked_ || !missing.empty()) {
-        client_->request_tiles(session_, missing, !index_asked_);
-        index_asked_ = true;
+      const auto missing = tiles_.missing(3000);
+      const bool ask_index = !index_received_ && now - last_request_ms_ > kAskIndexEveryMs;
+      if (ask_index || !missing.empty()) {
+        client_->request_tiles(session_, missing, !index_received_);
         last_request_ms_ = now;
       }
     }

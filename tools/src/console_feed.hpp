@@ -83,7 +83,7 @@ class LiveFeed {
   std::int64_t last_segment_ms_ = 0;
   std::int64_t last_request_ms_ = 0;
   std::int64_t last_tiles_event_ms_ = 0;
-  bool index_asked_ = false;
+  bool index_received_ = false;  // the full index of session_ came (else asked for again every 2 s)
   bool link_up_ = false;
 
   std::unique_ptr<LcmClient> client_;  // used by the feed's thread only (request_tiles)
