@@ -8,7 +8,7 @@
 //     page resumes without reloading the map (only changed tiles are fetched);
 //   - a payload that stops answering (SIGSTOP) shows a message, which clears on SIGCONT;
 //   - a map download's point count equals `adit download`'s, and an interrupted
-//     download resumes with Range to the same bytes.
+//     download resumes with Range to the same bytes; the trajectory downloads too.
 // Usage: node console_browser.test.mjs <build dir> [--screenshots <dir>]
 // Exit 0 pass, 1 fail, 77 skip (chromium or puppeteer-core absent).
 import fs from 'node:fs';
@@ -200,6 +200,15 @@ try {
   const header = whole.subarray(0, 400).toString('latin1');
   assert.equal(Number(header.match(/element vertex (\d+)/)[1]), cliPoints, 'the PLY holds every point');
   assert.ok(fs.readFileSync(path.join(work, 'cli.ply')).equals(whole), 'byte for byte the file `adit download` wrote');
+  // The trajectory, read from the sessions folder (the console on the payload), with Range too.
+  const trajectoryUrl = await page.$eval(`${item} a[href$="trajectory.tum"]`, (a) => a.href);
+  const trajectory = await (await fetch(trajectoryUrl)).text();
+  const onDisk = fs.readFileSync(path.join(work, 'state/sessions', id, 'trajectory.tum'), 'utf8');
+  assert.equal(trajectory, onDisk);
+  assert.ok(onDisk.split('\n').length > 20, 'poses in the trajectory');
+  const tail = await fetch(trajectoryUrl, { headers: { Range: 'bytes=10-' } });
+  assert.equal(tail.status, 206);
+  assert.equal(await tail.text(), onDisk.slice(10));
 
   // Afterwards only the failures this test provokes: refused commands and a
   // wrong passphrase (403), the stream cut by the console's restart.
