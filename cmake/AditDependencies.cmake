@@ -22,6 +22,7 @@ pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
 # LCM (liblcm-dev) ships only a pkg-config file; its lcm-gen is found in protocol/.
 pkg_check_modules(LCM REQUIRED IMPORTED_TARGET lcm)
 pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)  # command authentication (HMAC-SHA-256)
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)  # adit console (Debian libcpp-httplib-dev 0.11, a compiled library)
 if(ADIT_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

@@ -25,11 +25,31 @@ packages=(
   libsodium-dev          # command authentication: HMAC-SHA-256 tags (docs/decisions/022-command-authentication.md)
   liblcm-dev liblcm-bin libglib2.0-dev  # LCM messages and lcm-gen (lcm.pc needs glib)
   liblcm-java openjdk-17-jdk-headless  # the Java bindings and client for tablet apps (protocol/java)
+  libcpp-httplib-dev     # adit console's HTTP server (docs/CONSOLE.md)
+  libjs-three            # three.js for the console's web app, served from /usr/share/javascript/three
   libembree-dev          # ray casting in the simulator
   libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  chromium               # the console's browser tests: headless, driven over the DevTools protocol
 )
+# node and npm run the browser tests (puppeteer-core, tests/console); a node
+# already installed (e.g. from NodeSource) is used as it is.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
+
+# puppeteer-core for the browser tests, exactly as tests/console/package-lock.json pins it
+# (npm ci; never run by the build). Needs the npm registry only when it is not installed yet.
+install_browser_test_modules() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tests/console"
+  if [ -d "$dir/node_modules/puppeteer-core" ] && [ "$dir/node_modules/.package-lock.json" -nt "$dir/package-lock.json" ]; then
+    return 0
+  fi
+  echo "install-deps: npm ci in tests/console (puppeteer-core for the browser tests)"
+  npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+}
 
 if ! command -v apt-get >/dev/null 2>&1 || ! command -v dpkg-query >/dev/null 2>&1; then
   echo "install-deps: apt-get/dpkg not found: this script is for Debian 12 (bookworm)" >&2
@@ -44,6 +64,7 @@ for package in "${packages[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages are installed"
+  install_browser_test_modules
   exit 0
 fi
 
@@ -60,3 +81,4 @@ fi
 echo "install-deps: installing ${missing[*]}"
 "${sudo[@]}" apt-get update
 "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+install_browser_test_modules

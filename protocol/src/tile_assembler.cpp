@@ -97,6 +97,7 @@ SegmentOutcome TileAssembler::finish_if_complete(Tile& tile) {
   tile.segments.resize(tile.parts.size());  // the held ones below `first` stay
   for (std::size_t i = first; i < tile.parts.size(); ++i) tile.segments[i] = std::move(tile.parts[i]);
   tile.done_version = tile.pending_version;
+  tile.replaced_from = tile.pending_first;
   tile.pending_version = 0;
   tile.pending_first = -1;
   tile.parts.clear();
@@ -146,6 +147,13 @@ std::size_t TileAssembler::segments_have() const {
     }
   }
   return n;
+}
+
+std::optional<TileAssembler::HeldTile> TileAssembler::held(std::int64_t id) const {
+  const auto it = tiles_.find(id);
+  if (it == tiles_.end() || it->second.done_version == 0) return std::nullopt;
+  const Tile& tile = it->second;
+  return HeldTile{tile.done_version, tile.replaced_from, tile.segments};
 }
 
 std::vector<MapPoint> TileAssembler::points() const {

@@ -120,6 +120,14 @@ TEST(TileAssembler, AHeldVersionIsBroughtUpToDateByTheNewSegmentsOnly) {
   EXPECT_EQ(a.add_segment(tile.segment(3, held)), SegmentOutcome::completed);
   EXPECT_TRUE(a.complete());
   EXPECT_EQ(a.points().size(), 4500u);
+  // What a follower passes on: the tile at its new version, segments 2.. replaced.
+  const auto now = a.held(tile.id());
+  ASSERT_TRUE(now.has_value());
+  EXPECT_EQ(now->version, tile.version);
+  EXPECT_EQ(now->replaced_from, 2);
+  ASSERT_EQ(now->segments.size(), 5u);
+  EXPECT_EQ(now->segments[4].size(), 4500u - 4 * 1024u);
+  EXPECT_FALSE(a.held(tile_id({9, 9, 9})).has_value());
 
   // A delta from a base newer than the version held cannot complete it: the
   // client asks for what changed after its own version.

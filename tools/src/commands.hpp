@@ -22,6 +22,8 @@ void register_client_commands(CLI::App& app, int& status);
 void register_keygen_commands(CLI::App& app, int& status);
 
 void register_download_commands(CLI::App& app, int& status);
+// console: the web app for tablets and phones (cmd_console.cpp)
+void register_console_commands(CLI::App& app, int& status);
 void register_sim_commands(CLI::App& app, int& status);
 void register_replay_commands(CLI::App& app, int& status);
 

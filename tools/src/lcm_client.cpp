@@ -2,6 +2,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -130,13 +131,44 @@ std::optional<status_t> LcmClient::wait_status() {
 
 void LcmClient::watch(const std::function<void(const pose_t&)>& on_pose,
                       const std::function<void(const status_t&)>& on_status, const std::function<bool()>& until) {
-  const Listen poses(impl_->lcm, impl_->channel(Channel::pose), [&](const lcm::ReceiveBuffer* rbuf) {
-    if (auto p = decode<pose_t>(rbuf)) on_pose(*p);
-  });
-  const Listen statuses(impl_->lcm, impl_->channel(Channel::status), [&](const lcm::ReceiveBuffer* rbuf) {
-    if (auto s = decode<status_t>(rbuf)) on_status(*s);
-  });
+  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}}, until);
+}
+
+void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
+  // Subscribes `channel` for as long as the follow lasts, when `handler` is set.
+  const auto listen = [this]<typename Message>(Channel channel, const std::function<void(const Message&)>& handler) {
+    std::unique_ptr<Listen> l;  // on the heap: LCM holds its address
+    if (handler)
+      l = std::make_unique<Listen>(impl_->lcm, impl_->channel(channel), [&handler](const lcm::ReceiveBuffer* rbuf) {
+        if (auto m = decode<Message>(rbuf)) handler(*m);
+      });
+    return l;
+  };
+  const auto poses = listen(Channel::pose, handlers.pose);
+  const auto statuses = listen(Channel::status, handlers.status);
+  const auto index = listen(Channel::tile_index, handlers.tile_index);
+  const auto segments = listen(Channel::tile, handlers.tile_segment);
   while (!until()) impl_->handle_for(0.05);
+}
+
+std::int64_t LcmClient::request_tiles(const std::string& session,
+                                      const std::vector<protocol::MissingSegment>& missing, bool want_index) {
+  tile_request_t request;
+  request.schema = 2;  // versions[] are the versions held
+  request.request_id = impl_->new_request_id();
+  request.utime = realtime_us();
+  request.payload_id = impl_->options.payload_id;
+  request.session_id = session;
+  request.want_index = want_index;
+  const std::size_t n = std::min(missing.size(), kMaxRequestEntries);
+  for (std::size_t i = 0; i < n; ++i) {
+    request.tile_ids.push_back(missing[i].tile_id);
+    request.versions.push_back(missing[i].held_version);
+    request.chunks.push_back(missing[i].segment);
+  }
+  request.n_entries = static_cast<std::int32_t>(n);
+  impl_->lcm.publish(impl_->channel(Channel::tile_request), &request);
+  return request.request_id;
 }
 
 LcmClient::DownloadResult LcmClient::download(const std::string& session, protocol::TileAssembler& tiles,
@@ -177,10 +209,6 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
   });
   const auto index_complete = [&] { return n_parts > 0 && static_cast<std::int32_t>(parts.size()) >= n_parts; };
 
-  tile_request_t request;
-  request.schema = 2;  // versions[] are the versions held
-  request.payload_id = impl_->options.payload_id;
-  request.session_id = session;
   auto last_send = Clock::now() - std::chrono::seconds(10);
   while (true) {
     if (!index_error.empty()) {
@@ -203,22 +231,7 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
     // missing then was lost (or never sent).
     const bool quiet = seconds_since(last_chunk) > 0.3 && seconds_since(last_send) > 0.5;
     if (quiet) {
-      const auto missing = tiles.missing(kMaxRequestEntries);
-      request.request_id = impl_->new_request_id();
-      my_requests.insert(request.request_id);
-      request.utime = realtime_us();
-      request.session_id = locked;
-      request.want_index = !index_complete();
-      request.tile_ids.clear();
-      request.versions.clear();
-      request.chunks.clear();
-      for (const auto& m : missing) {
-        request.tile_ids.push_back(m.tile_id);
-        request.versions.push_back(m.held_version);
-        request.chunks.push_back(m.segment);
-      }
-      request.n_entries = static_cast<std::int32_t>(missing.size());
-      impl_->lcm.publish(impl_->channel(Channel::tile_request), &request);
+      my_requests.insert(request_tiles(locked, tiles.missing(kMaxRequestEntries), !index_complete()));
       ++result.requests;
       last_send = Clock::now();
     }

@@ -15,6 +15,8 @@
 #include "adit/pose_t.hpp"
 #include "adit/protocol/tile_assembler.hpp"
 #include "adit/status_t.hpp"
+#include "adit/tile_index_t.hpp"
+#include "adit/tile_segment_t.hpp"
 
 namespace adit::tools {
 
@@ -44,6 +46,21 @@ class LcmClient {
   // Calls `on_pose`/`on_status` for every message until `until` returns true.
   void watch(const std::function<void(const pose_t&)>& on_pose, const std::function<void(const status_t&)>& on_status,
              const std::function<bool()>& until);
+
+  // Everything a live view follows; an empty handler is not subscribed.
+  struct FollowHandlers {
+    std::function<void(const pose_t&)> pose;
+    std::function<void(const status_t&)> status;
+    std::function<void(const tile_index_t&)> tile_index;
+    std::function<void(const tile_segment_t&)> tile_segment;
+  };
+  // Calls the handlers for every message until `until` returns true (checked
+  // at least every 50 ms).
+  void follow(const FollowHandlers& handlers, const std::function<bool()>& until);
+  // Publishes one tile_request_t for `missing` of `session` (at most 3000
+  // entries are sent), with the full index when `want_index`; returns its id.
+  std::int64_t request_tiles(const std::string& session, const std::vector<protocol::MissingSegment>& missing,
+                             bool want_index);
 
   struct DownloadResult {
     bool ok = false;

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     adit::tools::register_client_commands(app, status);
     adit::tools::register_keygen_commands(app, status);
     adit::tools::register_download_commands(app, status);
+    adit::tools::register_console_commands(app, status);
     adit::tools::register_sim_commands(app, status);
     adit::tools::register_replay_commands(app, status);
     try {

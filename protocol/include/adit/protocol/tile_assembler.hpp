@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,6 +54,17 @@ class TileAssembler {
   // Every complete tile's points, in tile id order.
   std::vector<MapPoint> points() const;
   std::size_t tile_count() const { return tiles_.size(); }
+
+  // One tile held complete: its version, its segments, and the first segment
+  // its last completion replaced (the ones below it were held before), so a
+  // follower of the stream can pass on only what changed (adit console).
+  struct HeldTile {
+    std::int32_t version = 0;
+    std::int32_t replaced_from = 0;
+    std::span<const std::vector<MapPoint>> segments;
+  };
+  // The tile `id` as held complete, or nullopt when none of it is.
+  std::optional<HeldTile> held(std::int64_t id) const;
   const AssemblerCounts& counts() const { return counts_; }
   const std::string& last_error() const { return last_error_; }
 
@@ -61,6 +74,7 @@ class TileAssembler {
     std::int32_t wanted_segments = 0;
     std::int32_t done_version = 0;                // 0: nothing held yet
     std::vector<std::vector<MapPoint>> segments;  // complete at done_version
+    std::int32_t replaced_from = 0;               // the first segment the last completion replaced
     std::int32_t pending_version = 0;             // the version being collected, 0: none
     std::int32_t pending_first = -1;              // its first segment we lack, -1: not known yet
     std::vector<std::vector<MapPoint>> parts;     // its segments received

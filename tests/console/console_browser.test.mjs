@@ -1,0 +1,233 @@
+// adit console in a real browser (Debian's chromium, headless, software
+// WebGL), against aditd replaying a simulated mine drive on loopback LCM:
+//   - the page loads with no console errors; poses advance; the health shows MAPPING;
+//   - a START without the passphrase is refused with a visible message and changes nothing;
+//   - unlocked, START and STOP by clicking work; two browsers watch at once;
+//   - the map renders (non-background pixels of the map canvas);
+//   - the console restarting (a browser losing its link) shows a message, and the
+//     page resumes without reloading the map (only changed tiles are fetched);
+//   - a payload that stops answering (SIGSTOP) shows a message, which clears on SIGCONT;
+//   - a map download's point count equals `adit download`'s, and an interrupted
+//     download resumes with Range to the same bytes; the trajectory downloads too.
+// Usage: node console_browser.test.mjs <build dir> [--screenshots <dir>]
+// Exit 0 pass, 1 fail, 77 skip (chromium or puppeteer-core absent).
+import fs from 'node:fs';
+import path from 'node:path';
+import assert from 'node:assert/strict';
+import { setTimeout as sleep } from 'node:timers/promises';
+import { adit, launchBrowser, mapCoverage, processUsage, quantile, requireBrowser, simulatedSession, startConsole,
+         startPayload, waitFor } from './harness.mjs';
+
+const build = path.resolve(process.argv[2] || 'build');
+const shotsAt = process.argv.indexOf('--screenshots');
+const screenshots = shotsAt > 0 ? path.resolve(process.argv[shotsAt + 1]) : null;
+const puppeteer = await requireBrowser();
+
+const work = path.join(build, `console-test-${process.pid}`);
+fs.rmSync(work, { recursive: true, force: true });
+fs.mkdirSync(work, { recursive: true });
+const session = simulatedSession(build, 60);
+const port = 40000 + (process.pid % 20000);
+const base = `http://127.0.0.1:${port}`;
+const passphrase = 'correct horse battery';
+fs.writeFileSync(path.join(work, 'passphrase'), adit(build, ['console', '--hash-passphrase'], { input: `${passphrase}\n` }));
+
+const payload = await startPayload(build, work, session);
+let consoleProcess = await startConsole(build, work, payload, port, ['--passphrase-file', path.join(work, 'passphrase')]);
+const browser = await launchBrowser(puppeteer);
+const figures = {};
+let failed = false;
+
+function watchErrors(page, errors) {
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  page.on('pageerror', (e) => errors.push(`page: ${e.message}`));
+}
+const t0 = Date.now();
+const step = (what) => console.log(`[${((Date.now() - t0) / 1000).toFixed(1)} s] ${what}`);
+const text = (page, selector) => page.$eval(selector, (e) => (e.hidden ? '' : e.textContent));
+const metrics = (page) => page.evaluate(() => ({ ...window.adit.metrics, frameTimes: undefined }));
+
+try {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1280, height: 800 });
+  const errors = [];
+  watchErrors(page, errors);
+  await page.goto(base, { waitUntil: 'load' });
+  await waitFor('the snapshot', async () => (await metrics(page)).hellos > 0);
+  await waitFor('the IDLE state', async () => (await text(page, '#state')) === 'IDLE');
+
+  assert.deepEqual(errors, [], 'no console errors while the page loads');
+  step('Without the passphrase');
+  // Without the passphrase: refused, visibly, and nothing changes.
+  assert.equal(await page.$eval('#lock', (e) => e.hidden), false, 'the passphrase form shows when control is locked');
+  await page.evaluate(() => { document.getElementById('start').disabled = false; });
+  await page.click('#start');
+  await waitFor('the refusal', async () => (await text(page, '#command-message')).startsWith('Refused'));
+  assert.match(await text(page, '#command-message'), /passphrase/);
+  await sleep(1500);
+  assert.equal(await text(page, '#state'), 'IDLE', 'a refused START changed nothing');
+  // A wrong passphrase is refused too.
+  await page.type('#passphrase', 'wrong');
+  await page.click('#unlock');
+  await waitFor('the wrong passphrase message', async () => (await text(page, '#command-message')) === 'wrong passphrase');
+
+  step('Unlock, name the scan');
+  // Unlock, name the scan, start by clicking.
+  await page.$eval('#passphrase', (e) => { e.value = ''; });
+  await page.type('#passphrase', passphrase);
+  await page.click('#unlock');
+  await waitFor('unlocking', async () => (await text(page, '#command-message')) === 'Control unlocked');
+  await page.type('#scan-name', 'drift east');
+  await page.click('#start');
+  await waitFor('MAPPING', async () => (await text(page, '#state')) === 'MAPPING');
+  const started = await text(page, '#command-message');
+  const id = (started.match(/session ([0-9TZ-]+)/) || [])[1];
+  assert.ok(id, `START names its session: ${started}`);
+
+  step('Poses advance');
+  // Poses advance; a second browser watches at the same time.
+  // A second browser (its own process: a background tab of the same one would not draw).
+  const browser2 = await launchBrowser(puppeteer);
+  const other = await browser2.newPage();
+  await other.setViewport({ width: 390, height: 844, isMobile: true, hasTouch: true });
+  const otherErrors = [];
+  watchErrors(other, otherErrors);
+  await other.goto(base, { waitUntil: 'load' });
+  assert.deepEqual(otherErrors, [], 'no console errors while the phone page loads');
+  const m0 = await metrics(page);
+  await sleep(3000);
+  const m1 = await metrics(page);
+  assert.ok(m1.lastSeq > m0.lastSeq + 15, `poses advance at scan rate: seq ${m0.lastSeq} -> ${m1.lastSeq} in 3 s`);
+  const o1 = await metrics(other);
+  assert.ok(o1.poses > 10, `the second browser gets poses too (${o1.poses})`);
+
+  step('The map renders.');
+  // The map renders.
+  await waitFor('map tiles', async () => (await metrics(page)).tileFetches > 3, 20000);
+  await page.click('#camera-modes button[data-mode="top"]');
+  await sleep(1500);
+  figures.coverage_top = await mapCoverage(page);
+  assert.ok(figures.coverage_top > 0.02, `the map covers ${(100 * figures.coverage_top).toFixed(1)} % of the view`);
+  await page.click('#camera-modes button[data-mode="follow"]');
+  if (screenshots) {
+    await waitFor('the phone page to draw the map', async () => (await metrics(other)).tileFetches > 3, 20000);
+    await other.screenshot({ path: path.join(screenshots, 'console-phone.png') });
+  }
+  assert.deepEqual(otherErrors, [], 'no console errors in the phone page');
+  await browser2.close();
+
+  step("The console's CPU");
+  // The console's CPU and memory while one browser watches.
+  const u0 = processUsage(consoleProcess.pid);
+  const t0 = Date.now();
+  await sleep(5000);
+  const u1 = processUsage(consoleProcess.pid);
+  figures.console_cpu_percent = (100 * (u1.cpu_s - u0.cpu_s)) / ((Date.now() - t0) / 1000);
+  figures.console_rss_mb = u1.rss_kb / 1024;
+  if (screenshots) {
+    await page.screenshot({ path: path.join(screenshots, 'console-tablet.png') });
+  }
+
+  step('The link breaks');
+  // The link breaks (the console restarts): a visible message, then the
+  // stream resumes without loading the map again.
+  const before = await metrics(page);
+  const tilesBefore = await page.evaluate(() => window.adit.view.tiles.size);
+  await consoleProcess.stop();
+  await waitFor('the lost-link message', async () => (await text(page, '#banner')).includes('Connection to the console lost'));
+  consoleProcess = await startConsole(build, work, payload, port, ['--passphrase-file', path.join(work, 'passphrase')]);
+  await waitFor('the stream resuming', async () => (await metrics(page)).hellos > before.hellos, 15000);
+  await waitFor('the message clearing', async () => (await text(page, '#banner')) === '');
+  const tilesAfter = await page.evaluate(() => window.adit.view.tiles.size);
+  assert.ok(tilesAfter >= tilesBefore, `the map stays after reconnecting (${tilesBefore} -> ${tilesAfter} tiles)`);
+  await sleep(2000);
+  const after = await metrics(page);
+  figures.reconnect_tile_fetches = after.tileFetches - before.tileFetches;
+  figures.tiles_held = tilesAfter;
+  assert.ok(after.lastSeq > before.lastSeq, 'poses flow again after reconnecting');
+
+  step('Stop by clicking');
+  // Stop by clicking. The restarted console holds no tokens (they live in its
+  // memory): the page is refused, shows the passphrase field again, and stops
+  // once unlocked anew.
+  await page.click('#stop');
+  await waitFor('the refusal of a stale token', async () => (await text(page, '#command-message')).startsWith('Refused'));
+  assert.equal(await page.$eval('#lock', (e) => e.hidden), false, 'the passphrase field is back');
+  await page.type('#passphrase', passphrase);
+  await page.click('#unlock');
+  await waitFor('unlocking again', async () => (await text(page, '#command-message')) === 'Control unlocked');
+  await page.click('#stop');
+  await waitFor('STOP accepted', async () => (await text(page, '#command-message')).startsWith('STOP: '));
+  await waitFor('IDLE after STOP', async () => (await text(page, '#state')) === 'IDLE', 30000);
+  const lat = (await metrics(page)).latencies;
+  figures.latency_ms_p50 = quantile(lat, 0.5);
+  figures.latency_ms_p95 = quantile(lat, 0.95);
+  figures.latency_samples = lat.length;
+
+  step('The payload stops answering');
+  // The payload stops answering: a visible message; it clears when it answers again.
+  payload.aditd.signal('SIGSTOP');
+  await waitFor('the silent-payload message', async () => (await text(page, '#banner')).includes('is not answering'), 8000);
+  payload.aditd.signal('SIGCONT');
+  await waitFor('the payload answering again', async () => (await text(page, '#banner')) === '', 8000);
+
+  step('A map download');
+  // A map download: prepared by the console over LCM, saved by the browser.
+  await page.click('#refresh-sessions');
+  const item = `#session-list li[data-session="${id}"]`;
+  await waitFor('the session in the list', async () => (await page.$(item)) !== null);
+  assert.match(await text(page, item), /drift east/, 'the scan keeps its name');
+  await page.click(`${item} button[data-format="ply"]`);
+  await waitFor('the map prepared', async () => (await page.$(`${item} a[data-format="ply"]`)) !== null, 30000);
+  const consolePoints = Number(await page.$eval(`${item} a[data-format="ply"]`, (a) => a.dataset.points));
+  const url = await page.$eval(`${item} a[data-format="ply"]`, (a) => a.href);
+  const cli = adit(build, ['download', ...payload.client, '--session', id, '--format', 'ply', '--quiet', '--out',
+                           path.join(work, 'cli.ply')]);
+  const cliPoints = Number(cli.match(/^(\d+) points/)[1]);
+  figures.download_points = consolePoints;
+  assert.equal(consolePoints, cliPoints, '`adit console` and `adit download` give the same map');
+  step('Interrupted half way');
+  // Interrupted half way, resumed with Range: the same bytes as in one go.
+  const whole = Buffer.from(await (await fetch(url)).arrayBuffer());
+  const half = Math.floor(whole.length / 2);
+  const first = await fetch(url, { headers: { Range: `bytes=0-${half - 1}` } });
+  const rest = await fetch(url, { headers: { Range: `bytes=${half}-` } });
+  assert.equal(first.status, 206);
+  assert.equal(rest.status, 206);
+  assert.equal(rest.headers.get('content-range'), `bytes ${half}-${whole.length - 1}/${whole.length}`);
+  const joined = Buffer.concat([Buffer.from(await first.arrayBuffer()), Buffer.from(await rest.arrayBuffer())]);
+  assert.ok(joined.equals(whole), 'the resumed download has the same bytes');
+  const header = whole.subarray(0, 400).toString('latin1');
+  assert.equal(Number(header.match(/element vertex (\d+)/)[1]), cliPoints, 'the PLY holds every point');
+  assert.ok(fs.readFileSync(path.join(work, 'cli.ply')).equals(whole), 'byte for byte the file `adit download` wrote');
+  // The trajectory, read from the sessions folder (the console on the payload), with Range too.
+  const trajectoryUrl = await page.$eval(`${item} a[href$="trajectory.tum"]`, (a) => a.href);
+  const trajectory = await (await fetch(trajectoryUrl)).text();
+  const onDisk = fs.readFileSync(path.join(work, 'state/sessions', id, 'trajectory.tum'), 'utf8');
+  assert.equal(trajectory, onDisk);
+  assert.ok(onDisk.split('\n').length > 20, 'poses in the trajectory');
+  const tail = await fetch(trajectoryUrl, { headers: { Range: 'bytes=10-' } });
+  assert.equal(tail.status, 206);
+  assert.equal(await tail.text(), onDisk.slice(10));
+
+  // Afterwards only the failures this test provokes: refused commands and a
+  // wrong passphrase (403), the stream cut by the console's restart.
+  const expected = /status of 403 \(Forbidden\)|ERR_INCOMPLETE_CHUNKED_ENCODING|ERR_CONNECTION_REFUSED|ERR_EMPTY_RESPONSE/;
+  assert.deepEqual(errors.filter((e) => !expected.test(e)), [], 'no other console errors in the tablet page');
+  // The live view's target (pose on LCM -> drawn <= 200 ms at p95) is a speed
+  // figure: printed here and reported in docs/CONSOLE.md, not asserted on a
+  // shared CI machine. What is asserted is that poses stream at all: a stalled
+  // or buffered stream (seconds) fails.
+  assert.ok(figures.latency_ms_p95 <= 1000, `latency p95 ${figures.latency_ms_p95} ms: the pose stream stalls`);
+} catch (e) {
+  failed = true;
+  console.error(`FAIL: ${e.stack || e}`);
+} finally {
+  console.log(`figures: ${JSON.stringify(figures)}`);
+  await browser.close();
+  await consoleProcess.stop();
+  await payload.aditd.stop();
+  if (!failed) fs.rmSync(work, { recursive: true, force: true });
+  else console.error(`logs kept in ${work}`);
+}
+process.exit(failed ? 1 : 0);

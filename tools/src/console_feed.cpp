@@ -1,0 +1,277 @@
+#include "console_feed.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "adit/common/clock.hpp"
+
+namespace adit::tools::console {
+namespace {
+
+constexpr std::int64_t kLinkSilentMs = 2000;    // no status for this long: the payload stopped answering
+constexpr std::int64_t kQuietBeforeAskMs = 300;  // as `adit download`: ask once the stream is quiet
+constexpr std::int64_t kAskEveryMs = 500;
+constexpr std::int64_t kAskIndexEveryMs = 2000;  // until the full index comes (a payload down at first)
+constexpr std::int64_t kTilesEventEveryMs = 250;
+constexpr double kPathStepM = 0.05;       // the path keeps a point per 5 cm travelled
+constexpr std::size_t kPathMax = 20000;   // then every other one is dropped
+constexpr std::size_t kChangesKept = 32;  // completions remembered per tile
+
+std::int64_t now_ms() { return realtime_us() / 1000; }
+
+const char* state_name(int state) {
+  switch (state) {
+    case status_t::STATE_IDLE: return "IDLE";
+    case status_t::STATE_MAPPING: return "MAPPING";
+    case status_t::STATE_STOPPING: return "STOPPING";
+    default: return "UNKNOWN";
+  }
+}
+
+void append_f32(std::string& out, float v) {
+  char b[sizeof v];
+  std::memcpy(b, &v, sizeof v);
+  out.append(b, sizeof v);
+}
+void append_u32(std::string& out, std::uint32_t v) {
+  char b[sizeof v];
+  std::memcpy(b, &v, sizeof v);
+  out.append(b, sizeof v);
+}
+
+}  // namespace
+
+nlohmann::json status_json(const status_t& s) {
+  nlohmann::json sensors = nlohmann::json::array();
+  for (const auto& h : s.sensors)
+    sensors.push_back({{"name", h.name},
+                       {"rate_hz", h.packet_rate_hz},
+                       {"dropped", h.packets_dropped},
+                       {"last_seen_us", h.last_seen_utime},
+                       {"offset_s", h.time_offset_s}});
+  nlohmann::json threads = nlohmann::json::array();
+  for (const auto& t : s.threads)
+    threads.push_back(
+        {{"name", t.name}, {"load", t.load}, {"depth", t.queue_depth}, {"capacity", t.queue_capacity}});
+  return {{"utime", s.utime},      {"payload", s.payload_id},   {"state", state_name(s.state)},
+          {"session", s.session_id}, {"sensors", sensors},      {"threads", threads},
+          {"disk_free", s.disk_free_bytes}, {"map_points", s.map_points}, {"map_tiles", s.map_tiles},
+          {"fault", s.fault}};
+}
+
+nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms) {
+  return {{"seq", p.seq},
+          {"utime", p.utime},
+          {"rx", received_ms},
+          {"session", p.session_id},
+          {"p", {p.position[0], p.position[1], p.position[2]}},
+          {"q", {p.orientation[0], p.orientation[1], p.orientation[2], p.orientation[3]}},
+          {"valid", (p.flags & pose_t::FLAG_VALID) != 0},
+          {"degenerate", (p.flags & pose_t::FLAG_DEGENERATE) != 0},
+          {"held", (p.flags & pose_t::FLAG_HELD) != 0}};
+}
+
+LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)
+    : options_(std::move(options)), hub_(hub), client_(std::make_unique<LcmClient>(options_)) {
+  last_status_ms_ = now_ms();  // silent since the console started, until a status arrives
+  thread_ = std::thread([this] { run(); });
+}
+
+LiveFeed::~LiveFeed() {
+  stop_ = true;
+  thread_.join();
+}
+
+void LiveFeed::run() {
+  client_->follow({.pose = [this](const pose_t& p) { on_pose(p); },
+                   .status = [this](const status_t& s) { on_status(s); },
+                   .tile_index = [this](const tile_index_t& m) { on_index(m); },
+                   .tile_segment = [this](const tile_segment_t& m) { on_segment(m); }},
+                  [this] {
+                    tick();
+                    return stop_.load();
+                  });
+}
+
+void LiveFeed::switch_session(const std::string& session) {
+  if (session == session_) return;
+  session_ = session;
+  tiles_ = {};
+  changes_.clear();
+  pending_event_.clear();
+  path_.clear();
+  index_received_ = false;
+  hub_.publish("session", nlohmann::json{{"session", session}}.dump());
+}
+
+void LiveFeed::on_pose(const pose_t& p) {
+  const std::int64_t rx = now_ms();
+  nlohmann::json j = pose_json(p, rx);
+  {
+    const std::lock_guard lock(mutex_);
+    if (!p.session_id.empty()) switch_session(p.session_id);
+    if (p.flags & pose_t::FLAG_VALID) {
+      const std::array<float, 3> at{static_cast<float>(p.position[0]), static_cast<float>(p.position[1]),
+                                    static_cast<float>(p.position[2])};
+      const auto far = [&](const std::array<float, 3>& last) {
+        const float dx = at[0] - last[0], dy = at[1] - last[1], dz = at[2] - last[2];
+        return dx * dx + dy * dy + dz * dz >= kPathStepM * kPathStepM;
+      };
+      if (path_.empty() || far(path_.back())) {
+        path_.push_back(at);
+        if (path_.size() > kPathMax) {
+          std::vector<std::array<float, 3>> halved;
+          for (std::size_t i = 0; i < path_.size(); i += 2) halved.push_back(path_[i]);
+          path_ = std::move(halved);
+        }
+      }
+    }
+    pose_ = j;
+  }
+  hub_.publish("pose", j.dump());
+}
+
+void LiveFeed::on_status(const status_t& s) {
+  if (s.payload_id != options_.payload_id) return;
+  nlohmann::json j = status_json(s);
+  bool came_back = false;
+  {
+    const std::lock_guard lock(mutex_);
+    if (!s.session_id.empty()) switch_session(s.session_id);
+    status_ = j;
+    last_status_ms_ = now_ms();
+    came_back = !link_up_;
+    link_up_ = true;
+  }
+  if (came_back) hub_.publish("link", nlohmann::json{{"up", true}}.dump());
+  hub_.publish("status", j.dump());
+}
+
+void LiveFeed::on_index(const tile_index_t& m) {
+  if (m.payload_id != options_.payload_id || !m.error.empty()) return;
+  const std::lock_guard lock(mutex_);
+  if (session_.empty()) switch_session(m.session_id);
+  if (m.session_id != session_) return;
+  if (m.full) index_received_ = true;
+  for (std::size_t i = 0; i < m.tile_ids.size(); ++i) tiles_.note_index(m.tile_ids[i], m.versions[i], m.n_chunks[i]);
+}
+
+void LiveFeed::on_segment(const tile_segment_t& m) {
+  const std::lock_guard lock(mutex_);
+  if (session_.empty() || m.session_id != session_) return;
+  last_segment_ms_ = now_ms();
+  const std::int32_t before = tiles_.held(m.tile_id) ? tiles_.held(m.tile_id)->version : 0;
+  if (tiles_.add_segment(m) != protocol::SegmentOutcome::completed) return;
+  const auto held = tiles_.held(m.tile_id);
+  if (!held) return;
+  auto& list = changes_[m.tile_id];
+  list.push_back({before, held->version, before == 0 ? 0 : held->replaced_from});
+  if (list.size() > kChangesKept) list.erase(list.begin());
+  pending_event_[m.tile_id] = held->version;
+}
+
+void LiveFeed::tick() {
+  const std::int64_t now = now_ms();
+  bool link_lost = false;
+  std::string tiles_event;
+  {
+    const std::lock_guard lock(mutex_);
+    if (link_up_ && now - last_status_ms_ > kLinkSilentMs) {
+      link_up_ = false;
+      link_lost = true;
+    }
+    if (!session_.empty() && now - last_segment_ms_ > kQuietBeforeAskMs && now - last_request_ms_ > kAskEveryMs) {
+      const auto missing = tiles_.missing(3000);
+      const bool ask_index = !index_received_ && now - last_request_ms_ > kAskIndexEveryMs;
+      if (ask_index || !missing.empty()) {
+        client_->request_tiles(session_, missing, !index_received_);
+        last_request_ms_ = now;
+      }
+    }
+    if (!pending_event_.empty() && now - last_tiles_event_ms_ >= kTilesEventEveryMs) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& [id, version] : pending_event_) {
+        const auto held = tiles_.held(id);
+        std::size_t n = 0;
+        if (held)
+          for (const auto& s : held->segments) n += s.size();
+        list.push_back({{"id", std::to_string(id)}, {"v", version}, {"n", n}});
+      }
+      pending_event_.clear();
+      last_tiles_event_ms_ = now;
+      tiles_event = nlohmann::json{{"session", session_}, {"tiles", list}}.dump();
+    }
+  }
+  if (link_lost)
+    hub_.publish("link", nlohmann::json{{"up", false}, {"silent_ms", now - last_status_ms_}}.dump());
+  if (!tiles_event.empty()) hub_.publish("tiles", std::move(tiles_event));
+}
+
+nlohmann::json LiveFeed::snapshot() const {
+  const std::lock_guard lock(mutex_);
+  nlohmann::json path = nlohmann::json::array();
+  for (const auto& p : path_) path.push_back({p[0], p[1], p[2]});
+  nlohmann::json tiles = nlohmann::json::array();
+  std::size_t points = 0;
+  for (const auto& [id, changes] : changes_) {
+    const auto held = tiles_.held(id);
+    if (!held) continue;
+    std::size_t n = 0;
+    for (const auto& s : held->segments) n += s.size();
+    points += n;
+    tiles.push_back({{"id", std::to_string(id)}, {"v", held->version}, {"n", n}});
+  }
+  return {{"payload", options_.payload_id},
+          {"link", {{"up", link_up_}, {"silent_ms", link_up_ ? 0 : now_ms() - last_status_ms_}}},
+          {"session", session_},
+          {"status", status_ ? *status_ : nlohmann::json()},
+          {"pose", pose_ ? *pose_ : nlohmann::json()},
+          {"path", path},
+          {"tiles", tiles},
+          {"map_points", points}};
+}
+
+std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_version, int every) const {
+  const std::lock_guard lock(mutex_);
+  const auto held = tiles_.held(id);
+  if (!held) return std::nullopt;
+  TileBytes out;
+  out.version = held->version;
+  out.n_segments = static_cast<std::int32_t>(held->segments.size());
+  // The first segment changed after the version the browser holds, when the
+  // completions since are all known; otherwise the whole tile.
+  if (held_version > 0 && held_version <= held->version) {
+    const auto it = changes_.find(id);
+    std::int32_t from = out.n_segments;
+    std::int32_t reached = held->version;
+    if (it != changes_.end())
+      for (auto c = it->second.rbegin(); c != it->second.rend() && c->version > held_version; ++c) {
+        from = std::min(from, c->from);
+        reached = c->before;
+      }
+    out.from = reached <= held_version ? from : 0;
+    if (held_version == held->version) out.from = out.n_segments;
+  }
+  const auto step = static_cast<std::size_t>(std::max(1, every));
+  std::size_t index = 0;  // the point's place in the tile, for an even stride across segments
+  for (std::size_t s = 0; s < held->segments.size(); ++s) {
+    const auto& segment = held->segments[s];
+    out.n_points += static_cast<std::int64_t>(segment.size());
+    if (static_cast<std::int32_t>(s) < out.from) {
+      index += segment.size();
+      continue;
+    }
+    const std::size_t first = (step - index % step) % step;
+    const std::size_t count = first < segment.size() ? (segment.size() - first + step - 1) / step : 0;
+    append_u32(out.body, static_cast<std::uint32_t>(count));
+    for (std::size_t i = first; i < segment.size(); i += step) {
+      append_f32(out.body, static_cast<float>(segment[i].x));
+      append_f32(out.body, static_cast<float>(segment[i].y));
+      append_f32(out.body, static_cast<float>(segment[i].z));
+    }
+    index += segment.size();
+  }
+  return out;
+}
+
+}  // namespace adit::tools::console

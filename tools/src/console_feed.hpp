@@ -1,0 +1,93 @@
+#pragma once
+// adit console: the live side. One thread follows the payload's LCM channels
+// as the tablet would (tools/src/lcm_client.cpp): poses, status, the tile
+// index and the tile segments of the current session, asking for what it
+// lacks like `adit download` does. It keeps the latest status, the path and
+// the map (protocol::TileAssembler), and publishes what changed as events:
+//   pose     every pose, with the console's receive time (for the latency)
+//   status   every status (2 Hz)
+//   tiles    the tiles completed at a new version, at most every 250 ms
+//   session  the payload's session changed (the browser clears its map)
+//   link     the payload stopped answering (no status for 2 s) or came back
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "adit/protocol/tile_assembler.hpp"
+#include "console_events.hpp"
+#include "lcm_client.hpp"
+
+namespace adit::tools::console {
+
+nlohmann::json status_json(const status_t& s);
+nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms);
+
+// A tile's points for a browser: segments `from` .. n-1 at `version`, every
+// `every`-th point (x y z as float32, little-endian, per segment a uint32
+// count first).
+struct TileBytes {
+  std::int32_t version = 0;
+  std::int32_t from = 0;
+  std::int32_t n_segments = 0;
+  std::int64_t n_points = 0;  // the tile's, before decimation
+  std::string body;
+};
+
+class LiveFeed {
+ public:
+  LiveFeed(ClientOptions options, EventHub& hub);
+  ~LiveFeed();
+  LiveFeed(const LiveFeed&) = delete;
+  LiveFeed& operator=(const LiveFeed&) = delete;
+
+  // The whole current state: link, status, last pose, path, tile versions.
+  nlohmann::json snapshot() const;
+  // Tile `id` for a browser that holds it at `held_version` (0 = nothing):
+  // only the segments changed since when the console knows them.
+  std::optional<TileBytes> tile(std::int64_t id, std::int32_t held_version, int every) const;
+
+ private:
+  void run();
+  void on_pose(const pose_t& p);
+  void on_status(const status_t& s);
+  void on_index(const tile_index_t& m);
+  void on_segment(const tile_segment_t& m);
+  void tick();  // requests, throttled tile events, the link watch
+  void switch_session(const std::string& session);  // under mutex_
+
+  ClientOptions options_;
+  EventHub& hub_;
+  std::atomic<bool> stop_{false};
+
+  mutable std::mutex mutex_;
+  std::string session_;
+  std::optional<nlohmann::json> status_;
+  std::optional<nlohmann::json> pose_;
+  std::vector<std::array<float, 3>> path_;
+  protocol::TileAssembler tiles_;
+  // Per tile, the completions seen: (version before, version, first segment replaced).
+  struct Change {
+    std::int32_t before = 0, version = 0, from = 0;
+  };
+  std::map<std::int64_t, std::vector<Change>> changes_;
+  std::map<std::int64_t, std::int32_t> pending_event_;  // tile -> version completed, not yet announced
+  std::int64_t last_status_ms_ = 0;
+  std::int64_t last_segment_ms_ = 0;
+  std::int64_t last_request_ms_ = 0;
+  std::int64_t last_tiles_event_ms_ = 0;
+  bool index_received_ = false;  // the full index of session_ came (else asked for again every 2 s)
+  bool link_up_ = false;
+
+  std::unique_ptr<LcmClient> client_;  // used by the feed's thread only (request_tiles)
+  std::thread thread_;
+};
+
+}  // namespace adit::tools::console

@@ -1,0 +1,76 @@
+#include "console_sessions.hpp"
+
+#include <fstream>
+
+#include "adit/common/log.hpp"
+
+namespace adit::tools::console {
+
+ScanNames::ScanNames(std::filesystem::path file) : file_(std::move(file)) {
+  std::ifstream in(file_);
+  if (!in) return;
+  try {
+    names_ = nlohmann::json::parse(in);
+    if (!names_.is_object()) throw std::runtime_error("not a JSON object");
+  } catch (const std::exception& e) {
+    log::warn("{}: scan names unreadable, starting afresh: {}", file_.string(), e.what());
+    names_ = nlohmann::json::object();
+  }
+}
+
+void ScanNames::set(const std::string& session, const std::string& name) {
+  const std::lock_guard lock(mutex_);
+  names_[session] = name;
+  std::filesystem::create_directories(file_.parent_path());
+  const std::filesystem::path part = file_.string() + ".part";
+  std::ofstream(part) << names_.dump(2) << "\n";
+  std::filesystem::rename(part, file_);
+}
+
+std::string ScanNames::get(const std::string& session) const {
+  const std::lock_guard lock(mutex_);
+  const auto it = names_.find(session);
+  return it != names_.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+std::string scan_name_problem(const std::string& name) {
+  if (name.empty()) return "the name is empty";
+  if (name.size() > 64) return "the name is longer than 64 characters";
+  for (const char c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "the name has a control character";
+  return "";
+}
+
+nlohmann::json describe_sessions(const std::vector<std::string>& ids, const ScanNames& names,
+                                 const std::filesystem::path& sessions_dir) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const std::string& id : ids) {
+    nlohmann::json entry = {{"id", id}, {"name", names.get(id)}};
+    if (!sessions_dir.empty()) {
+      const std::filesystem::path dir = sessions_dir / id;
+      std::error_code ec;
+      std::uintmax_t bytes = 0;
+      for (const auto& f : std::filesystem::recursive_directory_iterator(dir, ec))
+        if (f.is_regular_file(ec)) bytes += f.file_size(ec);
+      entry["bytes"] = bytes;
+      entry["trajectory"] = std::filesystem::exists(dir / "trajectory.tum", ec);
+      std::ifstream in(dir / "summary.json");
+      if (in) {
+        try {
+          const auto s = nlohmann::json::parse(in);
+          entry["points"] = s.at("map").at("points");
+          entry["duration_s"] = s.at("timing").at("duration_s");
+          entry["poses"] = s.at("poses").at("total");
+          entry["invalid_poses"] = s.at("poses").at("invalid");
+          if (s.contains("loops") && s["loops"].contains("accepted")) entry["loops"] = s["loops"]["accepted"];
+        } catch (const std::exception& e) {
+          entry["summary_error"] = e.what();
+        }
+      }
+    }
+    out.push_back(std::move(entry));
+  }
+  return out;
+}
+
+}  // namespace adit::tools::console
