@@ -23,7 +23,9 @@ packages=(
   libssl-dev             # MD5 for the Ouster field digests (OpenSSL EVP)
   liblcm-dev liblcm-bin libglib2.0-dev  # LCM messages and lcm-gen (lcm.pc needs glib)
   libembree-dev          # ray casting in the simulator
-  libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI)
+  libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI); products' SOR filter
+  liboctomap-dev         # session products: 3D occupancy by ray casting, .bt/.ot files (products/)
+  libpng-dev             # session products: the top-down picture of the map (products/)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

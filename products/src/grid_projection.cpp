@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace adit::products {
 
@@ -57,6 +58,50 @@ Grid2d project_to_grid(const Occupancy3d& occupancy, std::span<const Eigen::Vect
     if (g.contains(col, row)) g.at(col, row) = kOccupied;
   }
   return g;
+}
+
+std::size_t fill_line_of_sight(Grid2d& g, std::span<const Eigen::Vector3f> viewpoints, double range_m,
+                               double viewpoint_step_m) {
+  if (g.cells.empty()) return 0;
+  std::vector<std::uint8_t> block(g.cells.size(), 0);
+  for (int r = 0; r < g.height; ++r)
+    for (int c = 0; c < g.width; ++c) {
+      if (g.at(c, r) != kOccupied) continue;
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc)
+          if (g.contains(c + dc, r + dr)) block[static_cast<std::size_t>(r + dr) * g.width + c + dc] = 1;
+    }
+  std::vector<std::size_t> cells;
+  std::size_t filled = 0;
+  const int rays = 1440;
+  const double step = 0.5 * g.resolution_m;
+  Eigen::Vector3f last(std::numeric_limits<float>::max(), 0, 0);
+  for (const Eigen::Vector3f& v : viewpoints) {
+    if ((v - last).norm() < viewpoint_step_m) continue;
+    last = v;
+    for (int k = 0; k < rays; ++k) {
+      const double a = 2 * M_PI * k / rays, dx = std::cos(a), dy = std::sin(a);
+      cells.clear();
+      bool bounded = false;
+      for (double t = 0; t <= range_m; t += step) {
+        const int c = g.col_of(v.x() + t * dx), r = g.row_of(v.y() + t * dy);
+        if (!g.contains(c, r)) break;
+        const std::size_t k2 = static_cast<std::size_t>(r) * g.width + c;
+        if (block[k2]) {
+          bounded = true;
+          break;
+        }
+        if (cells.empty() || cells.back() != k2) cells.push_back(k2);
+      }
+      if (!bounded) continue;
+      for (const std::size_t k2 : cells)
+        if (g.cells[k2] == kUnknown) {
+          g.cells[k2] = kFree;
+          ++filled;
+        }
+    }
+  }
+  return filled;
 }
 
 }  // namespace adit::products

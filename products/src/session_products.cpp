@@ -1,6 +1,7 @@
 #include "adit/products/session_products.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <fstream>
 #include <numeric>
@@ -30,11 +31,17 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"octree_leaves", r.leaves},
           {"octree_resolution_m", o.occupancy.resolution_m},
           {"grid_resolution_m", o.grid_resolution_m},
-          {"grid_cells", {{"occupied", r.grid_occupied}, {"free", r.grid_free}, {"unknown", r.grid_unknown}}},
+          {"grid_cells", {{"occupied", r.grid_occupied}, {"free", r.grid_free}, {"unknown", r.grid_unknown},
+                          {"free_by_line_of_sight_fill", r.grid_filled}}},
           {"points_file", r.points_file},
           {"bytes", {{"points", r.points_bytes}, {"octree_bt", r.bt_bytes}, {"octree_ot", r.ot_bytes}, {"grid", r.grid_bytes}}},
-          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml"})
-                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml"})},
+          {"top_view_bytes", r.top_view_bytes},
+          {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
+                        {"width_at_m", o.sections.width_at_m}}},
+          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml",
+                                                        "top_view.png", "sections/"})
+                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml", "top_view.png",
+                                                        "sections/"})},
           {"cpu_s", r.cpu_s}};
 }
 
@@ -73,6 +80,7 @@ void check_options(const ProductsOptions& o) {
   require(o.band_low_m < o.band_high_m, "band", "the band's low height must be below its high one");
   require(o.outliers.k >= 1 && o.outliers.stddev_mult > 0.0, "sor", "k >= 1 and a positive stddev multiple");
   require(o.ground.patch_m > 0.0 && o.ground.distance_m > 0.0, "ground", "patch and distance must be positive");
+  require(o.sections.interval_m > 0.0, "section-interval", "must be positive");
 }
 
 ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
@@ -117,8 +125,10 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
     begin = end;
   }
   std::vector<std::uint8_t> obstacle = kept;
-  const Grid2d grid = project_to_grid(occupancy, map.points, obstacle, ground.is_ground, ground.model,
+  Grid2d grid = project_to_grid(occupancy, map.points, obstacle, ground.is_ground, ground.model,
                                       {options.grid_resolution_m, options.band_low_m, options.band_high_m});
+  if (options.line_of_sight_fill)
+    r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
   r.grid_occupied = grid.count(kOccupied);
   r.grid_free = grid.count(kFree);
   r.grid_unknown = grid.count(kUnknown);
@@ -128,6 +138,16 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
   r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");
   r.leaves = occupancy.leaf_count();
+  r.top_view_bytes =
+      write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, {}, options.top_view).bytes;
+  const std::vector<CrossSection> sections = cut_sections(map.points, map.sensor_path, options.sections);
+  std::filesystem::create_directories(r.out_dir / "sections");
+  for (const CrossSection& c : sections) {
+    write_section_svg(r.out_dir / "sections" / fmt::format("section_{:03d}.svg", c.id), c, options.sections);
+    r.sections_measured += std::isfinite(c.width_m) && std::isfinite(c.height_m);
+  }
+  r.sections = sections.size();
+  write_sections_csv(r.out_dir / "sections" / "sections.csv", sections);
   r.cpu_s = thread_cpu_s() - cpu0;
   const nlohmann::json json = report_json(r, options);
   {

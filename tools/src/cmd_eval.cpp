@@ -131,6 +131,23 @@ void add_grid(CLI::App& eval, int& status) {
   });
 }
 
+void add_sections(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("sections", "Cross-section widths and heights (adit products) against the true scene");
+  auto o = std::make_shared<SectionsEvalOptions>();
+  cmd->add_option("--sections", o->sections, "sections.csv from adit products")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--scene", o->scene, "True scene: triangle mesh PLY (adit sim's scene.ply)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ref", o->ref, "Reference body trajectory (truth_body.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--est", o->est, "The map's trajectory (map_trajectory.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--width-at", o->width_at, "Height above the floor the widths were measured at (m, default 1.5)");
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_sections(*o);
+    status = kExitOk;
+  });
+}
+
 }  // namespace
 
 void register_eval_commands(CLI::App& app, int& status) {
@@ -141,6 +158,7 @@ void register_eval_commands(CLI::App& app, int& status) {
   add_targets(*eval, status);
   add_map(*eval, status);
   add_grid(*eval, status);
+  add_sections(*eval, status);
 }
 
 }  // namespace adit::tools

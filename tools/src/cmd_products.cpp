@@ -26,10 +26,12 @@ void run_products(const ProductsCommand& c) {
   fmt::print("products of {} in {}\n", c.session, r.out_dir.string());
   fmt::print("points            {} ({} ground, {} outliers removed)\n", r.points, r.ground_points, r.outliers_removed);
   fmt::print("octree            {} leaves at {} m\n", r.leaves, c.options.occupancy.resolution_m);
-  fmt::print("grid              {} occupied, {} free, {} unknown cells at {} m\n", r.grid_occupied, r.grid_free,
-             r.grid_unknown, c.options.grid_resolution_m);
+  fmt::print("grid              {} occupied, {} free ({} by the line-of-sight fill), {} unknown cells at {} m\n",
+             r.grid_occupied, r.grid_free, r.grid_filled, r.grid_unknown, c.options.grid_resolution_m);
   fmt::print("storage           points {} -> 3D {} (.bt){} -> 2D {} (PGM + YAML)\n", kib(r.points_bytes),
              kib(r.bt_bytes), r.ot_bytes > 0 ? fmt::format(", {} (.ot)", kib(r.ot_bytes)) : "", kib(r.grid_bytes));
+  fmt::print("pictures          top_view.png ({}), {} cross-sections ({} measured) every {} m in sections/\n",
+             kib(r.top_view_bytes), r.sections, r.sections_measured, c.options.sections.interval_m);
   fmt::print("cpu               {:.2f} s\n", r.cpu_s);
 }
 
@@ -50,6 +52,9 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--sor-k", o.outliers.k, "Statistical outlier removal: neighbours (default 15)");
   cmd->add_option("--sor-stddev", o.outliers.stddev_mult, "Statistical outlier removal: stddev multiple (default 1.0)");
   cmd->add_option("--ground-distance", o.ground.distance_m, "Ground: distance to the patch plane (m, default 0.12)");
+  cmd->add_option("--section-interval", o.sections.interval_m, "Cross-sections every this many m of path (default 10)");
+  cmd->add_option("--section-width-at", o.sections.width_at_m, "Widths measured this high above the floor (m, default 1.5)");
+  cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
   cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");
   cmd->callback([c, &status] {
     run_products(*c);

@@ -72,6 +72,15 @@ struct GridEvalOptions {
 
 void run_eval_grid(const GridEvalOptions& options);
 
+struct SectionsEvalOptions {
+  std::string sections, scene;  // adit products' sections.csv, scene.ply
+  std::string ref, est;         // truth_body.tum and the map's trajectory
+  double width_at = 1.5;        // m above the floor, as the sections were measured
+  bool json = false;
+};
+
+void run_eval_sections(const SectionsEvalOptions& options);
+
 // Shared by the runners.
 // The triangles of a scene mesh PLY; throws InputError when it has none.
 std::vector<eval::Triangle> scene_triangles(const std::string& file);

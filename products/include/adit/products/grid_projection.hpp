@@ -25,6 +25,15 @@ struct ProjectionOptions {
   double band_high_m = 2.0;
 };
 
+// 2D line-of-sight fill (how a 2D laser scan's free space is made): from each
+// viewpoint, rays over the grid every 0.25° mark unknown cells free up to the
+// first occupied cell (dilated by one cell, so a pinhole in a wall does not
+// leak), but only when they meet one within range_m: free space bounded by an
+// observed obstacle. It fills the floor between the sparse rings the 3D rays
+// leave in large rooms. Returns the cells it made free.
+std::size_t fill_line_of_sight(Grid2d& grid, std::span<const Eigen::Vector3f> viewpoints, double range_m,
+                               double viewpoint_step_m);
+
 Grid2d project_to_grid(const Occupancy3d& occupancy, std::span<const Eigen::Vector3f> points,
                        std::span<const std::uint8_t> obstacle, std::span<const std::uint8_t> floor,
                        const GroundModel& ground,

@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <string>
 
+#include "adit/products/cross_sections.hpp"
 #include "adit/products/ground.hpp"
 #include "adit/products/occupancy_3d.hpp"
 #include "adit/products/outlier_filter.hpp"
 #include "adit/products/session_map.hpp"
+#include "adit/products/top_view.hpp"
 
 namespace adit::products {
 
@@ -27,6 +29,11 @@ struct ProductsOptions {
   double band_low_m = 0.15;         // heights above the ground that block a robot / count as its free space
   double band_high_m = 2.0;
   bool write_ot = false;            // the full-probability octree beside the .bt
+  bool line_of_sight_fill = true;   // fill_line_of_sight (grid_projection.hpp)
+  double fill_range_m = 20.0;
+  double fill_step_m = 1.0;         // a viewpoint every metre of path
+  TopViewOptions top_view;
+  SectionOptions sections;
 };
 
 struct ProductsReport {
@@ -36,11 +43,14 @@ struct ProductsReport {
   std::size_t outliers_removed = 0;
   std::size_t leaves = 0;
   std::size_t grid_occupied = 0, grid_free = 0, grid_unknown = 0;
+  std::size_t grid_filled = 0;  // of the free cells, those the line-of-sight fill made free
   std::string points_file;          // the session's map file (map.las, .ply or .pcd)
   std::uintmax_t points_bytes = 0;
   std::uintmax_t bt_bytes = 0;
   std::uintmax_t ot_bytes = 0;
   std::uintmax_t grid_bytes = 0;    // PGM + YAML
+  std::uintmax_t top_view_bytes = 0;
+  std::size_t sections = 0, sections_measured = 0;  // measured: width and height both found
   double cpu_s = 0.0;               // this thread's CPU time for all of it
   std::filesystem::path out_dir;
 };
@@ -48,7 +58,8 @@ struct ProductsReport {
 // Checks the options; throws adit::InputError naming the option.
 void check_options(const ProductsOptions& options);
 
-// Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, products.json;
+// Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
+// sections/section_NNN.svg and sections/sections.csv, products.json;
 // OUT_DIR defaults to SESSION_DIR/products. Adds "products" to
 // SESSION_DIR/summary.json when it exists (written to a temporary file and
 // renamed). Throws adit::InputError for a missing or bad session file.
