@@ -24,7 +24,8 @@ std::string kib(std::uintmax_t bytes) { return fmt::format("{:.1f} kB", static_c
 void run_products(const ProductsCommand& c) {
   const products::ProductsReport r = products::write_session_products(c.session, c.options, c.out);
   fmt::print("products of {} in {}\n", c.session, r.out_dir.string());
-  fmt::print("points            {} ({} ground, {} outliers removed)\n", r.points, r.ground_points, r.outliers_removed);
+  fmt::print("points            {} ({} ground, {} outliers removed, {} without a line of sight to the path)\n", r.points,
+             r.ground_points, r.outliers_removed, r.without_ray);
   fmt::print("octree            {} leaves at {} m\n", r.leaves, c.options.occupancy.resolution_m);
   fmt::print("grid              {} occupied, {} free ({} by the line-of-sight fill), {} unknown cells at {} m\n",
              r.grid_occupied, r.grid_free, r.grid_filled, r.grid_unknown, c.options.grid_resolution_m);
@@ -54,6 +55,7 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--ground-distance", o.ground.distance_m, "Ground: distance to the patch plane (m, default 0.12)");
   cmd->add_option("--section-interval", o.sections.interval_m, "Cross-sections every this many m of path (default 10)");
   cmd->add_option("--section-width-at", o.sections.width_at_m, "Widths measured this high above the floor (m, default 1.5)");
+  cmd->add_option("--ray-candidates", o.rays.candidates, "Path positions tried for each point's line of sight (default 12)");
   cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
   cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");
   cmd->callback([c, &status] {

@@ -16,7 +16,7 @@ namespace adit::products {
 
 struct OutlierOptions {
   int k = 15;                 // neighbours (the seed's k = 15)
-  double stddev_mult = 1.0;   // γ; the seed's 0.2 removes ~40 % of a clean wall (docs/PRODUCTS.md)
+  double stddev_mult = 1.0;   // γ; the seed's 0.2 removes a quarter of the non-ground points (docs/PRODUCTS.md)
 };
 
 // 1 for each point kept among those with mask[i] != 0; points outside the mask are 0.

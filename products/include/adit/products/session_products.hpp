@@ -30,7 +30,7 @@ struct ProductsOptions {
   double band_high_m = 2.0;
   bool write_ot = false;            // the full-probability octree beside the .bt
   bool line_of_sight_fill = true;   // fill_line_of_sight (grid_projection.hpp)
-  double fill_range_m = 20.0;
+  double fill_range_m = 40.0;       // aditd's map.max_range_m
   double fill_step_m = 1.0;         // a viewpoint every metre of path
   TopViewOptions top_view;
   SectionOptions sections;
