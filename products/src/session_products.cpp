@@ -124,9 +124,8 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
     occupancy.insert(map.viewpoints[static_cast<std::size_t>(map.origin[order[begin]])], hits, passes);
     begin = end;
   }
-  std::vector<std::uint8_t> obstacle = kept;
-  Grid2d grid = project_to_grid(occupancy, map.points, obstacle, ground.is_ground, ground.model,
-                                      {options.grid_resolution_m, options.band_low_m, options.band_high_m});
+  Grid2d grid = project_to_grid(occupancy, map.points, kept, ground.is_ground, ground.model,
+                                {options.grid_resolution_m, options.band_low_m, options.band_high_m});
   if (options.line_of_sight_fill)
     r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
   r.grid_occupied = grid.count(kOccupied);

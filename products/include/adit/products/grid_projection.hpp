@@ -1,6 +1,6 @@
 #pragma once
 // The 2D occupancy grid from the 3D one: a cell is occupied when a kept
-// (non-ground, not an outlier, occupied in the octree) map point lies over it
+// (non-ground, not an outlier) map point lies over it
 // within the band of heights above the ground that blocks a robot; free when
 // a free voxel of the octree lies over it within that band, or a ground
 // point lies in it (the floor was seen there, so nothing stood over it: the
