@@ -47,7 +47,7 @@ void register_products_commands(CLI::App& app, int& status) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--out", c->out, "Where to write (default SESSION/products)");
   cmd->add_option("--grid-resolution", o.grid_resolution_m, "2D grid cell (m), 0.01 .. 1 (default 0.05)");
-  cmd->add_option("--octree-resolution", o.occupancy.resolution_m, "3D voxel (m), 0.01 .. 1 (default 0.05)");
+  cmd->add_option("--octree-resolution", o.occupancy.resolution_m, "3D voxel (m), 0.01 .. 1 (default 0.1)");
   cmd->add_option("--band", o.band_low_m, "Lowest height above the ground that blocks (m, default 0.15)");
   cmd->add_option("--band-high", o.band_high_m, "Highest height above the ground that blocks (m, default 2.0)");
   cmd->add_option("--sor-k", o.outliers.k, "Statistical outlier removal: neighbours (default 15)");
