@@ -28,7 +28,9 @@ packages=(
   libcpp-httplib-dev     # adit console's HTTP server (docs/CONSOLE.md)
   libjs-three            # three.js for the console's web app, served from /usr/share/javascript/three
   libembree-dev          # ray casting in the simulator
-  libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI)
+  libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI); products' SOR filter
+  liboctomap-dev         # session products: 3D occupancy by ray casting, .bt/.ot files (products/)
+  libpng-dev             # session products: the top-down picture of the map (products/)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   chromium               # the console's browser tests: headless, driven over the DevTools protocol

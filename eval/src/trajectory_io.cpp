@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
+#include "adit/slam/tum.hpp"
 #include "text_fields.hpp"
 
 namespace adit::eval {
@@ -99,23 +100,10 @@ TrajectoryFormat detect_trajectory_format(const fs::path& path) {
                    "cannot tell the format (8 numbers per line: TUM, 12: KITTI, .csv: EuRoC); name it explicitly");
 }
 
-slam::Trajectory read_tum(const fs::path& path) {
-  std::ifstream in = open(path);
-  return read_tum(in, path);
-}
+// TUM has one reader, beside the one writer (slam/tum.hpp).
+slam::Trajectory read_tum(const fs::path& path) { return slam::read_tum(path); }
 
-slam::Trajectory read_tum(std::istream& in, const fs::path& path) {
-  slam::Trajectory traj;
-  for_each_data_line(in, " \t", [&](const std::vector<std::string_view>& fields, std::size_t line) {
-    expect_fields(fields, 8, false, "t x y z qx qy qz qw", path, line);
-    double v[8];
-    parse_numbers(fields, 0, 8, path, line, v);
-    check_forward(traj, v[0], path, line);
-    traj.push_back(v[0], pose_from({v[1], v[2], v[3]}, Eigen::Quaterniond(v[7], v[4], v[5], v[6]), path, line));
-  });
-  expect_poses(traj, path);
-  return traj;
-}
+slam::Trajectory read_tum(std::istream& in, const fs::path& path) { return slam::read_tum(in, path); }
 
 slam::Trajectory read_kitti(std::istream& in, const fs::path& path) {
   slam::Trajectory traj;

@@ -1,9 +1,13 @@
 #include "adit/slam/tum.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -61,6 +65,69 @@ void TumWriter::write(std::int64_t stamp_ns, const Pose& pose) {
 bool TumWriter::flush() {
   if (!file_) return true;
   return std::fflush(file_.get()) == 0 && std::ferror(file_.get()) == 0;
+}
+
+namespace {
+
+std::string at(const std::filesystem::path& path, std::size_t line) { return fmt::format("{}:{}", path.string(), line); }
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// Whitespace-separated fields of `line` (runs of blanks are one separator).
+void split_blanks(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !is_blank(line[i])) ++i;
+    if (i > start) out.push_back(line.substr(start, i - start));
+  }
+}
+
+bool parse_finite(std::string_view field, double& value) {
+  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+  return ec == std::errc{} && end == field.data() + field.size() && !field.empty() && std::isfinite(value);
+}
+
+}  // namespace
+
+Trajectory read_tum(std::istream& in, const std::filesystem::path& name) {
+  Trajectory traj;
+  std::string line;
+  std::vector<std::string_view> fields;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    split_blanks(line, fields);
+    if (fields.empty() || fields.front().front() == '#') continue;
+    if (fields.size() != 8)
+      throw InputError(at(name, number), "",
+                       fmt::format("expected 8 fields (t x y z qx qy qz qw), found {}", fields.size()));
+    double v[8];
+    for (std::size_t k = 0; k < 8; ++k)
+      if (!parse_finite(fields[k], v[k]))
+        throw InputError(at(name, number), fmt::format("field {}", k + 1),
+                         fmt::format("'{}' is not a finite number", fields[k]));
+    if (!traj.stamps.empty() && v[0] < traj.stamps.back())
+      throw InputError(at(name, number), "timestamp",
+                       fmt::format("goes backwards: {:.9f} after {:.9f}", v[0], traj.stamps.back()));
+    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    const double norm = q.norm();
+    if (norm < 1e-6) throw InputError(at(name, number), "quaternion", "has zero length");
+    q.coeffs() /= norm;
+    Pose pose = Pose::Identity();
+    pose.linear() = q.toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    traj.push_back(v[0], pose);
+  }
+  if (traj.empty()) throw InputError(name.string(), "", "contains no poses");
+  return traj;
+}
+
+Trajectory read_tum(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "", "cannot open for reading");
+  return read_tum(in, path);
 }
 
 }  // namespace adit::slam

@@ -110,6 +110,44 @@ void add_map(CLI::App& eval, int& status) {
   });
 }
 
+void add_grid(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("grid", "2D occupancy grid (map_server YAML + PGM) against the true scene: IoU");
+  auto o = std::make_shared<GridEvalOptions>();
+  cmd->add_option("--grid", o->grid, "The grid's YAML (adit products' grid.yaml)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--scene", o->scene, "True scene: triangle mesh PLY (adit sim's scene.ply)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ref", o->ref, "Reference body trajectory (truth_body.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--est", o->est, "The map's trajectory (map_trajectory.tum), placed by ref(t0) est(t0)^-1")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--max-range", o->max_range, "Cells farther than this (m) from the path are not scored (default 20)")
+      ->check(CLI::Range(1.0, 200.0));
+  cmd->add_option("--floor-z", o->floor_z, "The scene's floor height in the world (default 0)");
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_grid(*o);
+    status = kExitOk;
+  });
+}
+
+void add_sections(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("sections", "Cross-section widths and heights (adit products) against the true scene");
+  auto o = std::make_shared<SectionsEvalOptions>();
+  cmd->add_option("--sections", o->sections, "sections.csv from adit products")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--scene", o->scene, "True scene: triangle mesh PLY (adit sim's scene.ply)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ref", o->ref, "Reference body trajectory (truth_body.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--est", o->est, "The map's trajectory (map_trajectory.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--width-at", o->width_at, "Height above the floor the widths were measured at (m, default 1.5)");
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_sections(*o);
+    status = kExitOk;
+  });
+}
+
 }  // namespace
 
 void register_eval_commands(CLI::App& app, int& status) {
@@ -119,6 +157,8 @@ void register_eval_commands(CLI::App& app, int& status) {
   add_endpoint(*eval, status);
   add_targets(*eval, status);
   add_map(*eval, status);
+  add_grid(*eval, status);
+  add_sections(*eval, status);
 }
 
 }  // namespace adit::tools

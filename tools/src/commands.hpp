@@ -26,5 +26,7 @@ void register_download_commands(CLI::App& app, int& status);
 void register_console_commands(CLI::App& app, int& status);
 void register_sim_commands(CLI::App& app, int& status);
 void register_replay_commands(CLI::App& app, int& status);
+void register_products_commands(CLI::App& app, int& status);
+void register_targets_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

@@ -7,7 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/eval/mesh_distance.hpp"
 #include "adit/eval/stats.hpp"
+#include "adit/slam/trajectory.hpp"
 
 namespace adit::tools {
 
@@ -56,7 +62,32 @@ void run_eval_map(const MapEvalOptions& options);
 void run_eval_endpoint(const EndpointEvalOptions& options);
 void run_eval_targets(const TargetsEvalOptions& options);
 
+struct GridEvalOptions {
+  std::string grid, scene;  // grid.yaml (map_server), scene.ply
+  std::string ref, est;     // truth_body.tum and the map's trajectory: place the grid by ref(t0) · est(t0)⁻¹
+  double max_range = 20.0;  // m: cells farther from the path are not scored
+  double floor_z = 0.0;     // the scene's floor height (world)
+  bool json = false;
+};
+
+void run_eval_grid(const GridEvalOptions& options);
+
+struct SectionsEvalOptions {
+  std::string sections, scene;  // adit products' sections.csv, scene.ply
+  std::string ref, est;         // truth_body.tum and the map's trajectory
+  double width_at = 1.5;        // m above the floor, as the sections were measured
+  bool json = false;
+};
+
+void run_eval_sections(const SectionsEvalOptions& options);
+
 // Shared by the runners.
+// The triangles of a scene mesh PLY; throws InputError when it has none.
+std::vector<eval::Triangle> scene_triangles(const std::string& file);
+// A time-stamped trajectory in any format eval reads (detected).
+slam::Trajectory timed_trajectory(const std::string& file);
+// Where the map frame lies in the world: ref(t0) · est(t0)⁻¹ at the estimate's first stamp t0.
+Eigen::Isometry3d world_from_map(const std::string& ref_file, const std::string& est_file);
 nlohmann::json stats_json(const eval::Stats& stats);
 std::string stats_row(const std::string& name, const eval::Stats& stats);
 std::string stats_header();

@@ -20,9 +20,6 @@
 #include "eval_commands.hpp"
 
 namespace adit::tools {
-namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 std::vector<eval::Triangle> scene_triangles(const std::string& file) {
   const protocol::PlyMesh mesh = protocol::read_ply_mesh(file);
@@ -42,28 +39,37 @@ slam::Trajectory timed_trajectory(const std::string& file) {
   return t;
 }
 
+// The map frame is the estimate's: its first pose est(t0) is where the body
+// was at t0, which the reference says is ref(t0) in the world. So a map point
+// p goes to ref(t0) · est(t0)⁻¹ · p.
+Eigen::Isometry3d world_from_map(const std::string& ref_file, const std::string& est_file) {
+  const slam::Trajectory ref = timed_trajectory(ref_file);
+  const slam::Trajectory est = timed_trajectory(est_file);
+  const double t0 = est.stamps.front();
+  const auto ref_t0 = eval::interpolate_pose(ref, t0);
+  if (!ref_t0)
+    throw InputError(ref_file, "",
+                     fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
+                                 "{:.6f} .. {:.6f} s",
+                                 t0, est_file, ref.stamps.front(), ref.stamps.back()));
+  return *ref_t0 * est.poses.front().inverse();
+}
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
 struct Placement {
   Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
   double t0 = 0.0;  // s; the estimate's first stamp when placed by trajectories
   bool by_trajectories = false;
 };
 
-// The map frame is the estimate's: its first pose est(t0) is where the body
-// was at t0, which the reference says is ref(t0) in the world. So a map point
-// p goes to ref(t0) · est(t0)⁻¹ · p.
 Placement placement(const MapEvalOptions& o) {
   Placement p;
   if (o.ref.empty()) return p;
-  const slam::Trajectory ref = timed_trajectory(o.ref);
-  const slam::Trajectory est = timed_trajectory(o.est);
-  p.t0 = est.stamps.front();
-  const auto ref_t0 = eval::interpolate_pose(ref, p.t0);
-  if (!ref_t0)
-    throw InputError(o.ref, "",
-                     fmt::format("t0 = {:.6f} s (first stamp of {}) is outside the reference's "
-                                 "{:.6f} .. {:.6f} s",
-                                 p.t0, o.est, ref.stamps.front(), ref.stamps.back()));
-  p.world_from_map = *ref_t0 * est.poses.front().inverse();
+  p.t0 = timed_trajectory(o.est).stamps.front();
+  p.world_from_map = world_from_map(o.ref, o.est);
   p.by_trajectories = true;
   return p;
 }

@@ -10,9 +10,17 @@
 #include "adit/eval/targets.hpp"
 #include "adit/eval/targets_io.hpp"
 #include "eval_commands.hpp"
-#include "svg_plot.hpp"
+#include "adit/products/svg_plot.hpp"
 
 namespace adit::tools {
+
+using products::kColorEstimate;
+using products::kColorReference;
+using products::kColorSecond;
+using products::Plot;
+using products::PlotSeries;
+using products::SeriesStyle;
+using products::write_svg;
 namespace {
 
 using namespace adit::slam;

@@ -17,9 +17,17 @@
 #include "adit/eval/trajectory_io.hpp"
 #include "adit/slam/tum.hpp"
 #include "eval_commands.hpp"
-#include "svg_plot.hpp"
+#include "adit/products/svg_plot.hpp"
 
 namespace adit::tools {
+
+using products::kColorEstimate;
+using products::kColorReference;
+using products::kColorSecond;
+using products::Plot;
+using products::PlotSeries;
+using products::SeriesStyle;
+using products::write_svg;
 namespace {
 
 using namespace adit::slam;

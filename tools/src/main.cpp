@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
     adit::tools::register_console_commands(app, status);
     adit::tools::register_sim_commands(app, status);
     adit::tools::register_replay_commands(app, status);
+    adit::tools::register_products_commands(app, status);
+    adit::tools::register_targets_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {

@@ -1,4 +1,4 @@
-#include "svg_plot.hpp"
+#include "adit/products/svg_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include "adit/common/error.hpp"
 
-namespace adit::tools {
+namespace adit::products {
 namespace {
 
 struct Range {
@@ -160,7 +160,8 @@ std::string render_svg(const Plot& plot) {
     } else if (s.style == SeriesStyle::points) {
       for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
         svg +=
-            fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"{}\"/>\n", px(s.x[i]), py(s.y[i]), s.color);
+            fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{}\" fill=\"{}\"/>\n", px(s.x[i]), py(s.y[i]),
+                        s.point_radius, s.color);
     } else {
       const double group = 0.8 / static_cast<double>(bar_count);
       for (std::size_t k = 0; k < s.y.size(); ++k) {
@@ -174,6 +175,9 @@ std::string render_svg(const Plot& plot) {
     }
   }
   svg += "</g>\n";
+  for (const PlotText& t : plot.texts)
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"{}\" fill=\"{}\" font-weight=\"bold\">{}</text>\n",
+                       px(t.x), py(t.y) + t.dy_px, t.anchor, t.color, escape(t.text));
 
   // Legend in one row above the plot, right-aligned, so it never hides data.
   double lx = left + pw;
@@ -194,4 +198,4 @@ void write_svg(const std::filesystem::path& path, const Plot& plot) {
   if (!out) throw InputError(path.string(), "", "cannot write the plot");
 }
 
-}  // namespace adit::tools
+}  // namespace adit::products

@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "svg_plot.hpp"
+#include "adit/products/svg_plot.hpp"
 
-namespace adit::tools {
+namespace adit::products {
 namespace {
 
 std::size_t count(const std::string& text, const std::string& what) {
@@ -45,4 +45,4 @@ TEST(SvgPlot, TinySpanFarFromZeroStillEnds) {
 }
 
 }  // namespace
-}  // namespace adit::tools
+}  // namespace adit::products

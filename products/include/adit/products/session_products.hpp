@@ -1,0 +1,69 @@
+#pragma once
+// The products of a finished session, made from its folder (map.las/.ply/.pcd,
+// map_trajectory.tum, config.yaml): the 3D occupancy
+// (.bt, .ot), the 2D occupancy grid (PGM + YAML), and their figures in
+// products.json (and in summary.json's "products" when there is one). aditd
+// calls write_session_products() after a session has stopped, from a thread
+// of its own (the next session may start meanwhile); `adit products` calls
+// it for any session folder. docs/PRODUCTS.md says how each step works.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "adit/products/cross_sections.hpp"
+#include "adit/products/ground.hpp"
+#include "adit/products/occupancy_3d.hpp"
+#include "adit/products/outlier_filter.hpp"
+#include "adit/products/session_map.hpp"
+#include "adit/products/top_view.hpp"
+
+namespace adit::products {
+
+struct ProductsOptions {
+  RayOptions rays;
+  Occupancy3dOptions occupancy;
+  GroundOptions ground;
+  OutlierOptions outliers;
+  double grid_resolution_m = 0.05;  // the 2D grid's cells; 0.01 .. 1
+  double band_low_m = 0.15;         // heights above the ground that block a robot / count as its free space
+  double band_high_m = 2.0;
+  bool write_ot = false;            // the full-probability octree beside the .bt
+  bool line_of_sight_fill = true;   // fill_line_of_sight (grid_projection.hpp)
+  double fill_range_m = 40.0;       // aditd's map.max_range_m
+  double fill_step_m = 1.0;         // a viewpoint every metre of path
+  TopViewOptions top_view;
+  SectionOptions sections;
+};
+
+struct ProductsReport {
+  std::size_t points = 0;
+  std::size_t without_ray = 0;  // no line of sight to the path found: occupied, casting no free space
+  std::size_t ground_points = 0;
+  std::size_t outliers_removed = 0;
+  std::size_t leaves = 0;
+  std::size_t grid_occupied = 0, grid_free = 0, grid_unknown = 0;
+  std::size_t grid_filled = 0;  // of the free cells, those the line-of-sight fill made free
+  std::string points_file;          // the session's map file (map.las, .ply or .pcd)
+  std::uintmax_t points_bytes = 0;
+  std::uintmax_t bt_bytes = 0;
+  std::uintmax_t ot_bytes = 0;
+  std::uintmax_t grid_bytes = 0;    // PGM + YAML
+  std::uintmax_t top_view_bytes = 0;
+  std::size_t sections = 0, sections_measured = 0;  // measured: width and height both found
+  double cpu_s = 0.0;               // this thread's CPU time for all of it
+  std::filesystem::path out_dir;
+};
+
+// Checks the options; throws adit::InputError naming the option.
+void check_options(const ProductsOptions& options);
+
+// Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
+// sections/section_NNN.svg and sections/sections.csv, products.json;
+// OUT_DIR defaults to SESSION_DIR/products. Adds "products" to
+// SESSION_DIR/summary.json when it exists (written to a temporary file and
+// renamed). Throws adit::InputError for a missing or bad session file.
+ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
+                                      const std::filesystem::path& out_dir = {});
+
+}  // namespace adit::products

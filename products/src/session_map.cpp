@@ -1,0 +1,112 @@
+#include "adit/products/session_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "adit/common/error.hpp"
+#include "adit/config/load.hpp"
+#include "adit/protocol/map_import.hpp"
+#include "adit/slam/tum.hpp"
+
+namespace adit::products {
+namespace {
+
+// A voxel's key: 21 bits a coordinate (±105 km at 0.1 m).
+std::uint64_t key_of(const Eigen::Vector3f& p, float inv_voxel) {
+  const auto c = [&](float v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv_voxel)) + (1 << 20)) & 0x1FFFFF; };
+  return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
+}
+
+}  // namespace
+
+std::filesystem::path map_file_of(const std::filesystem::path& dir) {
+  for (const char* name : {"map.las", "map.ply", "map.pcd"})
+    if (std::filesystem::exists(dir / name)) return dir / name;
+  throw InputError((dir / "map.las").string(), "", "no map.las, map.ply or map.pcd in the session folder");
+}
+
+SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::Trajectory& body_poses,
+                     const Eigen::Isometry3d& body_to_sensor, const RayOptions& o) {
+  SessionMap m;
+  m.points.reserve(points.size());
+  m.intensities.reserve(points.size());
+  for (const protocol::MapPoint& p : points) {
+    m.points.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+    m.intensities.push_back(p.intensity);
+  }
+  m.sensor_path.reserve(body_poses.size());
+  for (std::size_t i = 0; i < body_poses.size(); ++i) {
+    const slam::Pose s = body_poses.poses[i] * body_to_sensor;
+    m.sensor_path.push_back(body_poses.stamps[i], s);
+    const Eigen::Vector3f at = s.translation().cast<float>();
+    if (m.viewpoints.empty() || (at - m.viewpoints.back()).norm() >= o.path_step_m) m.viewpoints.push_back(at);
+  }
+  m.origin.assign(m.points.size(), -1);
+  if (m.viewpoints.empty() || m.points.empty()) return m;
+
+  const float inv_voxel = static_cast<float>(1.0 / o.voxel_m);
+  std::unordered_set<std::uint64_t> occupied;
+  occupied.reserve(m.points.size());
+  for (const Eigen::Vector3f& p : m.points) occupied.insert(key_of(p, inv_voxel));
+  const auto visible = [&](const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
+    const Eigen::Vector3f d = to - from;
+    const float length = d.norm();
+    const float step = static_cast<float>(o.voxel_m) / 2;
+    const float stop = length - static_cast<float>(o.end_clearance_m);
+    for (float t = step; t < stop; t += step)
+      if (occupied.contains(key_of(from + d * (t / length), inv_voxel))) return false;
+    return true;
+  };
+
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const Eigen::Vector3f& v : m.viewpoints) cloud->push_back(pcl::PointXYZ(v.x(), v.y(), v.z()));
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  const int k = std::min<int>(o.candidates, static_cast<int>(m.viewpoints.size()));
+  pcl::Indices nearest(static_cast<std::size_t>(k));
+  std::vector<float> d2(static_cast<std::size_t>(k));
+  const float max2 = static_cast<float>(o.max_range_m * o.max_range_m);
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const Eigen::Vector3f& p = m.points[i];
+    const int found = tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), k, nearest, d2);
+    for (int j = 0; j < found; ++j) {
+      if (d2[static_cast<std::size_t>(j)] > max2) break;
+      const auto v = static_cast<std::int32_t>(nearest[static_cast<std::size_t>(j)]);
+      if (visible(m.viewpoints[static_cast<std::size_t>(v)], p)) {
+        m.origin[i] = v;
+        break;
+      }
+    }
+    m.without_ray += m.origin[i] < 0;
+  }
+  return m;
+}
+
+SessionMap read_session_map(const std::filesystem::path& session_dir, const RayOptions& options) {
+  const std::filesystem::path map_file = map_file_of(session_dir);
+  const std::vector<protocol::MapPoint> points = protocol::read_map(map_file);
+  if (points.empty()) throw InputError(map_file.string(), "", "the map has no points");
+  const slam::Trajectory poses = slam::read_tum(session_dir / "map_trajectory.tum");
+  Eigen::Isometry3d body_to_sensor = Eigen::Isometry3d::Identity();
+  const std::filesystem::path config_file = session_dir / "config.yaml";
+  if (std::filesystem::exists(config_file)) {
+    const config::Config c = config::load_config(config_file);
+    const config::Transform& e = c.lidar.extrinsics;  // xyz, then roll-pitch-yaw Z·Y·X as aditd applies it
+    const double k = M_PI / 180.0;
+    body_to_sensor.linear() = (Eigen::AngleAxisd(e.rpy_deg[2] * k, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(e.rpy_deg[1] * k, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(e.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+    body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
+  }
+  return rays_from(points, poses, body_to_sensor, options);
+}
+
+}  // namespace adit::products

@@ -1,0 +1,161 @@
+#include "adit/products/session_products.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "adit/common/error.hpp"
+#include "adit/products/grid_io.hpp"
+#include "adit/products/grid_projection.hpp"
+#include "adit/products/session_map.hpp"
+
+namespace adit::products {
+namespace {
+
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
+  return {{"points", r.points},
+          {"points_without_ray", r.without_ray},
+          {"ground_points", r.ground_points},
+          {"outliers_removed", r.outliers_removed},
+          {"octree_leaves", r.leaves},
+          {"octree_resolution_m", o.occupancy.resolution_m},
+          {"grid_resolution_m", o.grid_resolution_m},
+          {"grid_cells", {{"occupied", r.grid_occupied}, {"free", r.grid_free}, {"unknown", r.grid_unknown},
+                          {"free_by_line_of_sight_fill", r.grid_filled}}},
+          {"points_file", r.points_file},
+          {"bytes", {{"points", r.points_bytes}, {"octree_bt", r.bt_bytes}, {"octree_ot", r.ot_bytes}, {"grid", r.grid_bytes}}},
+          {"top_view_bytes", r.top_view_bytes},
+          {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
+                        {"width_at_m", o.sections.width_at_m}}},
+          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml",
+                                                        "top_view.png", "sections/"})
+                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml", "top_view.png",
+                                                        "sections/"})},
+          {"cpu_s", r.cpu_s}};
+}
+
+// summary.json gains "products"; written beside and renamed, so a reader
+// never sees half a file.
+void add_to_summary(const std::filesystem::path& summary, const nlohmann::json& products) {
+  if (!std::filesystem::exists(summary)) return;
+  nlohmann::json s;
+  {
+    std::ifstream in(summary);
+    s = nlohmann::json::parse(in, nullptr, false);
+  }
+  if (s.is_discarded() || !s.is_object()) throw InputError(summary.string(), "", "is not a JSON object");
+  s["products"] = products;
+  std::filesystem::path tmp = summary;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << s.dump(2) << "\n";
+    if (!out) throw InputError(tmp.string(), "", "write failed");
+  }
+  std::filesystem::rename(tmp, summary);
+}
+
+
+}  // namespace
+
+void check_options(const ProductsOptions& o) {
+  const auto require = [](bool ok, const char* key, const std::string& what) {
+    if (!ok) throw InputError("options", key, what);
+  };
+  require(o.grid_resolution_m >= 0.01 - 1e-12 && o.grid_resolution_m <= 1.0, "grid-resolution",
+          fmt::format("{} m is outside 0.01 .. 1 m", o.grid_resolution_m));
+  require(o.occupancy.resolution_m >= 0.01 - 1e-12 && o.occupancy.resolution_m <= 1.0, "octree-resolution",
+          fmt::format("{} m is outside 0.01 .. 1 m", o.occupancy.resolution_m));
+  require(o.band_low_m < o.band_high_m, "band", "the band's low height must be below its high one");
+  require(o.outliers.k >= 1 && o.outliers.stddev_mult > 0.0, "sor", "k >= 1 and a positive stddev multiple");
+  require(o.ground.patch_m > 0.0 && o.ground.distance_m > 0.0, "ground", "patch and distance must be positive");
+  require(o.sections.interval_m > 0.0, "section-interval", "must be positive");
+}
+
+ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
+                                      const std::filesystem::path& out_dir) {
+  check_options(options);
+  const double cpu0 = thread_cpu_s();
+  ProductsReport r;
+  r.out_dir = out_dir.empty() ? session_dir / "products" : out_dir;
+  const SessionMap map = read_session_map(session_dir, options.rays);
+  r.without_ray = map.without_ray;
+  r.points = map.points.size();
+  r.points_file = map_file_of(session_dir).filename().string();
+  r.points_bytes = std::filesystem::file_size(session_dir / r.points_file);
+
+  const GroundSegmentation ground = segment_ground(map.points, options.ground);
+  r.ground_points = ground.ground_points;
+  std::vector<std::uint8_t> non_ground(map.points.size());
+  for (std::size_t i = 0; i < non_ground.size(); ++i) non_ground[i] = ground.is_ground[i] ? 0 : 1;
+  const std::vector<std::uint8_t> kept = statistical_inliers(map.points, non_ground, options.outliers);
+  r.outliers_removed = static_cast<std::size_t>(std::count(non_ground.begin(), non_ground.end(), 1) -
+                                                std::count(kept.begin(), kept.end(), 1));
+
+  // Rays in batches of one viewpoint (OctoMap counts a voxel once per batch).
+  std::vector<std::size_t> order;
+  order.reserve(map.points.size());
+  for (std::size_t i = 0; i < map.points.size(); ++i)
+    if (map.origin[i] >= 0) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return map.origin[a] < map.origin[b]; });
+  Occupancy3d occupancy(options.occupancy);
+  std::vector<Eigen::Vector3f> hits, passes;
+  for (std::size_t begin = 0; begin < order.size();) {
+    std::size_t end = begin;
+    hits.clear();
+    passes.clear();
+    for (; end < order.size() && map.origin[order[end]] == map.origin[order[begin]]; ++end) {
+      const std::size_t i = order[end];
+      if (kept[i]) hits.push_back(map.points[i]);
+      else if (ground.is_ground[i]) passes.push_back(map.points[i]);
+      // an outlier casts no ray: its range is what is in doubt
+    }
+    occupancy.insert(map.viewpoints[static_cast<std::size_t>(map.origin[order[begin]])], hits, passes);
+    begin = end;
+  }
+  Grid2d grid = project_to_grid(occupancy, map.points, kept, ground.is_ground, ground.model,
+                                {options.grid_resolution_m, options.band_low_m, options.band_high_m});
+  if (options.line_of_sight_fill)
+    r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
+  r.grid_occupied = grid.count(kOccupied);
+  r.grid_free = grid.count(kFree);
+  r.grid_unknown = grid.count(kUnknown);
+
+  std::filesystem::create_directories(r.out_dir);
+  r.grid_bytes = write_grid(r.out_dir / "grid", grid);
+  if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
+  r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");
+  r.leaves = occupancy.leaf_count();
+  r.top_view_bytes =
+      write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, {}, options.top_view).bytes;
+  const std::vector<CrossSection> sections = cut_sections(map.points, map.sensor_path, options.sections);
+  std::filesystem::create_directories(r.out_dir / "sections");
+  for (const CrossSection& c : sections) {
+    write_section_svg(r.out_dir / "sections" / fmt::format("section_{:03d}.svg", c.id), c, options.sections);
+    r.sections_measured += std::isfinite(c.width_m) && std::isfinite(c.height_m);
+  }
+  r.sections = sections.size();
+  write_sections_csv(r.out_dir / "sections" / "sections.csv", sections);
+  r.cpu_s = thread_cpu_s() - cpu0;
+  const nlohmann::json json = report_json(r, options);
+  {
+    std::ofstream out(r.out_dir / "products.json");
+    out << json.dump(2) << "\n";
+    if (!out) throw InputError((r.out_dir / "products.json").string(), "", "write failed");
+  }
+  add_to_summary(session_dir / "summary.json", json);
+  return r;
+}
+
+}  // namespace adit::products

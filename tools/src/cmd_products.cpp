@@ -1,0 +1,67 @@
+// adit products SESSION_DIR: the products of a finished session (3D
+// occupancy, 2D grid) written from its folder, with their storage figures
+// (docs/PRODUCTS.md).
+
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/products/session_products.hpp"
+#include "commands.hpp"
+
+namespace adit::tools {
+namespace {
+
+struct ProductsCommand {
+  std::string session;
+  std::string out;
+  products::ProductsOptions options;
+};
+
+std::string kib(std::uintmax_t bytes) { return fmt::format("{:.1f} kB", static_cast<double>(bytes) / 1000.0); }
+
+void run_products(const ProductsCommand& c) {
+  const products::ProductsReport r = products::write_session_products(c.session, c.options, c.out);
+  fmt::print("products of {} in {}\n", c.session, r.out_dir.string());
+  fmt::print("points            {} ({} ground, {} outliers removed, {} without a line of sight to the path)\n", r.points,
+             r.ground_points, r.outliers_removed, r.without_ray);
+  fmt::print("octree            {} leaves at {} m\n", r.leaves, c.options.occupancy.resolution_m);
+  fmt::print("grid              {} occupied, {} free ({} by the line-of-sight fill), {} unknown cells at {} m\n",
+             r.grid_occupied, r.grid_free, r.grid_filled, r.grid_unknown, c.options.grid_resolution_m);
+  fmt::print("storage           points {} -> 3D {} (.bt){} -> 2D {} (PGM + YAML)\n", kib(r.points_bytes),
+             kib(r.bt_bytes), r.ot_bytes > 0 ? fmt::format(", {} (.ot)", kib(r.ot_bytes)) : "", kib(r.grid_bytes));
+  fmt::print("pictures          top_view.png ({}), {} cross-sections ({} measured) every {} m in sections/\n",
+             kib(r.top_view_bytes), r.sections, r.sections_measured, c.options.sections.interval_m);
+  fmt::print("cpu               {:.2f} s\n", r.cpu_s);
+}
+
+}  // namespace
+
+void register_products_commands(CLI::App& app, int& status) {
+  auto* cmd = app.add_subcommand("products", "A finished session's products: 3D occupancy (.bt), 2D grid (PGM + YAML)");
+  auto c = std::make_shared<ProductsCommand>();
+  products::ProductsOptions& o = c->options;
+  cmd->add_option("session", c->session, "The session folder (map.ply, map_trajectory.tum, config.yaml)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--out", c->out, "Where to write (default SESSION/products)");
+  cmd->add_option("--grid-resolution", o.grid_resolution_m, "2D grid cell (m), 0.01 .. 1 (default 0.05)");
+  cmd->add_option("--octree-resolution", o.occupancy.resolution_m, "3D voxel (m), 0.01 .. 1 (default 0.1)");
+  cmd->add_option("--band", o.band_low_m, "Lowest height above the ground that blocks (m, default 0.15)");
+  cmd->add_option("--band-high", o.band_high_m, "Highest height above the ground that blocks (m, default 2.0)");
+  cmd->add_option("--sor-k", o.outliers.k, "Statistical outlier removal: neighbours (default 15)");
+  cmd->add_option("--sor-stddev", o.outliers.stddev_mult, "Statistical outlier removal: stddev multiple (default 1.0)");
+  cmd->add_option("--ground-distance", o.ground.distance_m, "Ground: distance to the patch plane (m, default 0.12)");
+  cmd->add_option("--section-interval", o.sections.interval_m, "Cross-sections every this many m of path (default 10)");
+  cmd->add_option("--section-width-at", o.sections.width_at_m, "Widths measured this high above the floor (m, default 1.5)");
+  cmd->add_option("--ray-candidates", o.rays.candidates, "Path positions tried for each point's line of sight (default 12)");
+  cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
+  cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");
+  cmd->callback([c, &status] {
+    run_products(*c);
+    status = kExitOk;
+  });
+}
+
+}  // namespace adit::tools

@@ -1,0 +1,55 @@
+// adit eval grid: a 2D occupancy grid (map_server PGM + YAML, as `adit
+// products` writes it) against the simulator's scene: IoU of free and of
+// occupied cells over what the path could see (eval/grid_truth.hpp).
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
+#include "adit/eval/grid_truth.hpp"
+#include "adit/products/grid_io.hpp"
+#include "eval_commands.hpp"
+
+namespace adit::tools {
+
+void run_eval_grid(const GridEvalOptions& o) {
+  const products::Grid2d grid = products::read_grid(o.grid);
+  const std::vector<eval::Triangle> scene = scene_triangles(o.scene);
+  const Eigen::Isometry3d map_from_world = world_from_map(o.ref, o.est).inverse();
+  const slam::Trajectory ref = timed_trajectory(o.ref);
+  const slam::Trajectory est = timed_trajectory(o.est);
+  std::vector<Eigen::Vector3d> path;  // the truth over the estimate's time span
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    if (ref.stamps[i] >= est.stamps.front() && ref.stamps[i] <= est.stamps.back())
+      path.push_back(ref.poses[i].translation());
+  if (path.empty()) throw InputError(o.ref, "", fmt::format("no pose within {}'s time span", o.est));
+  eval::GridTruthOptions options;
+  options.max_range_m = o.max_range;
+  options.floor_z = o.floor_z;
+  const eval::GridTruthScore s = score_grid(
+      {grid.resolution_m, grid.origin_x, grid.origin_y, grid.width, grid.height, grid.cells}, scene, map_from_world,
+      path, options);
+  if (o.json) {
+    const nlohmann::json j = {{"iou_free", s.iou_free},
+                              {"iou_occupied", s.iou_occupied},
+                              {"iou_occupied_within_1_cell", s.iou_occupied_within_1_cell},
+                              {"iou_known", s.iou_known},
+                              {"truth_free", s.truth_free},
+                              {"truth_occupied", s.truth_occupied},
+                              {"grid_free", s.grid_free},
+                              {"grid_occupied", s.grid_occupied},
+                              {"cell_m", options.cell_m},
+                              {"max_range_m", options.max_range_m}};
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  fmt::print("grid              {} x {} cells of {} m; truth on a {} m lattice, within {} m of the path\n", grid.width,
+             grid.height, grid.resolution_m, options.cell_m, options.max_range_m);
+  fmt::print("cells             truth free {}, occupied {}; grid free {}, occupied {}\n", s.truth_free,
+             s.truth_occupied, s.grid_free, s.grid_occupied);
+  fmt::print("iou free          {:.4f}\n", s.iou_free);
+  fmt::print("iou occupied      {:.4f}\n", s.iou_occupied);
+  fmt::print("iou occupied ±1   {:.4f}\n", s.iou_occupied_within_1_cell);
+  fmt::print("iou known         {:.4f}\n", s.iou_known);
+}
+
+}  // namespace adit::tools
