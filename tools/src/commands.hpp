@@ -22,5 +22,6 @@ void register_client_commands(CLI::App& app, int& status);
 void register_download_commands(CLI::App& app, int& status);
 void register_sim_commands(CLI::App& app, int& status);
 void register_replay_commands(CLI::App& app, int& status);
+void register_prior_map_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools
