@@ -253,8 +253,10 @@ LocalisationResult localise(std::span<const Eigen::Vector3f> cloud, const PriorM
     result.failure = fmt::format("ambiguous: a pose {:.1f} m away leaves nearly as few points unexplained (overlap "
                                  "{:.2f} against {:.2f})",
                                  result.rival_distance_m, result.rival_overlap, best.overlap);
-  } else if (best.degenerate) {
-    result.failure = "ill-conditioned: the registration cannot fix every direction here (a featureless corridor?)";
+  } else if (best.degenerate || best.weakest < config.min_weakest_eigenvalue) {
+    result.failure = fmt::format("ill-conditioned: the registration's weakest direction has {:.3f} (at least {:.3f}): "
+                                 "too little fixes it here (a long corridor?)",
+                                 best.weakest, config.min_weakest_eigenvalue);
   } else if (position_sigma > config.max_position_sigma_m || yaw_sigma > config.max_yaw_sigma_rad) {
     result.failure = fmt::format("uncertain: σ {:.3f} m, {:.2f}° (limits {:.3f} m, {:.2f}°)", position_sigma,
                                  yaw_sigma * 180.0 / std::numbers::pi, config.max_position_sigma_m,

@@ -16,32 +16,48 @@ struct KeyHash {
 }  // namespace
 
 std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
-                                     std::span<const Eigen::Vector3f> viewpoints, const VoxelHashMap& index,
+                                     std::span<const Eigen::Vector3f> viewpoints, const PriorMap& prior,
                                      const DeviationConfig& config) {
   VoxelHashMap views(config.viewpoint_voxel_m, std::max<std::size_t>(1024, 2 * viewpoints.size()));
   views.add(viewpoints);
+  // The prior's points by cell of max_distance_m: the 27 cells round a point hold every one within reach.
+  const float inv = 1.0F / config.max_distance_m;
+  std::unordered_map<VoxelKey, std::vector<std::uint32_t>, KeyHash> cells;
+  for (std::size_t i = 0; i < prior.points.size(); ++i) cells[voxel_key(prior.points[i], inv)].push_back(static_cast<std::uint32_t>(i));
+  const float reach2 = config.max_distance_m * config.max_distance_m;
   std::vector<float> out(points.size(), config.max_distance_m);
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points[i];
-    const MapPlane plane = index.nearest_plane(p, config.plane_neighbors, 0.5F * config.max_distance_m);
+    const VoxelKey c = voxel_key(p, inv);
+    float best = reach2;
+    std::int64_t nearest = -1;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find(VoxelKey{c.x + dx, c.y + dy, c.z + dz});
+          if (it == cells.end()) continue;
+          for (const std::uint32_t k : it->second) {
+            const float d2 = (prior.points[k] - p).squaredNorm();
+            if (d2 < best) {
+              best = d2;
+              nearest = k;
+            }
+          }
+        }
+    if (nearest < 0) continue;  // the designed free space: +max_distance_m
+    const Eigen::Vector3f delta = p - prior.points[static_cast<std::size_t>(nearest)];
+    Eigen::Vector3f normal = prior.normals[static_cast<std::size_t>(nearest)];
     float d = 0.0F;
-    Eigen::Vector3f normal;
-    if (plane.found && (plane.point - p).norm() < config.max_distance_m) {
-      normal = plane.normal;
-      d = normal.dot(p - plane.point);
+    if (!normal.isZero()) {
+      d = normal.dot(delta);
     } else {
-      // An edge or corner of the prior (no plane), or nothing near: the nearest point's distance.
-      const MapNeighbor near = index.nearest(p, config.max_distance_m);
-      if (!near.found) continue;  // the designed free space: +max_distance_m
-      const Eigen::Vector3f delta = p - near.point;
       d = delta.norm();
       normal = d > 0.0F ? Eigen::Vector3f(delta / d) : Eigen::Vector3f::UnitZ();
-      d = normal.dot(delta);
     }
     // Towards the observer is positive.
     const MapNeighbor view = views.nearest(p);
-    if (view.found && normal.dot(view.point - p) < 0.0F) d = -d;
-    else if (!view.found) d = std::abs(d);
+    if (view.found && normal.dot(view.point - p) * d < 0.0F) d = -std::abs(d);
+    else d = std::abs(d);
     out[i] = std::clamp(d, -config.max_distance_m, config.max_distance_m);
   }
   return out;

@@ -52,9 +52,12 @@ struct LocalisationConfig {
   // The best distinct rival must leave at least this many times the best's
   // unexplained wall points (1 − overlap): most of a cloud is long walls that
   // fit anywhere along them, so the overlaps themselves differ little.
-  double min_rival_miss_ratio = 2.0;
+  double min_rival_miss_ratio = 1.5;
   double rival_m = 0.3;                  // refined poses this far apart (or rival_rad) are rivals, not one answer
   double rival_rad = 0.035;
+  // The refinement's weakest normalised Hessian eigenvalue (RegistrationResult)
+  // must clear the odometry's degeneracy threshold (0.01) by this much.
+  double min_weakest_eigenvalue = 0.03;
   double point_sigma_m = 0.05;           // σ of one residual for the reported covariance (range noise, planes)
   double max_position_sigma_m = 0.05;    // the refinement's covariance must be at least this tight
   double max_yaw_sigma_rad = 0.0035;

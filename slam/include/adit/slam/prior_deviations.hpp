@@ -2,10 +2,10 @@
 // As-built against as-designed: each map point's signed distance to the
 // prior's surface, and the regions that deviate by more than a threshold.
 //
-// The distance is along the normal of the prior's local plane through the
-// points nearest the map point (point-to-plane, as the registration measures;
-// a prior sampled every 10 cm gives 7 cm point-to-point for a point lying on
-// it). Its sign faces the observer: positive in front of the designed
+// The distance is along the normal of the prior point nearest the map point
+// (point-to-plane, as the registration measures: a prior sampled every 10 cm
+// is up to 7 cm away point-to-point from a point lying on its surface; where
+// that point has no normal, an edge, the point-to-point distance). Its sign faces the observer: positive in front of the designed
 // surface (something built into the designed space: furniture, a wall moved
 // in), negative behind it (a wall moved out, a missing column's place). A
 // point with no prior surface within `max_distance_m` stands in the designed
@@ -17,23 +17,22 @@
 
 #include <Eigen/Core>
 
-#include "adit/slam/voxel_hash_map.hpp"
+#include "adit/slam/prior_map.hpp"
 
 namespace adit::slam {
 
 struct DeviationConfig {
   float threshold_m = 0.05F;       // |deviation| above this: deviating
-  float max_distance_m = 0.5F;     // at most the prior index's voxel edge
-  int plane_neighbors = 8;
+  float max_distance_m = 0.5F;     // beyond: the designed free space
   float region_voxel_m = 0.2F;     // connectivity of a region
   std::size_t min_region_points = 50;
   float viewpoint_voxel_m = 5.0F;  // viewpoints are looked up within 1.5 of these voxels (farther: the sign stays +)
 };
 
 // `points` and `viewpoints` (sensor positions along the trajectory) in the
-// prior's frame; `index`: index_prior_map(prior) with a voxel of at least max_distance_m.
+// prior's frame.
 std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
-                                     std::span<const Eigen::Vector3f> viewpoints, const VoxelHashMap& index,
+                                     std::span<const Eigen::Vector3f> viewpoints, const PriorMap& prior,
                                      const DeviationConfig& config = {});
 
 struct DeviationRegion {

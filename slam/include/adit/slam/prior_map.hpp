@@ -26,7 +26,7 @@ namespace adit::slam {
 struct PriorMapConfig {
   float point_spacing_m = 0.1F;     // downsampling voxel of the prior's points
   float normal_radius_m = 0.35F;    // voxel of the index the normals' neighbours are searched in
-  int normal_neighbors = 12;        // points a normal's plane is fitted through
+  int normal_neighbors = 7;         // points a normal's plane is fitted through: few, so both faces of a 0.2 m partition are not mixed
   float plan_cell_m = 0.25F;        // plan-view cell (the coarse search's translation step)
   float plan_sigma_m = 0.25F;       // width of the plan's likelihood field round a wall
   float vertical_max_nz = 0.3F;     // |n_z| below this: a vertical surface (wall, pillar)
