@@ -63,6 +63,23 @@ std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
   return out;
 }
 
+std::vector<float> smooth_deviations(std::span<const Eigen::Vector3f> points, std::span<const float> deviations,
+                                     float voxel_m) {
+  std::unordered_map<VoxelKey, std::pair<double, int>, KeyHash> sums;
+  const float inv = 1.0F / voxel_m;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    auto& [sum, n] = sums[voxel_key(points[i], inv)];
+    sum += deviations[i];
+    ++n;
+  }
+  std::vector<float> out(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto& [sum, n] = sums.at(voxel_key(points[i], inv));
+    out[i] = static_cast<float>(sum / n);
+  }
+  return out;
+}
+
 std::vector<DeviationRegion> deviation_regions(std::span<const Eigen::Vector3f> points,
                                                std::span<const float> deviations, const DeviationConfig& config,
                                                std::span<int> member) {

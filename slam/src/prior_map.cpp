@@ -18,6 +18,8 @@ std::size_t capacity_for(std::size_t n, float spacing, float voxel) {
   return std::max<std::size_t>(1024, static_cast<std::size_t>(2.0 * static_cast<double>(n) / per_voxel));
 }
 
+constexpr float kMaxPlanExtentM = 5000.0F;
+
 PlanGrid draw_plan(const PriorMap& prior, const PriorMapConfig& config) {
   PlanGrid plan;
   plan.cell_m = config.plan_cell_m;
@@ -27,6 +29,9 @@ PlanGrid draw_plan(const PriorMap& prior, const PriorMapConfig& config) {
     lo = lo.cwiseMin(p.head<2>());
     hi = hi.cwiseMax(p.head<2>());
   }
+  // A plan larger than 5 km a side is not a site (millimetres read as metres):
+  // left empty, and check_prior_map says why.
+  if ((hi - lo).maxCoeff() > kMaxPlanExtentM) return plan;
   const float margin = 1.0F;
   plan.origin = lo - Eigen::Vector2f::Constant(margin);
   plan.width = static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * margin) / plan.cell_m)) + 1;
@@ -122,15 +127,28 @@ std::string check_prior_map(const PriorMap& prior) {
     return fmt::format("it spans {:.0f} x {:.0f} x {:.0f} m: millimetres read as metres? (scale it by 0.001)",
                        extent.x(), extent.y(), extent.z());
   const double n = static_cast<double>(prior.points.size());
-  if (static_cast<double>(prior.horizontal_points) < 0.05 * n && static_cast<double>(y_facing) > 0.2 * n)
-    return fmt::format("only {:.1f} % of its surfaces face up or down but {:.1f} % face along y: exported Y-up? "
-                       "(rotate it to z up)",
-                       100.0 * static_cast<double>(prior.horizontal_points) / n, 100.0 * static_cast<double>(y_facing) / n);
+  if (prior.plan.likelihood.empty()) return "no plan could be drawn";
   if (static_cast<double>(prior.vertical_points) < 0.05 * n)
     return fmt::format("only {:.1f} % of its surfaces are vertical: no walls to localise on",
                        100.0 * static_cast<double>(prior.vertical_points) / n);
   if (static_cast<double>(prior.horizontal_points) < 0.01 * n)
-    return "it has no floor (no upward-facing horizontal surface): z up?";
+    return "it has no floor (no horizontal surface): z up?";
+  // A Y-up export read as Z-up turns a storey on its side: taller than it is wide.
+  if (extent.z() > std::min(extent.x(), extent.y()))
+    return fmt::format("it is {:.1f} m tall but {:.1f} m wide: exported Y-up? (rotate it to z up: --up y)", extent.z(),
+                       std::min(extent.x(), extent.y()));
+  // Floors standing upright (a Y-up export read as Z-up) cover the plan with
+  // walls: hardly a floor cell is clear of them.
+  std::size_t floor = 0, free = 0;
+  for (std::size_t c = 0; c < prior.plan.floor_z.size(); ++c) {
+    if (std::isnan(prior.plan.floor_z[c])) continue;
+    ++floor;
+    free += prior.plan.wall_distance[c] >= 0.3F ? 1 : 0;
+  }
+  if (static_cast<double>(free) < 0.1 * static_cast<double>(floor))
+    return fmt::format("only {} of its {} floor cells are clear of walls, {:.1f} % of its surfaces face along y: "
+                       "exported Y-up? (rotate it to z up: --up y)",
+                       free, floor, 100.0 * static_cast<double>(y_facing) / n);
   return {};
 }
 
