@@ -196,6 +196,12 @@ struct SessionSection {
   std::vector<std::string> exports{"ply", "las"};  // map files written when a session stops
 };
 
+// A prior map (BIM export, design model, earlier survey) prepared by
+// `adit prior-map prepare IN --out DIR` (docs/PRIOR-MAP.md).
+struct PriorMapSection {
+  std::string dir;  // the prepared folder (prior_map.bin); empty: no prior
+};
+
 struct LcmSection {
   std::string url = "udpm://239.255.76.67:7667?ttl=1";
 };
@@ -226,6 +232,7 @@ struct Config {
   GpioSection gpio;
   MapSection map;
   SessionSection session;
+  PriorMapSection prior_map;
   LcmSection lcm;
   ThreadsSection threads;
 };

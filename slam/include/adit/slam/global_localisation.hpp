@@ -47,7 +47,7 @@ struct LocalisationConfig {
   double distinct_m = 1.0;               // peaks closer than this (and distinct_rad) are one
   double distinct_rad = 0.15;
   // Checks (docs/decisions/022-prior-map-correlative-search.md).
-  double min_overlap = 0.6;              // share of wall points within overlap_m of the prior after refinement
+  double min_overlap = 0.9;              // share of wall points within overlap_m of the prior after refinement
   double overlap_m = 0.15;               // the prior index is thinned to 1/4 of its 0.5 m voxel: a point on a surface is within 0.09 m of one
   // The best distinct rival must leave at least this many times the best's
   // unexplained wall points (1 − overlap): most of a cloud is long walls that
