@@ -18,6 +18,7 @@
 #include "adit/daemon/payload_panel.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "adit/daemon/supervisor.hpp"
+#include "adit/slam/prior_map_file.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -88,6 +89,22 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   log::info("configuration {}: payload '{}', lidar {} from {}", config_file.string(), config.payload.id,
             config.lidar.model, source_name(config.lidar.source));
   if (!keep_large_blocks_mmapped()) log::warn("malloc: cannot fix the mmap threshold; a long session's RSS may creep");
+  // The prior map (prior_map.dir) is read and checked at start, so a bad one is
+  // named before a flight; the odometry goes on without it when it is unusable.
+  // Localising against it and correcting drift live are not wired in yet
+  // (docs/PRIOR-MAP.md, "Not done").
+  if (!config.prior_map.dir.empty()) {
+    try {
+      const slam::PriorMap prior = slam::read_prior_map(config.prior_map.dir);
+      if (const std::string problem = slam::check_prior_map(prior); !problem.empty())
+        log::error("prior map {}: not usable ({}); mapping without it", config.prior_map.dir, problem);
+      else
+        log::info("prior map {}: {} points, plan {} x {} cells", config.prior_map.dir, prior.points.size(),
+                  prior.plan.width, prior.plan.height);
+    } catch (const InputError& e) {
+      log::error("prior map: {}; mapping without it", e.what());
+    }
+  }
 
   // SIGINT/SIGTERM are taken synchronously by this thread (sigtimedwait); the
   // workers inherit the blocked mask, so no handler runs on a hot path.

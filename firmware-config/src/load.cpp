@@ -131,10 +131,16 @@ Config parse_config(std::string_view yaml, const std::string& name, const std::f
   check_consistency(config, ctx);
 
   for (std::string* path : {&config.lidar.pcap, &config.lidar.scan_dir, &config.lidar.calibration,
-                            &config.can.log, &config.can.dbc, &config.payload.state_dir})
+                            &config.can.log, &config.can.dbc, &config.payload.state_dir,
+                            &config.prior_map.dir})
     resolve(*path, base_dir);
   // "$CREDENTIALS_DIRECTORY/…" is a systemd credential, resolved by aditd at run time.
   if (!config.lcm.key_file.starts_with('$')) resolve(config.lcm.key_file, base_dir);
+  // A prior named but not prepared is caught here, before a flight (the
+  // file's contents are checked by aditd when it loads it).
+  if (!config.prior_map.dir.empty() && !std::filesystem::is_regular_file(std::filesystem::path(config.prior_map.dir) / "prior_map.bin"))
+    throw InputError(name, "prior_map.dir",
+                     fmt::format("'{}' holds no prepared prior map (adit prior-map prepare IN --out DIR)", config.prior_map.dir));
   return config;
 }
 

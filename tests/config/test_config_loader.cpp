@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "adit/common/error.hpp"
 #include "adit/config/load.hpp"
@@ -250,6 +251,28 @@ TEST(ShippedConfigs, EveryFileInFirmwareConfigIsValid) {
     EXPECT_NO_THROW(load_config(entry.path())) << entry.path();
   }
   EXPECT_GE(count, 2);
+}
+
+}  // namespace
+}  // namespace adit::config
+
+namespace adit::config {
+namespace {
+
+TEST(ConfigLoader, PriorMapMustBeAPreparedFolder) {
+  EXPECT_TRUE(parse_config(kMinimal, "test.yaml", "/base").prior_map.dir.empty());
+  try {
+    parse_config(std::string(kMinimal) + "prior_map:\n  dir: no-such-prior\n", "test.yaml", "/base");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("prior_map.dir"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/base/no-such-prior"), std::string::npos) << e.what();
+  }
+  const auto dir = std::filesystem::temp_directory_path() / "adit_config_prior";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "prior_map.bin") << "x";
+  EXPECT_EQ(parse_config(std::string(kMinimal) + "prior_map:\n  dir: " + dir.string() + "\n", "test.yaml", "/base").prior_map.dir,
+            dir.string());
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // Fuzzes the readers `adit eval map` trusts with user files: map files (PLY,
-// PCD, LAS) and the scene mesh (PLY). Bad input must end in adit::InputError,
+// PCD, LAS), the scene mesh (PLY) and prior-map meshes (OBJ, STL). Bad input must end in adit::InputError,
 // nothing else (no crash, no other exception, no sanitizer report).
 
 #include <cstddef>
@@ -8,6 +8,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/protocol/map_import.hpp"
+#include "adit/protocol/mesh_files.hpp"
 #include "adit/protocol/ply_mesh.hpp"
 
 namespace {
@@ -28,5 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const MapFormat f : {MapFormat::ply, MapFormat::pcd, MapFormat::las})
     expect_only_input_errors([&] { adit::protocol::read_map(bytes, f, "fuzz"); });
   expect_only_input_errors([&] { adit::protocol::read_ply_mesh(bytes, "fuzz.ply"); });
+  expect_only_input_errors([&] { adit::protocol::read_obj_mesh(bytes, "fuzz.obj"); });
+  expect_only_input_errors([&] { adit::protocol::read_stl_mesh(bytes, "fuzz.stl"); });
   return 0;
 }

@@ -28,5 +28,6 @@ void register_sim_commands(CLI::App& app, int& status);
 void register_replay_commands(CLI::App& app, int& status);
 void register_products_commands(CLI::App& app, int& status);
 void register_targets_commands(CLI::App& app, int& status);
+void register_prior_map_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

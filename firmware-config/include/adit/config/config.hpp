@@ -209,6 +209,12 @@ struct SessionSection {
   bool keep_journal = false;  // after a clean stop (the map files hold it all then): for audits and tests
 };
 
+// A prior map (BIM export, design model, earlier survey) prepared by
+// `adit prior-map prepare IN --out DIR` (docs/PRIOR-MAP.md).
+struct PriorMapSection {
+  std::string dir;  // the prepared folder (prior_map.bin); empty: no prior
+};
+
 struct LcmSection {
   std::string url = "udpm://239.255.76.67:7667?ttl=1";
   // Command authentication (docs/PROTOCOL.md): a key file readable only by
@@ -244,6 +250,7 @@ struct Config {
   GpioSection gpio;
   MapSection map;
   SessionSection session;
+  PriorMapSection prior_map;
   LcmSection lcm;
   ThreadsSection threads;
 };

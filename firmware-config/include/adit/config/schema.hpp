@@ -208,6 +208,11 @@ void describe(V& v, MapSection& s) {
 }
 
 template <typename V>
+void describe(V& v, PriorMapSection& s) {
+  v.optional("dir", s.dir);
+}
+
+template <typename V>
 void describe(V& v, SessionSection& s) {
   v.optional("autostart", s.autostart);
   v.optional("record_lidar", s.record_lidar);
@@ -253,6 +258,7 @@ void describe(V& v, Config& c) {
   v.section("gpio", c.gpio);
   v.section("map", c.map);
   v.section("session", c.session);
+  v.section("prior_map", c.prior_map);
   v.section("lcm", c.lcm);
   v.section("threads", c.threads);
 }

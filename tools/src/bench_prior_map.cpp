@@ -1,0 +1,249 @@
+// adit bench prior-map: global localisation from random starts of a simulated
+// session against its prior (the session's bim.ply, or --prior). Each start
+// accumulates a second of scans in a gravity-levelled frame at that start,
+// placed with the true sensor motion (what the odometry gives over one second,
+// to millimetres: docs/ODOMETRY.md) and levelled with a tilt error drawn as an
+// accelerometer's; slam::localise sees the cloud and the prior only. A start
+// counts as localised when it is reported found and lies within 0.05 m and
+// 0.5° of the truth; a start reported found beyond that is a false localisation.
+
+#include "bench_prior_map.hpp"
+
+#include <algorithm>
+#include <map>
+#include <numbers>
+#include <random>
+
+#include <time.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "adit/common/clock.hpp"
+#include "adit/common/error.hpp"
+#include "adit/common/quantile.hpp"
+#include "adit/config/load.hpp"
+#include "adit/eval/align.hpp"
+#include "adit/eval/associate.hpp"
+#include "adit/eval/interpolate.hpp"
+#include "adit/eval/trajectory_io.hpp"
+#include "adit/slam/global_localisation.hpp"
+#include "bench_scans.hpp"
+#include "prior_map_source.hpp"
+
+namespace adit::tools {
+namespace {
+
+struct Options {
+  std::string session;
+  std::string prior;
+  std::string prior_trajectory;  // the prior's session: its estimated trajectory (the prior's frame) ...
+  std::string prior_truth;       // ... and its truth, which place the prior's frame in the world
+  int starts = 40;
+  int scans = 10;
+  std::uint64_t seed = 1;
+  double hint_m = 0.0;           // > 0: give a hint this far off (at most), heading within 10°
+  double tilt_sigma_deg = 0.3;   // the levelling's error (accelerometer, 1 mg ≈ 0.06°, plus motion)
+  bool json = false;
+};
+
+struct Start {
+  std::size_t scan = 0;
+  bool reported = false;
+  bool within = false;
+  double error_m = 0.0;
+  double error_deg = 0.0;
+  double seconds = 0.0;
+  std::string failure;
+};
+
+// CPU time of this thread: the localisation on one core, whatever else the machine runs.
+std::int64_t thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+Eigen::Isometry3d yaw_only(const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d x = pose.linear().col(0);
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::AngleAxisd(std::atan2(x.y(), x.x()), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  out.translation() = pose.translation();
+  return out;
+}
+
+int run(const Options& o) {
+  const std::filesystem::path dir(o.session);
+  const config::Config cfg = config::load_config(dir / "session.yaml");
+  BenchInput input;
+  input.pcap = cfg.lidar.pcap;
+  input.model = cfg.lidar.model;
+  input.calibration = cfg.lidar.calibration;
+  const std::vector<BenchScan> scans = load_bench_scans(input);
+  const slam::Trajectory truth = eval::read_tum(dir / "truth_sensor.tum");
+  if (static_cast<int>(scans.size()) < o.scans + 1) throw InputError(o.session, "", "too few scans for one start");
+
+  const std::filesystem::path prior_path = o.prior.empty() ? dir / "bim.ply" : std::filesystem::path(o.prior);
+  const LoadedPrior prior = load_prior(prior_path);
+  const slam::VoxelHashMap index = slam::index_prior_map(prior.map);
+  // The prior's frame in the world: the world itself (bim.ply), or where the
+  // prior session's trajectory lies on its truth.
+  Eigen::Isometry3d world_from_prior = Eigen::Isometry3d::Identity();
+  if (!o.prior_trajectory.empty()) {
+    const slam::Trajectory est = eval::read_tum(o.prior_trajectory);
+    const eval::Associated a = eval::associate(eval::read_tum(o.prior_truth), est, 0.02);
+    const auto fit = eval::align_trajectory(a.ref, a.est, eval::Alignment::se3);
+    if (!fit) throw InputError(o.prior_trajectory, "", "cannot be aligned with --prior-truth");
+    world_from_prior.linear() = fit->rotation;
+    world_from_prior.translation() = fit->translation;
+  }
+
+  std::mt19937_64 rng(o.seed);
+  std::uniform_int_distribution<std::size_t> pick(0, scans.size() - static_cast<std::size_t>(o.scans) - 1);
+  std::normal_distribution<double> tilt(0.0, o.tilt_sigma_deg * std::numbers::pi / 180.0);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Start> starts;
+  std::vector<Eigen::Vector3f> cloud;
+  for (int s = 0; s < o.starts; ++s) {
+    Start start;
+    start.scan = pick(rng);
+    const double t0 = 1e-9 * static_cast<double>(scans[start.scan].stamp_ns);
+    const auto sensor0 = eval::interpolate_pose(truth, t0);
+    if (!sensor0) throw InputError(dir / "truth_sensor.tum", "", fmt::format("no truth at {:.3f} s", t0));
+    // The levelled frame: the sensor's position and heading, tilted by the levelling's error.
+    Eigen::Isometry3d level = yaw_only(*sensor0);
+    level.linear() = level.linear() * (Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitX()) *
+                                       Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitY())).toRotationMatrix();
+    const Eigen::Isometry3d level_inv = level.inverse();
+    cloud.clear();
+    for (std::size_t j = start.scan; j < start.scan + static_cast<std::size_t>(o.scans); ++j) {
+      const BenchScan& scan = scans[j];
+      const bool timed = scan.time_offsets_ns.size() == scan.points.size();
+      // The motion within a sweep, at 1 ms steps (a sensor moves under 2 mm in one).
+      double cached_t = -1.0;
+      Eigen::Isometry3f to_level = Eigen::Isometry3f::Identity();
+      for (std::size_t k = 0; k < scan.points.size(); ++k) {
+        const double t = 1e-9 * static_cast<double>(scan.stamp_ns) + (timed ? std::floor(1e3 * scan.time_s(k)) * 1e-3 : 0.0);
+        if (t != cached_t) {
+          const auto pose = eval::interpolate_pose(truth, t);
+          if (!pose) continue;
+          to_level = (level_inv * *pose).cast<float>();
+          cached_t = t;
+        }
+        cloud.push_back(to_level * scan.points[k]);
+      }
+    }
+    std::optional<slam::LocalisationHint> hint;
+    if (o.hint_m > 0.0) {
+      const Eigen::Isometry3d prior_level = world_from_prior.inverse() * level;
+      slam::LocalisationHint h;
+      h.position = prior_level.translation().head<2>() + o.hint_m * Eigen::Vector2d(unit(rng), unit(rng)) / std::sqrt(2.0);
+      h.radius_m = 2.0 * o.hint_m;
+      const Eigen::Vector3d x = prior_level.linear().col(0);
+      h.yaw_rad = std::atan2(x.y(), x.x()) + unit(rng) * 10.0 * std::numbers::pi / 180.0;
+      h.yaw_tolerance_rad = 20.0 * std::numbers::pi / 180.0;
+      hint = h;
+    }
+    const std::int64_t c0 = thread_cpu_ns();
+    const slam::LocalisationResult r = slam::localise(cloud, prior.map, index, hint);
+    start.seconds = 1e-9 * static_cast<double>(thread_cpu_ns() - c0);
+    const Eigen::Isometry3d error = (world_from_prior * r.pose).inverse() * level;
+    start.error_m = error.translation().norm();
+    start.error_deg = Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
+    start.reported = r.success;
+    start.within = start.error_m <= 0.05 && start.error_deg <= 0.5;
+    start.failure = r.failure;
+    if (!o.json)
+      fmt::print("start {:2d} scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, weakest {:.3f} sigma {:.3f} m {:.3f} deg, {:.2f} s{}{}\n", s,
+                 start.scan, r.success ? (start.within ? "found " : "FALSE ") : "failed", start.error_m,
+                 start.error_deg, r.overlap, r.rival_overlap, r.rival_distance_m, r.weakest_eigenvalue, r.position_sigma_m, r.yaw_sigma_rad * 180 / std::numbers::pi, start.seconds, r.success ? "" : ": ",
+                 r.success ? "" : r.failure);
+    starts.push_back(start);
+  }
+  const auto count = [&](auto pred) { return static_cast<int>(std::count_if(starts.begin(), starts.end(), pred)); };
+  const int found = count([](const Start& s) { return s.reported && s.within; });
+  const int wrong = count([](const Start& s) { return s.reported && !s.within; });
+  const int failed = count([](const Start& s) { return !s.reported; });
+  const int failed_near = count([](const Start& s) { return !s.reported && s.within; });
+  std::vector<double> seconds;
+  std::vector<double> err_m, err_deg;
+  for (const Start& s : starts) {
+    seconds.push_back(s.seconds);
+    if (s.reported && s.within) {
+      err_m.push_back(s.error_m);
+      err_deg.push_back(s.error_deg);
+    }
+  }
+  std::map<std::string, int> reasons;
+  for (const Start& s : starts)
+    if (!s.reported) ++reasons[s.failure.substr(0, s.failure.find_first_of(":0123456789"))];
+  const double rate = static_cast<double>(found) / static_cast<double>(starts.size());
+  const double median_s = quantile(seconds, 0.5);
+  const double max_s = *std::max_element(seconds.begin(), seconds.end());
+  const std::size_t memory = prior_map_bytes(prior.map);
+  if (o.json) {
+    nlohmann::json j;
+    j["session"] = o.session;
+    j["prior"] = prior_path.string();
+    j["prior_points"] = prior.map.points.size();
+    j["prior_memory_mb"] = 1e-6 * static_cast<double>(memory);
+    j["prepare_s"] = prior.prepare_s;
+    j["starts"] = starts.size();
+    j["scans_per_start"] = o.scans;
+    j["localisation_success_rate"] = rate;
+    j["false_localisations"] = wrong;
+    j["failed"] = failed;
+    j["failed_but_near"] = failed_near;
+    j["median_localisation_s"] = median_s;
+    j["max_localisation_s"] = max_s;
+    j["median_error_m"] = err_m.empty() ? 0.0 : quantile(err_m, 0.5);
+    j["median_error_deg"] = err_deg.empty() ? 0.0 : quantile(err_deg, 0.5);
+    j["failure_reasons"] = reasons;
+    // Drift correction against the prior is not built (docs/PRIOR-MAP.md).
+    j["drift_percent_with_prior"] = nullptr;
+    j["drift_percent_without_prior"] = nullptr;
+    fmt::print("{}\n", j.dump(2));
+    return kExitOk;
+  }
+  fmt::print("prior: {} ({} points, {:.1f} MB prepared{})\n", prior_path.string(), prior.map.points.size(),
+             1e-6 * static_cast<double>(memory),
+             prior.prepared_now ? fmt::format(", read and prepared in {:.1f} s", prior.prepare_s) : "");
+  fmt::print("starts: {} of {} scans each\n", starts.size(), o.scans);
+  fmt::print("localisation_success_rate {:.3f} ({} of {} within 0.05 m and 0.5 deg)\n", rate, found, starts.size());
+  fmt::print("false_localisations {}\n", wrong);
+  fmt::print("failed {} ({} of them were near the truth)\n", failed, failed_near);
+  for (const auto& [why, n] : reasons) fmt::print("  {} x {}\n", n, why);
+  fmt::print("median_localisation_s {:.2f} (max {:.2f}, one core, CPU time)\n", median_s, max_s);
+  if (!err_m.empty())
+    fmt::print("error of the localised: median {:.3f} m {:.3f} deg, max {:.3f} m {:.3f} deg\n", quantile(err_m, 0.5),
+               quantile(err_deg, 0.5), *std::max_element(err_m.begin(), err_m.end()),
+               *std::max_element(err_deg.begin(), err_deg.end()));
+  fmt::print("drift_percent_with_prior not measured (drift correction against the prior is not built)\n");
+  fmt::print("drift_percent_without_prior not measured\n");
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_bench_prior_map_command(CLI::App& bench, int& status) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = bench.add_subcommand("prior-map", "Global localisation against a prior map from random starts of a simulated session");
+  cmd->add_option("--session", o->session, "Simulated session folder (adit sim)")->required();
+  cmd->add_option("--prior", o->prior, "Prior map: a prepared folder, or a cloud/mesh file (default: the session's bim.ply)");
+  cmd->add_option("--prior-trajectory", o->prior_trajectory,
+                  "When the prior is another session's map: that session's trajectory.tum (the prior's frame) ...");
+  cmd->add_option("--prior-truth", o->prior_truth, "... and its truth_body.tum, which place the prior in the world");
+  cmd->add_option("--starts", o->starts, "Random starts")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--scans", o->scans, "Scans accumulated per start")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the starts")->capture_default_str();
+  cmd->add_option("--hint-m", o->hint_m, "Give a hint up to this far off (heading within 10 deg); 0: none")->capture_default_str();
+  cmd->add_option("--tilt-sigma-deg", o->tilt_sigma_deg, "σ of the levelling error")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print the figures as JSON");
+  cmd->callback([o, &status] {
+    if (o->prior_trajectory.empty() != o->prior_truth.empty())
+      throw InputError("", "--prior-trajectory/--prior-truth", "give both or neither");
+    status = run(*o);
+  });
+}
+
+}  // namespace adit::tools
