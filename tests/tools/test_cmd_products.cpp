@@ -12,32 +12,14 @@
 
 #include "adit/protocol/map_export.hpp"
 #include "adit/slam/tum.hpp"
+#include "run_program.hpp"
 #include "shared_data.hpp"
 
 namespace adit {
 namespace {
 
-struct ToolRun {
-  int status = -1;
-  std::string output;
-};
-
-ToolRun adit(const std::string& args) {
-  std::string command = "'";
-  command += (test::binary_dir() / "bin" / "adit").string();
-  command += "' ";
-  command += args;
-  command += " 2>&1";
-  ToolRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) run.output.append(buffer, n);
-  const int raw = ::pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
+using ToolRun = test::CommandRun;
+ToolRun adit(const std::string& args) { return test::run_adit(args); }
 
 // A 20 m corridor 3 m wide, the sensor 0.5 m over the floor along its middle.
 std::filesystem::path corridor(const std::string& name) {

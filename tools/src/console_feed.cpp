@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "adit/common/clock.hpp"
+#include "adit/protocol/session_state.hpp"
 
 namespace adit::tools::console {
 namespace {
@@ -19,13 +20,9 @@ constexpr std::size_t kChangesKept = 32;  // completions remembered per tile
 
 std::int64_t now_ms() { return realtime_us() / 1000; }
 
-const char* state_name(int state) {
-  switch (state) {
-    case status_t::STATE_IDLE: return "IDLE";
-    case status_t::STATE_MAPPING: return "MAPPING";
-    case status_t::STATE_STOPPING: return "STOPPING";
-    default: return "UNKNOWN";
-  }
+// The protocol's name of a status_t/command_ack_t state.
+std::string state_name(int state) {
+  return std::string(protocol::state_name(static_cast<protocol::SessionState>(state)));
 }
 
 void append_f32(std::string& out, float v) {

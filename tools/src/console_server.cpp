@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/common/log.hpp"
+#include "adit/protocol/session_state.hpp"
 #include "console_downloads.hpp"
 #include "console_events.hpp"
 #include "console_feed.hpp"
@@ -31,13 +32,9 @@ std::optional<command_ack_t> payload_command(const ClientOptions& client, const 
   return lcm.command(verb, args);
 }
 
-const char* state_name(int state) {
-  switch (state) {
-    case status_t::STATE_IDLE: return "IDLE";
-    case status_t::STATE_MAPPING: return "MAPPING";
-    case status_t::STATE_STOPPING: return "STOPPING";
-    default: return "UNKNOWN";
-  }
+// The protocol's name of a status_t/command_ack_t state.
+std::string state_name(int state) {
+  return std::string(protocol::state_name(static_cast<protocol::SessionState>(state)));
 }
 
 void reply_json(httplib::Response& res, int status, const nlohmann::json& body) {
