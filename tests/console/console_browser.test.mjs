@@ -38,6 +38,21 @@ const browser = await launchBrowser(puppeteer);
 const figures = {};
 let failed = false;
 
+// Clicks `selector` once it is drawn; a list drawn again between finding the
+// element and clicking it (the node replaced) is clicked again, as a person would.
+async function clickWhenDrawn(page, selector) {
+  for (let attempt = 0; ; ++attempt) {
+    await page.waitForSelector(selector, { visible: true, timeout: 10000 });
+    try {
+      await page.click(selector);
+      return;
+    } catch (e) {
+      if (attempt >= 4 || !/not clickable|detached|not an Element/.test(String(e))) throw e;
+      await new Promise((resolve) => setTimeout(resolve, 200));
+    }
+  }
+}
+
 function watchErrors(page, errors) {
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
   page.on('pageerror', (e) => errors.push(`page: ${e.message}`));
@@ -177,7 +192,8 @@ try {
   const item = `#session-list li[data-session="${id}"]`;
   await waitFor('the session in the list', async () => (await page.$(item)) !== null);
   assert.match(await text(page, item), /drift east/, 'the scan keeps its name');
-  await page.click(`${item} button[data-format="ply"]`);
+  // The list is drawn again when the refresh answers: click the button as it is then.
+  await clickWhenDrawn(page, `${item} button[data-format="ply"]`);
   await waitFor('the map prepared', async () => (await page.$(`${item} a[data-format="ply"]`)) !== null, 30000);
   const consolePoints = Number(await page.$eval(`${item} a[data-format="ply"]`, (a) => a.dataset.points));
   const url = await page.$eval(`${item} a[data-format="ply"]`, (a) => a.href);
