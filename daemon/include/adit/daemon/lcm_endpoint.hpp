@@ -85,7 +85,7 @@ struct EndpointOptions {
   double chunk_bytes_per_s = 4.0e6;    // pacing of tile chunks (broadcast and answers)
   std::size_t queue_capacity = 256;    // per hand-off queue
   std::size_t command_window = 1024;   // request ids remembered for replays
-  // Command authentication (docs/PROTOCOL.md): a key file readable only by
+  // Command authentication (docs/COMMAND-AUTH.md): a key file readable only by
   // the service; empty = commands are not authenticated. The file is checked
   // for changes every `key_check_period_s` and re-read (key rotation without
   // a restart); a file that has become unreadable or bad keeps the old keys.

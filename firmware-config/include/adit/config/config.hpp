@@ -217,7 +217,7 @@ struct PriorMapSection {
 
 struct LcmSection {
   std::string url = "udpm://239.255.76.67:7667?ttl=1";
-  // Command authentication (docs/PROTOCOL.md): a key file readable only by
+  // Command authentication (docs/COMMAND-AUTH.md): a key file readable only by
   // aditd (`adit keygen`); "" = commands are not authenticated. A path that
   // starts with $CREDENTIALS_DIRECTORY/ names a systemd credential.
   std::string key_file;

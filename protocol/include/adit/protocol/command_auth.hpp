@@ -1,5 +1,5 @@
 #pragma once
-// Command authentication (docs/PROTOCOL.md "Authenticated commands",
+// Command authentication (docs/COMMAND-AUTH.md,
 // docs/decisions/023-command-authentication.md): HMAC-SHA-256 with a
 // pre-shared 32-byte key over a canonical encoding of every field of a
 // command_t but the tag itself. This file is the pure part: canonical bytes,

@@ -1,4 +1,4 @@
-// Signing adit commands in Java (docs/PROTOCOL.md "Authenticated commands"):
+// Signing adit commands in Java (docs/COMMAND-AUTH.md):
 // HMAC-SHA-256 with a pre-shared 32-byte key over the canonical bytes of a
 // command_t, the same layout as protocol/src/command_auth.cpp. Java 17's own
 // javax.crypto does the HMAC and SHA-256; no other library is needed.
