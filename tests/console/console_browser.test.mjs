@@ -112,7 +112,12 @@ try {
   const m0 = await metrics(page);
   await sleep(3000);
   const m1 = await metrics(page);
-  assert.ok(m1.lastSeq > m0.lastSeq + 15, `poses advance at scan rate: seq ${m0.lastSeq} -> ${m1.lastSeq} in 3 s`);
+  // At scan rate (10 Hz; half of it allowed) in the optimised build. A
+  // sanitizer build runs aditd several times slower (CI's ASan pass drew 13
+  // poses in 3 s), so there the rate is reported and only advancing is asserted.
+  figures.poses_per_s = (m1.lastSeq - m0.lastSeq) / 3;
+  const minPoses = process.env.ADIT_SANITIZED ? 3 : 15;
+  assert.ok(m1.lastSeq > m0.lastSeq + minPoses, `poses advance at scan rate: seq ${m0.lastSeq} -> ${m1.lastSeq} in 3 s`);
   const o1 = await metrics(other);
   assert.ok(o1.poses > 10, `the second browser gets poses too (${o1.poses})`);
 
