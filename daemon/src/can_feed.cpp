@@ -80,6 +80,8 @@ struct CanFeed::Impl {
   slam::WheelOdometry odometry;
   std::optional<can::CandumpReader> log;
   std::optional<can::CanSocket> socket;
+  HostClock host_clock;  // live frames' stamps
+  can::BusMonitor bus;
   std::optional<can::CandumpWriter> recorder;
   std::vector<double> values;
   bool wheels = false;                 // wheel_odometry.enabled
@@ -152,10 +154,11 @@ struct CanFeed::Impl {
     }
   }
 
-  Impl(const config::Config& c, ImuStats& imu_stats)
+  Impl(const config::Config& c, ImuStats& imu_stats, HostClock clock)
       : config(c),
         decoder(make_decoder(c)),
         odometry(geometry_of(c.wheel_odometry), {}, limits_of(c.wheel_odometry)),
+        host_clock(clock),
         wheels(c.wheel_odometry.enabled),
         imu(imu_on_can(c)),
         gyro(gyro_on_can(c)),
@@ -204,8 +207,8 @@ struct CanFeed::Impl {
   }
 };
 
-CanFeed::CanFeed(const config::Config& config)
-    : impl_(std::make_unique<Impl>(config, imu_stats_)),
+CanFeed::CanFeed(const config::Config& config, HostClock clock)
+    : impl_(std::make_unique<Impl>(config, imu_stats_, clock)),
       replay_(config.can.source == config::CanSource::candump),
       wheels_(impl_->wheels),
       imu_(impl_->imu),
@@ -285,12 +288,25 @@ void CanFeed::run() {
       if (!i.log->next(frame)) break;  // the replayed log has ended
     } else if (i.socket->read(frame, 100) != can::ReadResult::frame) {
       continue;
+    } else {
+      frame.time_us = i.host_clock.from_recent_realtime(frame.time_us * 1000) / 1000;
     }
     stats_.frames.fetch_add(1, std::memory_order_relaxed);
     stats_.last_frame_us.store(frame.time_us, std::memory_order_relaxed);
     if (i.recorder) {
       i.recorder->write(frame);
       stats_.recorded.fetch_add(1, std::memory_order_relaxed);
+    }
+    const can::BusState before = i.bus.state();
+    if (const can::BusState now = i.bus.on_frame(frame); now != before) {
+      const can::BusCounters& c = i.bus.counters();
+      stats_.bus_state.store(static_cast<int>(now), std::memory_order_relaxed);
+      stats_.bus_off.store(c.bus_off, std::memory_order_relaxed);
+      stats_.recoveries.store(c.recoveries, std::memory_order_relaxed);
+    }
+    if (frame.error) {
+      stats_.error_frames.fetch_add(1, std::memory_order_relaxed);
+      continue;
     }
     const can::DecodeResult r = i.decoder.decode(frame, i.values);
     if (r.status != can::DecodeStatus::decoded) continue;

@@ -43,8 +43,9 @@ struct Packet {
 
 struct LidarSource::Impl {
   Impl(const config::Config& c, double speed, Overflow overflow, PipelineStats& s, const std::atomic<bool>& stop_flag,
-       const std::atomic<bool>& end_flag)
-      : stats(s),
+       const std::atomic<bool>& end_flag, HostClock clock)
+      : host_clock(clock),
+        stats(s),
         stop(stop_flag),
         end(end_flag),
         packets(kPacketSlots, overflow, [] { return Packet{}; }),
@@ -138,6 +139,7 @@ struct LidarSource::Impl {
     std::memcpy(packet->data.data(), payload.data(), packet->size);
     packet->received_mono_ns = monotonic_ns();
     stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+    stats.last_packet_mono_ns.store(packet->received_mono_ns, std::memory_order_relaxed);
     if (recorder && stats.recording_stopped.load(std::memory_order_relaxed) == 0) {
       // Buffered file output on the receiver: a copy and no allocation per packet.
       const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, from_imu ? imu_port : data_port};
@@ -186,16 +188,25 @@ struct LidarSource::Impl {
       // With the IMU's socket beside it, the LiDAR's waits at most 5 ms, so
       // the IMU is read within 5 ms even when the LiDAR falls silent.
       const int wait_ms = imu_udp ? 5 : 100;
+      // Live stamps go on the session's step-free timeline; a step of the
+      // wall clock is counted (and shown) instead of reaching the odometry.
+      const auto host_time = [this](std::int64_t kernel_ns) {
+        return kernel_ns > 0 ? host_clock.from_recent_realtime(kernel_ns) : host_clock.now_ns();
+      };
       while (reading()) {
         receiver.beat.beat();
+        if (const std::optional<std::int64_t> step = step_watch.look()) {
+          stats.clock_steps.fetch_add(1, std::memory_order_relaxed);
+          stats.last_clock_step_ns.store(*step, std::memory_order_relaxed);
+        }
         for (const drivers::ReceivedDatagram& d : udp->receive(wait_ms)) {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
-          push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port);
+          push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port);
         }
         if (!imu_udp) continue;
         for (const drivers::ReceivedDatagram& d : imu_udp->receive(0)) {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
-          push(d.payload, d.kernel_time_ns, d.src_ip, d.src_port, true);
+          push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port, true);
         }
       }
     }
@@ -252,6 +263,8 @@ struct LidarSource::Impl {
     scans->close();
   }
 
+  const HostClock host_clock;  // live stamps (udp)
+  ClockStepWatch step_watch;   // receiver thread
   PipelineStats& stats;
   const std::atomic<bool>& stop;
   const std::atomic<bool>& end;
@@ -286,9 +299,9 @@ Overflow overflow_of(const config::Config& c) {
 }  // namespace
 
 LidarSource::LidarSource(const config::Config& config, double replay_speed, std::size_t scan_dir_points,
-                         PipelineStats& stats, const std::atomic<bool>& stop)
+                         PipelineStats& stats, const std::atomic<bool>& stop, HostClock clock)
     : impl_(std::make_unique<Impl>(config, replay_speed >= 0.0 ? replay_speed : config.lidar.replay_speed,
-                                   overflow_of(config), stats, stop, end_)),
+                                   overflow_of(config), stats, stop, end_, clock)),
       overflow_(overflow_of(config)),
       max_points_(impl_->assembler ? impl_->assembler->config().max_points_per_scan : scan_dir_points),
       scans_(kScanSlots, overflow_, [points = max_points_] {

@@ -21,10 +21,10 @@ namespace adit::daemon {
 namespace {
 
 // The CAN thread runs for the wheels, a CAN IMU, or both.
-std::unique_ptr<CanFeed> can_feed_of(const config::Config& c) {
+std::unique_ptr<CanFeed> can_feed_of(const config::Config& c, HostClock clock) {
   const bool imu = c.imu.enabled && c.imu.source == config::ImuSource::can;
   if (!c.can.enabled || (!c.wheel_odometry.enabled && !imu)) return nullptr;
-  return std::make_unique<CanFeed>(c);
+  return std::make_unique<CanFeed>(c, clock);
 }
 
 // The IMU the odometry reads: the CAN feed's or the Ouster's (LidarSource), or none.
@@ -39,9 +39,9 @@ ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& sou
 struct Pipeline::Impl {
   Impl(const config::Config& c, const PipelineOptions& o)
       : config(c),
-        source(c, o.replay_speed, o.odometry.max_scan_points, stats, stop),
+        source(c, o.replay_speed, o.odometry.max_scan_points, stats, stop, host_clock),
         odometry_config(odometry_config_of(c, o.odometry, source.max_points_per_scan())),
-        can(can_feed_of(c)),
+        can(can_feed_of(c, host_clock)),
         odometry(c, odometry_config, source.scans(), can.get(), imu_source_of(c, can.get(), source), o.mapping,
                  source.max_points_per_scan(), source.overflow(), stats, timings, stop),
         output(c, odometry.poses(), o.sinks.pose, stats, timings, stop),
@@ -74,6 +74,7 @@ struct Pipeline::Impl {
   std::atomic<bool> stop{false};
   PipelineStats stats;
   PipelineTimings timings;
+  const HostClock host_clock;  // the session's step-free timeline for live stamps (LiDAR and CAN alike)
   LidarSource source;
   slam::OdometryConfig odometry_config;
   std::unique_ptr<CanFeed> can;
@@ -183,6 +184,7 @@ std::vector<StageLoad> Pipeline::loads() const {
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }
 const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &*impl_->loops : nullptr; }
 const JournalWriter* Pipeline::journal() const { return impl_->journal ? &*impl_->journal : nullptr; }
+const CanFeedStats* Pipeline::can_stats() const { return impl_->can ? &impl_->can->stats() : nullptr; }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

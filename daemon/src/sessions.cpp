@@ -28,6 +28,8 @@
 #include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/map_files.hpp"
 #include "adit/daemon/durable_file.hpp"
+#include "adit/daemon/can_feed.hpp"
+#include "adit/drivers/can/bus_status.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/tile_spill.hpp"
@@ -38,6 +40,17 @@ namespace adit::daemon {
 namespace {
 
 // summary.json's "imu": the IMU source's figures (imu_stats.hpp).
+// The CAN feed's frames and its bus's health; null without a CAN feed.
+nlohmann::json can_summary(const CanFeedStats* can) {
+  if (can == nullptr) return nullptr;
+  return {{"frames", can->frames.load()},
+          {"dropped", can->dropped.load()},
+          {"error_frames", can->error_frames.load()},
+          {"bus_off", can->bus_off.load()},
+          {"recoveries", can->recoveries.load()},
+          {"bus_state_at_end", std::string(drivers::can::bus_state_name(static_cast<drivers::can::BusState>(can->bus_state.load())))}};
+}
+
 nlohmann::json imu_summary(const ImuStats& imu) {
   nlohmann::json problems = nlohmann::json::object();
   for (std::size_t k = 0; k < kImuProblemKinds; ++k) {
@@ -390,6 +403,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},
+        {"can", can_summary(pipeline->can_stats())},
+        {"host_clock", {{"steps", s.clock_steps.load()}, {"last_step_s", 1e-9 * static_cast<double>(s.last_clock_step_ns.load())}}},
         {"loops", loops_summary(loops, track, corrected)},
         {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
@@ -485,6 +500,57 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
   return "";
 }
 
+// Every fault of the running session, most urgent first, joined by "; ":
+// what is wrong now (silence, a full disk, a bus off) and what has happened
+// with its count (packets lost, clock steps, IMU gaps), so that each one a
+// crew should know of is in the status log. Called with mutex_ held.
+std::string Sessions::session_faults(const PipelineStats& s, std::uint64_t datagrams, const std::string& imu_source,
+                                     std::int64_t disk_free) {
+  std::vector<std::string> faults;
+  const auto add = [&faults](std::string fault) {
+    if (!fault.empty()) faults.push_back(std::move(fault));
+  };
+  const std::int64_t last_packet_mono = s.last_packet_mono_ns.load();
+  const double silent_s = 1e-9 * static_cast<double>(monotonic_ns() - last_packet_mono);
+  // The recording stops before the disk is full, so the journal and the map files still fit.
+  const double reserve = config_.session.record_min_free_mb * 1e6;
+  if (disk_free >= 0 && static_cast<double>(disk_free) < reserve) pipeline_->stop_recording(RecordingStop::low_disk);
+  const auto recording = static_cast<RecordingStop>(s.recording_stopped.load());
+  const JournalWriter* journal = pipeline_->journal();
+  if (pipeline_->drained()) add("the recording has ended");
+  if (journal != nullptr) add(journal->fault());  // disk full
+  if (recording != RecordingStop::recording)
+    add(fmt::format("raw recording stopped: {}; the mapping goes on", to_string(recording)));
+  if (last_packet_mono == 0) add("no LiDAR packets yet");
+  else if (silent_s > 1.0 && !pipeline_->drained()) add(fmt::format("no LiDAR packets for {:.0f} s", silent_s));
+  if (const CanFeedStats* can = pipeline_->can_stats()) {
+    const auto bus = static_cast<drivers::can::BusState>(can->bus_state.load());
+    if (bus != drivers::can::BusState::ok || can->bus_off.load() > 0)
+      add(fmt::format("CAN bus {}: bus-off {}, recovered {}, {} error frames", drivers::can::bus_state_name(bus),
+                      can->bus_off.load(), can->recoveries.load(), can->error_frames.load()));
+  }
+  if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
+    add(fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
+                    s.dropped_scans.load()));
+  if (s.missing_packets.load() + s.duplicate_packets.load() + s.late_packets.load() > 0)
+    add(fmt::format("LiDAR link: {} packets missing ({:.1f} %), {} repeated, {} late (skipped)",
+                    s.missing_packets.load(),
+                    100.0 * static_cast<double>(s.missing_packets.load()) /
+                        static_cast<double>(std::max<std::uint64_t>(1, datagrams + s.missing_packets.load())),
+                    s.duplicate_packets.load(), s.late_packets.load()));
+  if (s.clock_steps.load() > 0)
+    add(fmt::format("host clock stepped {} times, last {:+.3f} s (stamps unaffected)", s.clock_steps.load(),
+                    1e-9 * static_cast<double>(s.last_clock_step_ns.load())));
+  const ImuStats& imu = s.imu;
+  if (config_.imu.enabled && imu.samples.load() == 0 && s.scans.load() > 10)
+    add(fmt::format("no IMU readings ({}) after {} scans", imu_source, s.scans.load()));
+  else if (config_.imu.enabled)
+    add(describe_problems(imu, imu_source));  // "" when the IMU has none
+  std::string joined;
+  for (const std::string& f : faults) joined += (joined.empty() ? "" : "; ") + f;
+  return joined;
+}
+
 StatusSample Sessions::status_sample() {
   StatusSample sample;
   sample.utime = realtime_us();
@@ -532,34 +598,7 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
-  const std::int64_t last_packet_ns = s.last_packet_realtime_ns.load();
-  const double silent_s = 1e-9 * static_cast<double>(realtime_us() * 1000 - last_packet_ns);
-  // The recording stops before the disk is full, so the journal and the map files still fit.
-  const double reserve = config_.session.record_min_free_mb * 1e6;
-  if (sample.disk_free_bytes >= 0 && static_cast<double>(sample.disk_free_bytes) < reserve)
-    pipeline_->stop_recording(RecordingStop::low_disk);
-  const auto recording = static_cast<RecordingStop>(s.recording_stopped.load());
-  const JournalWriter* journal = pipeline_->journal();
-  if (pipeline_->drained()) sample.fault = "the recording has ended";
-  else if (journal != nullptr && !journal->fault().empty()) sample.fault = journal->fault();  // disk full
-  else if (recording != RecordingStop::recording)
-    sample.fault = fmt::format("raw recording stopped: {}; the mapping goes on", to_string(recording));
-  else if (last_packet_ns == 0) sample.fault = "no LiDAR packets yet";
-  else if (silent_s > 1.0) sample.fault = fmt::format("no LiDAR packets for {:.0f} s", silent_s);
-  else if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
-    sample.fault = fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
-                               s.dropped_scans.load());
-  else if (const std::uint64_t lost = s.missing_packets.load() + s.duplicate_packets.load() + s.late_packets.load();
-           lost > 0)
-    sample.fault = fmt::format("LiDAR link: {} packets missing ({:.1f} %), {} repeated, {} late (skipped)",
-                               s.missing_packets.load(),
-                               100.0 * static_cast<double>(s.missing_packets.load()) /
-                                   static_cast<double>(std::max<std::uint64_t>(1, datagrams + s.missing_packets.load())),
-                               s.duplicate_packets.load(), s.late_packets.load());
-  else if (config_.imu.enabled && imu.samples.load() == 0 && s.scans.load() > 10)
-    sample.fault = fmt::format("no IMU readings ({}) after {} scans", imu_source, s.scans.load());
-  else if (config_.imu.enabled)
-    sample.fault = describe_problems(imu, imu_source);  // "" when the IMU has none
+  sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;
 }
 

@@ -16,6 +16,7 @@
 #include "adit/common/error.hpp"
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/can_imu_pairing.hpp"
+#include "adit/drivers/can/bus_status.hpp"
 #include "can_logs.hpp"
 #include "shared_data.hpp"
 
@@ -200,6 +201,42 @@ TEST(CanFeed, ImuGapsSaturationStuckAxesTimeGoingBackAndLoneFramesAreCountedByNa
   EXPECT_NE(text.find("1 saturated"), std::string::npos) << text;
   EXPECT_NE(text.find("1 time going back"), std::string::npos) << text;
   EXPECT_NE(text.find("last: stuck axis at axis gz at frame"), std::string::npos) << text;
+  std::filesystem::remove(log);
+}
+
+// A bus that went bus-off for half a second (a loose connector, a babbling
+// node), as candump -L logs it with error frames: linux/can/error.h's
+// CAN_ERR_BUSOFF (0x40) class, then CAN_ERR_RESTARTED (0x100) when the
+// controller is back. The feed counts both, says the bus is ok again, and the
+// wheels go on after the gap.
+TEST(CanFeed, BusOffAndItsRecoveryAreCountedFromTheErrorFrames) {
+  const std::filesystem::path log = test::binary_dir() / fmt::format("bus-off-{}.log", ::getpid());
+  {
+    std::ofstream out(log);
+    for (int i = 0; i <= 300; ++i) {
+      const double t = 1000.0 + 0.01 * i;
+      if (i == 100) out << fmt::format("({:.6f}) can0 20000040#0000000000000000\n", t);  // bus-off
+      if (i == 150) out << fmt::format("({:.6f}) can0 20000100#0000000000000000\n", t);  // restarted
+      if (i >= 100 && i < 150) continue;  // nothing on the bus meanwhile
+      out << fmt::format("({:.6f}) can0 300#E803E803\n", t);
+    }
+  }
+  CanFeed feed(test::wheel_config(log));
+  feed.start({});
+  slam::WheelHistory history(8192);
+  for (int i = 0; i < 5000 && !feed.finished(); ++i) {
+    feed.drain_into(history, 1e9);
+    std::this_thread::sleep_for(1ms);
+  }
+  feed.drain_into(history, 1e9);
+  feed.stop();
+  const CanFeedStats& s = feed.stats();
+  EXPECT_EQ(s.error_frames.load(), 2U);
+  EXPECT_EQ(s.bus_off.load(), 1U);
+  EXPECT_EQ(s.recoveries.load(), 1U);
+  EXPECT_EQ(s.bus_state.load(), static_cast<int>(drivers::can::BusState::ok));
+  EXPECT_EQ(s.samples.load(), 251U) << "every data frame, none of the error frames";
+  EXPECT_NEAR(history.latest(), 1003.0, 1e-6) << "the wheels go on after the bus is back";
   std::filesystem::remove(log);
 }
 

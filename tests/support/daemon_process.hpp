@@ -22,12 +22,15 @@ namespace adit::test {
 
 class Daemon {
  public:
-  Daemon(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+  // `environment`: NAME=value entries added to the child's (e.g. LD_PRELOAD).
+  Daemon(const std::vector<std::string>& argv, const std::filesystem::path& log,
+         const std::vector<std::string>& environment = {}) {
     pid_ = ::fork();
     if (pid_ == 0) {
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, STDOUT_FILENO);
       ::dup2(fd, STDERR_FILENO);
+      for (const std::string& e : environment) ::putenv(const_cast<char*>(e.c_str()));
       std::vector<char*> args;
       for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
       args.push_back(nullptr);

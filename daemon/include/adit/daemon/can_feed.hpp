@@ -27,6 +27,7 @@
 #include <variant>
 #include <vector>
 
+#include "adit/common/host_clock.hpp"
 #include "adit/config/config.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/heartbeat.hpp"
@@ -52,6 +53,12 @@ struct CanFeedStats {
   std::atomic<std::uint64_t> recorded{0};
   std::atomic<std::uint64_t> imu_samples{0};  // IMU readings handed over (ImuStats::samples)
   std::atomic<std::int64_t> last_frame_us{0};
+  // The bus's health from its error frames (drivers/can/bus_status.hpp),
+  // from the socket or a replayed log alike.
+  std::atomic<int> bus_state{0};  // drivers::can::BusState
+  std::atomic<std::uint64_t> error_frames{0};
+  std::atomic<std::uint64_t> bus_off{0};     // times the controller went bus-off
+  std::atomic<std::uint64_t> recoveries{0};  // times it came back (restarted, error-active, frames again)
 };
 
 class CanFeed final : public ImuSource {
@@ -59,7 +66,9 @@ class CanFeed final : public ImuSource {
   // Opens the source (throws adit::InputError naming the log or the
   // interface) and builds the decoder; `replay` hand-offs wait instead of
   // dropping, so a replay as fast as possible loses nothing.
-  explicit CanFeed(const config::Config& config);
+  // Live frames are stamped on `clock` (common/host_clock.hpp), the same
+  // step-free timeline as the LiDAR's.
+  explicit CanFeed(const config::Config& config, HostClock clock = HostClock());
   ~CanFeed() override;
   CanFeed(const CanFeed&) = delete;
   CanFeed& operator=(const CanFeed&) = delete;

@@ -22,6 +22,7 @@
 #include <optional>
 #include <vector>
 
+#include "adit/common/host_clock.hpp"
 #include "adit/config/config.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/pipeline_items.hpp"
@@ -37,8 +38,10 @@ class LidarSource {
   // Opens the source and builds the decoder; throws adit::InputError naming
   // the file or the config key. `replay_speed` ≥ 0 overrides lidar.replay_speed.
   // A scan of a directory source holds at most `scan_dir_points` points.
+  // Live datagrams are stamped on `clock` (common/host_clock.hpp: the
+  // session's step-free timeline; the CAN feed gets the same one).
   LidarSource(const config::Config& config, double replay_speed, std::size_t scan_dir_points, PipelineStats& stats,
-              const std::atomic<bool>& stop);
+              const std::atomic<bool>& stop, HostClock clock = HostClock());
   ~LidarSource();
   LidarSource(const LidarSource&) = delete;
   LidarSource& operator=(const LidarSource&) = delete;

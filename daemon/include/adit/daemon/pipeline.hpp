@@ -30,6 +30,7 @@ namespace adit::daemon {
 
 class LoopClosureStage;
 class JournalWriter;
+struct CanFeedStats;
 
 struct PipelineOptions {
   std::filesystem::path trajectory_file;  // TUM, written as poses arrive; empty = none
@@ -104,6 +105,8 @@ class Pipeline {
   const LoopClosureStage* loop_closure() const;
   // The session journal's writer (SessionFiles::journal_file), closed after join(); null without it.
   const JournalWriter* journal() const;
+  // The CAN thread's counters (bus health, frames); null without a CAN feed.
+  const CanFeedStats* can_stats() const;
 
  private:
   struct Impl;

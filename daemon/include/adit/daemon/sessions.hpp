@@ -90,6 +90,8 @@ class Sessions {
   std::exception_ptr take_start_failure();
 
  private:
+  std::string session_faults(const PipelineStats& stats, std::uint64_t datagrams, const std::string& imu_source,
+                             std::int64_t disk_free);
   std::string start_locked();
   std::unique_ptr<Pipeline> build_pipeline() const;
   void finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::filesystem::path dir);
