@@ -33,6 +33,7 @@ packages=(
   libpng-dev             # session products: the top-down picture of the map (products/)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  libfaketime            # tests: the wall clock stepped under aditd (tests/daemon/test_clock_steps.cpp)
   chromium               # the console's browser tests: headless, driven over the DevTools protocol
 )
 # node and npm run the browser tests (puppeteer-core, tests/console); a node
