@@ -62,15 +62,26 @@ std::string status_line(protocol::SessionState state, const StatusSample& s, con
   for (const SensorHealth& h : s.sensors) line += fmt::format("; {} {:.0f} packets/s", h.name, h.packet_rate_hz);
   line += fmt::format("; poses {} published", c.poses_published.load());
   line += fmt::format("; commands {} executed, {} rejected", c.commands_executed.load(), c.commands_rejected.load());
+  if (!c.commands_authenticated) line += ", not authenticated";
+  if (!s.fault.empty()) line += "; " + s.fault;  // with lcm_faults()
+  return line;
+}
+
+// What arrived over LCM that aditd refused: undecodable commands and tile
+// requests (garbage, another protocol on the group), and commands refused by
+// authentication, each counted by reason. "" while there is none.
+std::string lcm_faults(const EndpointCounters& c) {
+  std::string text;
+  if (const std::uint64_t bad = c.commands_malformed + c.tile_requests_malformed; bad > 0)
+    text = fmt::format("LCM: {} malformed commands, {} malformed tile requests (ignored)", c.commands_malformed.load(),
+                       c.tile_requests_malformed.load());
   const std::uint64_t refused = c.commands_unsigned + c.commands_bad_tag + c.commands_stale +
                                 c.commands_replay_rejected + c.commands_other_payload;
   if (refused > 0)
-    line += fmt::format(" ({} unsigned, {} bad tag, {} stale, {} replayed, {} other payload)", c.commands_unsigned.load(),
-                        c.commands_bad_tag.load(), c.commands_stale.load(), c.commands_replay_rejected.load(),
-                        c.commands_other_payload.load());
-  if (!c.commands_authenticated) line += ", not authenticated";
-  if (!s.fault.empty()) line += "; " + s.fault;
-  return line;
+    text += fmt::format("{}commands refused: {} unsigned, {} bad tag, {} stale, {} replayed, {} other payload",
+                        text.empty() ? "" : "; ", c.commands_unsigned.load(), c.commands_bad_tag.load(),
+                        c.commands_stale.load(), c.commands_replay_rejected.load(), c.commands_other_payload.load());
+  return text;
 }
 
 drivers::gpio::PayloadState panel_state(protocol::SessionState state, bool fault) {
@@ -215,6 +226,8 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     if (now - last_status_ns >= status_ns) {
       last_status_ns = now;
       StatusSample status = sessions.status_sample();
+      if (const std::string lcm = lcm_faults(endpoint->counters()); !lcm.empty())
+        status.fault += (status.fault.empty() ? "" : "; ") + lcm;
       const std::string line = status_line(endpoint->state(), status, endpoint->counters());
       endpoint->publish_status(std::move(status));
       if (!reported_stall) notify_status(line);
