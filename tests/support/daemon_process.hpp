@@ -64,6 +64,7 @@ class Daemon {
     kill_now();
     return -1;
   }
+  pid_t pid() const { return pid_; }
   // SIGKILL: no handler runs, nothing is flushed.
   void kill_now() {
     ::kill(pid_, SIGKILL);
