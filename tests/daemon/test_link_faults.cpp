@@ -5,8 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <optional>
-#include <random>
+#include <cstdio>
 #include <vector>
 
 #include <fmt/format.h>
@@ -14,8 +13,6 @@
 
 #include "adit/config/load.hpp"
 #include "adit/daemon/pipeline.hpp"
-#include "adit/drivers/pcap_reader.hpp"
-#include "adit/drivers/pcap_writer.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "sim_sessions.hpp"
@@ -29,52 +26,18 @@ struct Faults {
   std::uint64_t packets = 0, cable_out = 0, lost = 0, repeated = 0, late = 0;
 };
 
-// Copies `in` to `out` with the link's faults (seeded): the cable out from
-// 4 s to 6 s, then each packet lost, repeated or held back behind the next.
+// `adit faults pcap`: the cable out from 4 s to 6 s, then each packet lost
+// (5 %), held back behind the next one (1 %) or repeated (1 %), seeded.
 Faults faulty_copy(const std::filesystem::path& in, const std::filesystem::path& out, std::uint32_t seed) {
+  const test::CommandRun run = test::run_adit(fmt::format(
+      "faults pcap {} {} --cut 4:2 --loss 0.05 --late 0.01 --repeat 0.01 --seed {}", in.string(), out.string(), seed));
+  EXPECT_EQ(run.status, 0) << run.output;
   Faults f;
-  drivers::PcapReader reader(in);
-  drivers::PcapWriter writer(out);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  struct Held {
-    std::int64_t time_ns;
-    drivers::UdpEndpoints endpoints;
-    std::vector<std::uint8_t> payload;
-  };
-  std::optional<Held> held;
-  std::int64_t t0 = -1;
-  drivers::UdpDatagram d;
-  while (reader.next(d)) {
-    ++f.packets;
-    if (t0 < 0) t0 = d.capture_time_ns;
-    const double t = 1e-9 * static_cast<double>(d.capture_time_ns - t0);
-    const drivers::UdpEndpoints e{d.src_ip, d.dst_ip, d.src_port, d.dst_port};
-    if (t >= 4.0 && t < 6.0) {
-      ++f.cable_out;
-      continue;
-    }
-    const double r = u(rng);
-    if (r < 0.05) {
-      ++f.lost;
-      continue;
-    }
-    if (r < 0.06 && !held) {  // sent after the next one
-      held = Held{d.capture_time_ns, e, {d.payload.begin(), d.payload.end()}};
-      ++f.late;
-      continue;
-    }
-    writer.write_udp(d.capture_time_ns, e, d.payload);
-    if (r < 0.07) {
-      writer.write_udp(d.capture_time_ns, e, d.payload);
-      ++f.repeated;
-    }
-    if (held) {
-      writer.write_udp(held->time_ns, held->endpoints, held->payload);
-      held.reset();
-    }
-  }
-  writer.flush();
+  const std::size_t at = run.output.find(": ", run.output.find(out.filename().string()));
+  EXPECT_EQ(std::sscanf(run.output.c_str() + at, ": %lu packets; cable out %lu, lost %lu, repeated %lu, late %lu", &f.packets,
+                        &f.cable_out, &f.lost, &f.repeated, &f.late),
+            5)
+      << run.output;
   return f;
 }
 

@@ -10,7 +10,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <functional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -28,18 +27,11 @@
 namespace adit::daemon {
 namespace {
 
-// A copy of a candump -L log, each line kept, dropped or preceded by another
-// as `edit(stamp_s, line)` says (the returned text replaces the line).
-std::filesystem::path edited_log(const std::filesystem::path& in, const std::filesystem::path& out,
-                                 const std::function<std::string(double, const std::string&)>& edit) {
-  std::ifstream src(in);
-  std::ofstream dst(out);
-  double t0 = -1.0;
-  for (std::string line; std::getline(src, line);) {
-    const double t = std::stod(line.substr(1, line.find(')') - 1));
-    if (t0 < 0) t0 = t;
-    dst << edit(t - t0, line);
-  }
+// `adit faults can IN OUT ARGS`: the log with the bus off or some ids missing.
+std::filesystem::path faulty_log(const std::filesystem::path& in, const std::filesystem::path& out,
+                                 const std::string& args) {
+  const test::CommandRun run = test::run_adit(fmt::format("faults can {} {} {}", in.string(), out.string(), args));
+  EXPECT_EQ(run.status, 0) << run.output;
   return out;
 }
 
@@ -101,20 +93,7 @@ TEST(SensorFaults, CanBusOffForOneSecondIsCountedRecoveredAndTheTrajectoryHolds)
   const FaultRun clean = map_with(session, session / "can.log", work / "clean");
   EXPECT_EQ(clean.bus_off, 0U);
   // The controller's own error frames at the edges of the silence; nothing else gets through meanwhile.
-  bool off = false, on = false;
-  const std::filesystem::path log = edited_log(session / "can.log", work / "bus-off.log", [&](double t, const std::string& line) {
-    const double t0 = std::stod(line.substr(1, line.find(')') - 1)) - t;
-    std::string out;
-    if (!off && t >= 4.0) {
-      out += fmt::format("({:.6f}) can0 20000040#0000000000000000\n", t0 + 4.0);  // CAN_ERR_BUSOFF
-      off = true;
-    }
-    if (!on && t >= 5.0) {
-      out += fmt::format("({:.6f}) can0 20000100#0000000000000000\n", t0 + 5.0);  // CAN_ERR_RESTARTED
-      on = true;
-    }
-    return t >= 4.0 && t < 5.0 ? out : out + line + "\n";
-  });
+  const std::filesystem::path log = faulty_log(session / "can.log", work / "bus-off.log", "--bus-off 4:1");
   const FaultRun r = map_with(session, log, work / "faulty");
   EXPECT_EQ(r.error_frames, 2U);
   EXPECT_EQ(r.bus_off, 1U);
@@ -140,9 +119,8 @@ TEST(SensorFaults, ImuDropoutOfThreeSecondsOnADroneIsCountedAndTheOdometryCarrie
   const std::filesystem::path work = work_dir("imu-dropout");
   const FaultRun clean = map_with(session, session / "can.log", work / "clean");
   EXPECT_EQ(clean.imu_gaps, 0U) << clean.imu_problems;
-  const std::filesystem::path log = edited_log(session / "can.log", work / "dropout.log", [](double t, const std::string& line) {
-    return t >= 8.0 && t < 11.0 ? std::string() : line + "\n";
-  });
+  // The IMU's frames (accelerometer 0x190, gyroscope 0x191) missing from 8 s to 11 s.
+  const std::filesystem::path log = faulty_log(session / "can.log", work / "dropout.log", "--drop 8:3 --drop-ids 0x190,0x191");
   const FaultRun r = map_with(session, log, work / "faulty");
   EXPECT_EQ(r.imu_gaps, 1U) << r.imu_problems;
   EXPECT_NEAR(r.longest_imu_gap_s, 3.0, 0.02);

@@ -20,6 +20,7 @@ void register_calibrate_wheels_commands(CLI::App& app, int& status);
 void register_client_commands(CLI::App& app, int& status);
 // keygen: a key file for signed commands
 void register_keygen_commands(CLI::App& app, int& status);
+void register_faults_commands(CLI::App& app, int& status);
 
 void register_download_commands(CLI::App& app, int& status);
 // console: the web app for tablets and phones (cmd_console.cpp)

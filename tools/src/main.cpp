@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     adit::tools::register_calibrate_wheels_commands(app, status);
     adit::tools::register_client_commands(app, status);
     adit::tools::register_keygen_commands(app, status);
+    adit::tools::register_faults_commands(app, status);
     adit::tools::register_download_commands(app, status);
     adit::tools::register_console_commands(app, status);
     adit::tools::register_sim_commands(app, status);
