@@ -133,6 +133,14 @@ struct LidarSource::Impl {
     if (packet == nullptr) return;
     packet->imu = from_imu;
     packet->host_time_ns = time_ns;
+    if (!from_imu && time_ns > 0) {  // a silence by the stamps: the same in a replay as it was live
+      if (const std::int64_t gap = time_ns - last_data_time_ns; last_data_time_ns > 0 && gap > kSilence_ns) {
+        stats.silences.fetch_add(1, std::memory_order_relaxed);
+        if (gap > stats.longest_silence_ns.load(std::memory_order_relaxed))
+          stats.longest_silence_ns.store(gap, std::memory_order_relaxed);
+      }
+      last_data_time_ns = time_ns;
+    }
     packet->src_ip = src_ip;
     packet->src_port = src_port;
     packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
@@ -264,6 +272,8 @@ struct LidarSource::Impl {
   }
 
   const HostClock host_clock;  // live stamps (udp)
+  static constexpr std::int64_t kSilence_ns = 1'000'000'000;
+  std::int64_t last_data_time_ns = 0;  // receiver thread
   ClockStepWatch step_watch;   // receiver thread
   PipelineStats& stats;
   const std::atomic<bool>& stop;

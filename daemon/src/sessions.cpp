@@ -391,6 +391,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
                    {"missing_packets", s.missing_packets.load()}, {"duplicate_packets", s.duplicate_packets.load()},
                    {"late_packets", s.late_packets.load()}, {"resyncs", s.resyncs.load()},
+                   {"silences", s.silences.load()}, {"longest_silence_s", 1e-9 * static_cast<double>(s.longest_silence_ns.load())},
                    {"recorded_datagrams", s.recorded_datagrams.load()}, {"recorded_bytes", s.recorded_bytes.load()},
                    {"recording_stopped", s.recording_stopped.load() == 0
                                              ? nlohmann::json(nullptr)
@@ -523,6 +524,9 @@ std::string Sessions::session_faults(const PipelineStats& s, std::uint64_t datag
     add(fmt::format("raw recording stopped: {}; the mapping goes on", to_string(recording)));
   if (last_packet_mono == 0) add("no LiDAR packets yet");
   else if (silent_s > 1.0 && !pipeline_->drained()) add(fmt::format("no LiDAR packets for {:.0f} s", silent_s));
+  if (s.silences.load() > 0)
+    add(fmt::format("LiDAR silent {} times (longest {:.1f} s)", s.silences.load(),
+                    1e-9 * static_cast<double>(s.longest_silence_ns.load())));
   if (const CanFeedStats* can = pipeline_->can_stats()) {
     const auto bus = static_cast<drivers::can::BusState>(can->bus_state.load());
     if (bus != drivers::can::BusState::ok || can->bus_off.load() > 0)

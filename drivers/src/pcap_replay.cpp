@@ -1,8 +1,7 @@
 #include "adit/drivers/pcap_replay.hpp"
 
-#include <time.h>
-
-#include <cerrno>
+#include <chrono>
+#include <thread>
 
 #include "adit/common/clock.hpp"
 
@@ -21,9 +20,10 @@ bool PacedPcapReader::next(UdpDatagram& out) {
   // Captures can step backwards (clock adjustments): never wait for those.
   const std::int64_t since_first = std::max<std::int64_t>(out.capture_time_ns - *first_capture_ns_, 0);
   const std::int64_t due = start_monotonic_ns_ + static_cast<std::int64_t>(static_cast<double>(since_first) / speed_);
-  const timespec until{static_cast<time_t>(due / 1'000'000'000), static_cast<long>(due % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr) == EINTR) {
-  }
+  // On the monotonic clock (monotonic_ns() is steady_clock's). Not an
+  // absolute clock_nanosleep: libfaketime (the clock-step tests) returns from
+  // that at once, and sleep_until does the same here.
+  std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(due)));
   lateness_ns_ = monotonic_ns() - due;
   return true;
 }

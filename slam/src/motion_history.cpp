@@ -20,6 +20,7 @@ bool WheelHistory::interpolate(double t, Pose2& pose, double& distance) const {
   }
   const WheelSample& a = at[lo - 1];
   const WheelSample& b = at[lo];
+  if (b.after_gap && t < b.t) return false;  // inside a silence: the wheels do not know
   const double u = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
   pose = {a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
           a.pose.theta + u * wrap_angle(b.pose.theta - a.pose.theta)};
@@ -33,6 +34,9 @@ std::optional<MotionPrior> WheelHistory::prior(double t0, double t1) const {
   double d0 = 0.0;
   double d1 = 0.0;
   if (!(t1 > t0) || !interpolate(t0, p0, d0) || !interpolate(t1, p1, d1)) return std::nullopt;
+  // Newest first: the scans ask about the last few samples.
+  for (std::size_t i = samples_.size(); i-- > 0 && samples_[i].t > t0;)
+    if (samples_[i].after_gap && samples_[i].t <= t1) return std::nullopt;  // the wheels were silent in between
   return wheel_motion_prior(p0, p1, d1 - d0);
 }
 

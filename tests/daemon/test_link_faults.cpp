@@ -42,8 +42,9 @@ Faults faulty_copy(const std::filesystem::path& in, const std::filesystem::path&
 }
 
 struct LinkRun {
-  std::uint64_t poses = 0, missing = 0, duplicate = 0, late = 0;
+  std::uint64_t poses = 0, missing = 0, duplicate = 0, late = 0, silences = 0;
   double ape_rmse_m = 0.0;
+  double longest_silence_s = 0.0;
 };
 
 LinkRun map_with(const std::filesystem::path& pcap, const std::filesystem::path& work) {
@@ -59,7 +60,8 @@ LinkRun map_with(const std::filesystem::path& pcap, const std::filesystem::path&
   pipeline.start();
   pipeline.join();
   const PipelineStats& s = pipeline.stats();
-  LinkRun run{s.poses.load(), s.missing_packets.load(), s.duplicate_packets.load(), s.late_packets.load(), 0.0};
+  LinkRun run{s.poses.load(), s.missing_packets.load(), s.duplicate_packets.load(), s.late_packets.load(),
+              s.silences.load(), 0.0, 1e-9 * static_cast<double>(s.longest_silence_ns.load())};
   const test::CommandRun eval = test::run_adit(fmt::format("eval traj --ref {} --est {} --json",
                                                            (session / "truth_body.tum").string(),
                                                            (work / "trajectory.tum").string()));
@@ -75,7 +77,7 @@ TEST(LinkFaults, LostRepeatedLateAndCutPacketsAreCountedAndTheTrajectoryHolds) {
   std::filesystem::create_directories(work);
   const std::filesystem::path session = test::mine_drive_12s();
   const LinkRun clean = map_with(session / "lidar.pcap", work / "clean");
-  EXPECT_EQ(clean.missing + clean.duplicate + clean.late, 0U);
+  EXPECT_EQ(clean.missing + clean.duplicate + clean.late + clean.silences, 0U);
 
   std::vector<double> apes;
   for (const std::uint32_t seed : {1U, 2U, 3U}) {
@@ -89,6 +91,8 @@ TEST(LinkFaults, LostRepeatedLateAndCutPacketsAreCountedAndTheTrajectoryHolds) {
     EXPECT_EQ(r.late, f.late);
     EXPECT_GE(r.missing, f.lost + f.cable_out);
     EXPECT_LE(r.missing, f.lost + f.cable_out + f.late);
+    EXPECT_EQ(r.silences, 1U) << "the cable out, once";
+    EXPECT_NEAR(r.longest_silence_s, 2.0, 0.01);
     // 2 s without packets: about 20 scans fewer, and no more.
     EXPECT_LT(r.poses, clean.poses - 15);
     EXPECT_GT(r.poses, clean.poses - 30);

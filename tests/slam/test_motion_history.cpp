@@ -22,6 +22,23 @@ TEST(WheelHistory, InterpolatesTheMotionBetweenTwoTimesAndKeepsItsCapacity) {
   EXPECT_FALSE(history.prior(4.0, 5.5).has_value()) << "beyond the newest sample";
 }
 
+// The wheels silent for a second (a bus-off): the odometry holds its pose
+// across the gap (nothing integrated), so a prior across it would say the body
+// stood still. None is given; on either side of the gap priors are as before.
+TEST(WheelHistory, GivesNoPriorAcrossTheWheelsSilence) {
+  WheelHistory history(16);
+  for (int i = 0; i <= 4; ++i) history.push({0.1 * i, {0.1 * i, 0.0, 0.0}, 0.1 * i});
+  // Silent from 0.4 s to 1.4 s; the pose resumes where it was held.
+  for (int i = 0; i <= 4; ++i) history.push({1.4 + 0.1 * i, {0.4 + 0.1 * i, 0.0, 0.0}, 0.4 + 0.1 * i, i == 0});
+  EXPECT_TRUE(history.prior(0.1, 0.4).has_value());
+  EXPECT_FALSE(history.prior(0.3, 0.9).has_value()) << "into the silence";
+  EXPECT_FALSE(history.prior(0.3, 1.5).has_value()) << "across it";
+  EXPECT_FALSE(history.prior(0.9, 1.5).has_value()) << "out of it";
+  const auto after = history.prior(1.4, 1.7);
+  ASSERT_TRUE(after.has_value());
+  EXPECT_NEAR(after->delta.translation().x(), 0.3, 1e-12);
+}
+
 TEST(ImuHistory, AveragesTheReadingsJoinedByLinesOverAnyInterval) {
   ImuHistory history(64);
   // f_x = 2t: readings every 10 ms, 3 ms after each 10 ms mark (as a bus delays them).

@@ -52,6 +52,8 @@ struct PipelineStats {
   std::atomic<std::uint64_t> resyncs{0};
   std::atomic<std::int64_t> last_packet_realtime_ns{0};  // wall clock of the newest datagram
   std::atomic<std::int64_t> last_packet_mono_ns{0};      // its monotonic time (silence is measured on this)
+  std::atomic<std::uint64_t> silences{0};                // the LiDAR silent > 1 s (cable, power), by its packets' stamps
+  std::atomic<std::int64_t> longest_silence_ns{0};
   std::atomic<std::uint64_t> clock_steps{0};             // live: the host's wall clock stepped (NTP, PTP), ≥ 0.1 s
   std::atomic<std::int64_t> last_clock_step_ns{0};       // the newest step, signed (+: the wall clock jumped ahead)
   std::atomic<std::int64_t> clock_offset_ns{0};          // host − sensor clock, per scan (drivers/lidar/sensor_clock.hpp)

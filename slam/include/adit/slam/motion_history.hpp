@@ -23,6 +23,10 @@ struct WheelSample {
   double t = 0.0;         // s, on the LiDAR clock (wheel_odometry.time_offset_s removed)
   Pose2 pose;             // integrated body pose
   double distance = 0.0;  // m travelled so far
+  // The wheels were silent before this sample (a bus-off, a cable: longer
+  // than WheelLimits::max_gap): how the body moved since the sample before is
+  // not known, so no prior is interpolated across it.
+  bool after_gap = false;
 };
 
 // Samples of one kind (with a time `t`): fixed capacity, the oldest dropped,

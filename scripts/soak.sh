@@ -1,0 +1,139 @@
+#!/usr/bin/env bash
+# Soak: a long simulated session mapped at real time by aditd with the field's
+# faults injected on a schedule, against the same drive mapped fault-free
+# (issue #21; docs/SESSIONS.md "Faults and the soak").
+#
+# Every minute of the drive (seconds into each minute):
+#   10-12  the LiDAR cable out                     (adit faults pcap --cut)
+#   all    5 % of LiDAR packets lost, 1 % repeated, 1 % late (after the next)
+#   25-26  the CAN bus off (wheels and accelerometer silent; error frames)
+#   40-43  the IMU (accelerometer, id 0x190) dropping out
+#   45-48  LCM flooded with garbage on aditd's channels (adit faults lcm)
+#   50     the host's wall clock stepped 2 s ahead, at 55 back (libfaketime)
+# It passes when aditd does not crash, its resident memory after the first
+# quarter grows by at most 5 %, every fault shows in the status log (`adit
+# status` every 2 s), and the map's points within 5 cm of the true scene are
+# within 1 point of the fault-free run's.
+#
+# Usage: scripts/soak.sh [MINUTES (30)] [SEED (1)]   (CI runs 3 minutes)
+# ADIT_BUILD_DIR: the build tree whose bin/ runs (default: build). Files go to
+# $build/soak-MINUTES-sSEED/: status.log, memory.csv, each run's aditd.log and session.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/sim-sessions.sh
+minutes=${1:-30}
+seed=${2:-1}
+seconds=$((minutes * 60))
+work="$build/soak-$minutes-s$seed"
+rm -rf "$work"
+mkdir -p "$work"
+session=$(sim_session "mine:robot:$seconds:$seed" "$work") || exit $?
+adit="$build/bin/adit"
+faketime_lib=/usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1
+
+# aditd's configuration for a run: the simulator's session.yaml with absolute
+# paths, this run's state folder and recordings, its own LCM port.
+config_for() {  # RUN PCAP CAN_LOG REPLAY_SPEED PAYLOAD URL
+  sed -e "s#  state_dir: state#  state_dir: $work/$1/state#" \
+      -e "s#  pcap: lidar.pcap#  pcap: $2#" \
+      -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
+      -e "s#  log: can.log#  log: $3#" \
+      -e "s#  replay_speed: 1.0#  replay_speed: $4#" \
+      -e "s#  id: sim-.*#  id: $5#" \
+      -e "s#  url: udpm://.*#  url: $6#" "$session/session.yaml"
+  printf 'threads:\n  lock_memory: false\nsession:\n  record_lidar: false\n'
+}
+
+map_within() {  # RUN: percent of map points within 5 cm of the scene
+  local folder
+  folder=$(ls -d "$work/$1"/state/sessions/*/ | head -1)
+  "$adit" eval map --map "$folder/map.ply" --scene "$session/scene.ply" --ref "$session/truth_body.tum" \
+    --est "$folder/trajectory.tum" --within 0.05 > "$work/$1/eval.txt"
+  awk '/^within/ {print $4}' "$work/$1/eval.txt"
+}
+
+echo "soak: $minutes min mine drive (seed $seed) in $work"
+# The fault-free run, as fast as it goes (a replay waits for each stage, so
+# the map is the one a real-time run makes).
+mkdir -p "$work/clean"
+config_for clean "$session/lidar.pcap" "$session/can.log" 0 soak-clean "udpm://239.255.76.67:7701?ttl=0" > "$work/clean/aditd.yaml"
+"$build/bin/aditd" --config "$work/clean/aditd.yaml" --once > "$work/clean/aditd.log" 2>&1 ||
+  { echo "soak: the fault-free run failed ($work/clean/aditd.log)" >&2; exit 1; }
+
+# The faulty recordings.
+mkdir -p "$work/faulty"
+"$adit" faults pcap "$session/lidar.pcap" "$work/faulty/lidar.pcap" --cut 10:2 --every 60 --loss 0.05 --repeat 0.01 \
+  --late 0.01 --seed "$seed" > "$work/faulty/faults.txt"
+"$adit" faults can "$session/can.log" "$work/faulty/can.log" --bus-off 25:1 --drop 40:3 --drop-ids 0x190 --every 60 \
+  >> "$work/faulty/faults.txt"
+payload=soak-faulty
+url="udpm://239.255.76.67:7702?ttl=0"
+config_for faulty "$work/faulty/lidar.pcap" "$work/faulty/can.log" 1.0 "$payload" "$url" > "$work/faulty/aditd.yaml"
+offset="$work/faulty/faketime"
+echo "+0" > "$offset"
+preload=()
+if [ -f "$faketime_lib" ]; then
+  preload=(env "LD_PRELOAD=$faketime_lib" "FAKETIME_TIMESTAMP_FILE=$offset" FAKETIME_CACHE_DURATION=1
+           FAKETIME_DONT_FAKE_MONOTONIC=1)
+else
+  echo "soak: libfaketime is absent: no clock steps (scripts/install-deps.sh installs it)" >&2
+fi
+"${preload[@]}" "$build/bin/aditd" --config "$work/faulty/aditd.yaml" --once > "$work/faulty/aditd.log" 2>&1 &
+aditd_pid=$!
+client=(--payload "$payload" --lcm-url "$url" --timeout 2)
+echo "elapsed_s,rss_mb" > "$work/memory.csv"
+: > "$work/status.log"
+started=$(date +%s)
+flooding=0
+while kill -0 "$aditd_pid" 2> /dev/null; do
+  elapsed=$(($(date +%s) - started))
+  second=$((elapsed % 60))
+  case $second in
+    50) echo "+2s" > "$offset" ;;
+    55) echo "+0" > "$offset" ;;
+  esac
+  if [ "$second" -ge 45 ] && [ "$second" -lt 48 ] && [ "$flooding" -eq 0 ]; then
+    "$adit" faults lcm --payload "$payload" --lcm-url "$url" --seconds 3 --seed "$elapsed" >> "$work/faulty/faults.txt" &
+    flooding=1
+  fi
+  [ "$second" -lt 45 ] && flooding=0
+  rss=$(awk '/^VmRSS/ {print $2 / 1024}' "/proc/$aditd_pid/status" 2> /dev/null || true)
+  [ -z "$rss" ] || echo "$elapsed,$rss" >> "$work/memory.csv"
+  if [ $((elapsed % 2)) -eq 0 ]; then
+    "$adit" status "${client[@]}" 2> /dev/null | sed "s/^/[$elapsed s] /" >> "$work/status.log" || true
+  fi
+  sleep 1
+done
+status=0
+wait "$aditd_pid" || status=$?
+wait
+
+# The verdict.
+clean=$(map_within clean)
+faulty=$(map_within faulty)
+failed=0
+check() {  # NAME OK(0/1) FIGURE
+  printf '%-44s %-5s %s\n' "$1" "$([ "$2" -eq 1 ] && echo pass || echo FAIL)" "$3"
+  [ "$2" -eq 1 ] || failed=1
+}
+check "aditd ran to the end (exit status)" "$([ "$status" -eq 0 ] && echo 1 || echo 0)" "$status"
+read -r first peak growth < <(awk -F, -v q=$((seconds / 4)) 'NR > 1 && $1 >= q {
+    if (!f) f = $2; if ($2 > p) p = $2 } END {printf "%.1f %.1f %.2f\n", f, p, f ? 100 * (p - f) / f : 0}' "$work/memory.csv")
+check "memory after the first quarter, growth <= 5 %" "$(awk -v g="$growth" 'BEGIN {print (g <= 5) ? 1 : 0}')" \
+  "$first MB -> peak $peak MB (+$growth %)"
+for fault in "LiDAR silent" "LiDAR link" "CAN bus" "gap" "host clock stepped" "LCM: "; do
+  if [ "$fault" = "host clock stepped" ] && [ ${#preload[@]} -eq 0 ]; then continue; fi
+  seen=$(grep -c -- "$fault" "$work/status.log" || true)
+  check "status shows \"$fault\"" "$([ "$seen" -gt 0 ] && echo 1 || echo 0)" "in $seen status lines"
+done
+check "map within 5 cm: within 1 point of fault-free" \
+  "$(awk -v a="$clean" -v b="$faulty" 'BEGIN {d = a - b; print (d <= 1 && d >= -1) ? 1 : 0}')" \
+  "$faulty % (fault-free $clean %)"
+folder=$(ls -d "$work/faulty"/state/sessions/*/ | head -1)
+echo "faults injected:"
+head -2 "$work/faulty/faults.txt" | sed 's/^/  /'
+echo "  LCM floods: $(grep -c garbage "$work/faulty/faults.txt" || true)"
+echo "counted in $folder/summary.json:"
+grep -E '"(silences|missing_packets|duplicate_packets|late_packets|bus_off|recoveries|steps)"' "$folder/summary.json" |
+  tr -d ' ,' | paste -sd ' ' | sed 's/^/  /'
+exit $failed
