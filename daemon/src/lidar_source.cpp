@@ -162,6 +162,15 @@ struct LidarSource::Impl {
     packets.publish(packet);
   }
 
+  // Receiver thread: a step of the host's wall clock (NTP, PTP) is counted and
+  // shown; live stamps do not see it (host_clock), replayed ones are the capture's.
+  void watch_the_clock() {
+    if (const std::optional<std::int64_t> step = step_watch.look()) {
+      stats.clock_steps.fetch_add(1, std::memory_order_relaxed);
+      stats.last_clock_step_ns.store(*step, std::memory_order_relaxed);
+    }
+  }
+
   // The first reason wins; the status names it, the mapping goes on.
   void stop_recording(RecordingStop why) {
     int recording = 0;
@@ -174,6 +183,7 @@ struct LidarSource::Impl {
       drivers::UdpDatagram d;
       while (reading() && pcap->next(d)) {
         receiver.beat.beat();
+        watch_the_clock();
         stats.datagrams.fetch_add(1, std::memory_order_relaxed);
         if (imu && d.dst_port == imu_port) {
           push(d.payload, d.capture_time_ns, d.src_ip, d.src_port, true);
@@ -203,10 +213,7 @@ struct LidarSource::Impl {
       };
       while (reading()) {
         receiver.beat.beat();
-        if (const std::optional<std::int64_t> step = step_watch.look()) {
-          stats.clock_steps.fetch_add(1, std::memory_order_relaxed);
-          stats.last_clock_step_ns.store(*step, std::memory_order_relaxed);
-        }
+        watch_the_clock();
         for (const drivers::ReceivedDatagram& d : udp->receive(wait_ms)) {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
           push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port);
