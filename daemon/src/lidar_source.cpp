@@ -52,6 +52,7 @@ struct LidarSource::Impl {
         receiver("receiver", c.threads.receiver, stop_flag),
         assembly("assembly", c.threads.receiver, stop_flag) {
     record_budget_bytes = static_cast<std::uint64_t>(c.session.record_budget_mb * 1e6);
+    record_part_bytes = static_cast<std::uint64_t>(c.session.record_part_mb * 1e6);
     if (c.lidar.source == config::LidarSource::scan_dir) {
       scan_directory.emplace(c.lidar.scan_dir);
       return;
@@ -151,15 +152,33 @@ struct LidarSource::Impl {
     if (recorder && stats.recording_stopped.load(std::memory_order_relaxed) == 0) {
       // Buffered file output on the receiver: a copy and no allocation per packet.
       const drivers::UdpEndpoints endpoints{src_ip, 0xFFFFFFFF, src_port, from_imu ? imu_port : data_port};
-      if (record_budget_bytes > 0 && recorder->bytes() + payload.size() + kRecordOverhead > record_budget_bytes) {
+      const std::uint64_t next = payload.size() + kRecordOverhead;
+      if (record_budget_bytes > 0 && earlier_parts_bytes + recorder->bytes() + next > record_budget_bytes) {
         stop_recording(RecordingStop::budget);
+      } else if (record_part_bytes > 0 && recorder->bytes() + next > record_part_bytes && !next_record_part()) {
+        stop_recording(RecordingStop::write_failed);
       } else if (recorder->write_udp(time_ns > 0 ? time_ns : realtime_ns(), endpoints, payload)) {
         stats.recorded_datagrams.fetch_add(1, std::memory_order_relaxed);
-        stats.recorded_bytes.store(recorder->bytes(), std::memory_order_relaxed);
+        stats.recorded_bytes.store(earlier_parts_bytes + recorder->bytes(), std::memory_order_relaxed);
       }
       if (recorder->failed()) stop_recording(RecordingStop::write_failed);
     }
     packets.publish(packet);
+  }
+
+  // Receiver thread: the recording goes on in its next part (lidar.1.pcap,
+  // ...: drivers/pcap_replay.hpp reads them as one), once per
+  // session.record_part_mb; false (logged) when the part cannot be opened.
+  bool next_record_part() {
+    try {
+      recorder->flush();
+      earlier_parts_bytes += recorder->bytes();
+      recorder.emplace(drivers::pcap_part(record_file, ++record_part));
+      return true;
+    } catch (const std::exception& e) {
+      log::error("LiDAR recording, part {}: {}", record_part, e.what());
+      return false;
+    }
   }
 
   // Receiver thread: a step of the host's wall clock (NTP, PTP) is counted and
@@ -298,6 +317,10 @@ struct LidarSource::Impl {
   std::string model;
   bool period_learnt = false;  // assembly thread
   std::uint64_t record_budget_bytes = 0;  // 0: none
+  std::uint64_t record_part_bytes = 0;    // 0: one file
+  std::filesystem::path record_file;      // the first part
+  int record_part = 0;
+  std::uint64_t earlier_parts_bytes = 0;
   static constexpr std::size_t kRecordOverhead = 128;  // pcap, Ethernet, IP and UDP headers of one datagram
   std::optional<OusterImu> imu;           // imu.source ouster
   std::uint16_t imu_port = 0;
@@ -338,6 +361,7 @@ void LidarSource::record_to(const std::filesystem::path& file) {
     throw InputError(file.string(), "session.record_lidar", "only packet sources can be recorded");
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   impl_->recorder.emplace(file);
+  impl_->record_file = file;
 }
 
 void LidarSource::start() {

@@ -30,6 +30,7 @@
 #include "adit/daemon/durable_file.hpp"
 #include "adit/daemon/can_feed.hpp"
 #include "adit/drivers/can/bus_status.hpp"
+#include "adit/drivers/pcap_replay.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/tile_spill.hpp"
@@ -384,6 +385,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     if (s.spilled_keyframes.load() > 0) files.push_back("keyframes/");
     const JournalWriter* journal = pipeline->journal();
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
+    for (int part = 1; std::filesystem::exists(drivers::pcap_part(dir / "lidar.pcap", part)); ++part)
+      files.push_back(drivers::pcap_part("lidar.pcap", part).string());
     if (config_.can.enabled && config_.can.record) files.push_back("can.log");
     const nlohmann::json summary = {
         {"session", id},

@@ -7,10 +7,35 @@
 
 namespace adit::drivers {
 
-PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed) : reader_(file), speed_(speed) {}
+std::filesystem::path pcap_part(const std::filesystem::path& first, int index) {
+  if (index == 0) return first;
+  std::filesystem::path part = first;
+  part.replace_filename(first.stem().string() + "." + std::to_string(index) + first.extension().string());
+  return part;
+}
+
+PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed)
+    : reader_(file), first_(file), speed_(speed) {}
+
+PcapStats PacedPcapReader::stats() const {
+  PcapStats s = reader_.stats();
+  s.records += earlier_parts_.records;
+  s.datagrams += earlier_parts_.datagrams;
+  s.non_udp += earlier_parts_.non_udp;
+  s.damaged += earlier_parts_.damaged;
+  s.reassembled += earlier_parts_.reassembled;
+  s.fragments_dropped += earlier_parts_.fragments_dropped;
+  return s;
+}
 
 bool PacedPcapReader::next(UdpDatagram& out) {
-  if (!reader_.next(out)) return false;
+  while (!reader_.next(out)) {
+    const std::filesystem::path next_part = pcap_part(first_, part_ + 1);
+    if (!std::filesystem::exists(next_part)) return false;
+    earlier_parts_ = stats();
+    reader_ = PcapReader(next_part);  // throws adit::InputError naming a part that is no capture
+    ++part_;
+  }
   if (speed_ <= 0.0) return true;
   if (!first_capture_ns_) {
     first_capture_ns_ = out.capture_time_ns;

@@ -14,6 +14,7 @@
 #include "adit/config/load.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/pipeline.hpp"
+#include "adit/drivers/pcap_replay.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
@@ -61,6 +62,53 @@ TEST(SessionFaults, AFullDiskStopsTheRecordingAndTheJournalNotTheMapping) {
   EXPECT_GT(s.poses.load(), 100U);
   EXPECT_EQ(s.poses.load(), spared->stats().poses.load());
   EXPECT_EQ(full->map().size(), spared->map().size());
+  std::filesystem::remove_all(work);
+}
+
+// The recording in parts (session.record_part_mb): each part under the size,
+// the parts read back as one capture hold every recorded datagram, and the
+// session maps again from them as from the original.
+TEST(SessionFaults, TheRecordingGoesOnInPartsThatReadBackAsOneCapture) {
+  const std::filesystem::path work = test::binary_dir() / fmt::format("faults-parts-{}", ::getpid());
+  std::filesystem::remove_all(work);
+  config::Config c = session_config(work, "");
+  c.session.record_part_mb = 2.0;
+  Pipeline pipeline(c, PipelineOptions{});
+  SessionFiles files;
+  files.record_file = work / "lidar.pcap";
+  pipeline.start(files);
+  pipeline.join();
+  const PipelineStats& s = pipeline.stats();
+  EXPECT_EQ(static_cast<RecordingStop>(s.recording_stopped.load()), RecordingStop::recording);
+  int parts = 0;
+  std::uint64_t bytes = 0;
+  for (; std::filesystem::exists(drivers::pcap_part(work / "lidar.pcap", parts)); ++parts) {
+    const std::uint64_t size = std::filesystem::file_size(drivers::pcap_part(work / "lidar.pcap", parts));
+    EXPECT_LE(size, 2'000'000U) << "part " << parts;
+    bytes += size;
+  }
+  EXPECT_GE(parts, 5) << "a 12 s VLP-16 drive is ~11 MB";
+  EXPECT_EQ(bytes, s.recorded_bytes.load());
+  drivers::PacedPcapReader reader(work / "lidar.pcap", 0.0);
+  drivers::UdpDatagram d;
+  std::uint64_t datagrams = 0;
+  std::int64_t previous = 0;
+  bool in_order = true;
+  while (reader.next(d)) {
+    ++datagrams;
+    in_order = in_order && d.capture_time_ns >= previous;
+    previous = d.capture_time_ns;
+  }
+  EXPECT_EQ(datagrams, s.recorded_datagrams.load());
+  EXPECT_EQ(reader.parts(), parts);
+  EXPECT_TRUE(in_order);
+
+  config::Config again = c;
+  again.lidar.pcap = (work / "lidar.pcap").string();
+  Pipeline replayed(again, PipelineOptions{});
+  replayed.start();
+  replayed.join();
+  EXPECT_EQ(replayed.stats().poses.load(), s.poses.load());
   std::filesystem::remove_all(work);
 }
 

@@ -1,8 +1,11 @@
 #pragma once
 // Pcap replay at a chosen pace: as fast as possible (speed 0) or at `speed`
 // times the recorded rate, each datagram released when its capture time,
-// scaled from the first one, comes due on CLOCK_MONOTONIC (absolute sleeps, so
-// delays do not accumulate).
+// scaled from the first one, comes due on CLOCK_MONOTONIC (sleeping until that
+// instant, so delays do not accumulate).
+//
+// A recording in parts (aditd's, session.record_part_mb) is one capture:
+// X.pcap goes on in X.1.pcap, X.2.pcap, ... (pcap_part()), read in turn.
 
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +15,10 @@
 
 namespace adit::drivers {
 
+// Part `index` of a recording that starts with `first`: the first itself for
+// 0, else its name with ".<index>" before the extension (lidar.1.pcap).
+std::filesystem::path pcap_part(const std::filesystem::path& first, int index);
+
 class PacedPcapReader {
  public:
   // speed ≤ 0: no pacing. Throws adit::InputError as PcapReader does.
@@ -19,12 +26,17 @@ class PacedPcapReader {
 
   // The next datagram, once it is due; false at the end of the capture.
   bool next(UdpDatagram& out);
-  const PcapStats& stats() const { return reader_.stats(); }
+  // Totals over the parts read so far.
+  PcapStats stats() const;
+  int parts() const { return part_ + 1; }
   // How late the latest datagram was released, ns (scheduling and I/O lag).
   std::int64_t last_lateness_ns() const { return lateness_ns_; }
 
  private:
   PcapReader reader_;
+  std::filesystem::path first_;
+  int part_ = 0;
+  PcapStats earlier_parts_;
   double speed_;
   std::optional<std::int64_t> first_capture_ns_;
   std::int64_t start_monotonic_ns_ = 0;

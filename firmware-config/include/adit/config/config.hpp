@@ -199,6 +199,10 @@ struct SessionSection {
   // (0 = no budget) or free disk space falls below record_min_free_mb.
   bool record_lidar = true;
   double record_budget_mb = 16000.0;
+  // The recording goes on in a new file (lidar.1.pcap, lidar.2.pcap, ...) when
+  // one would pass this: under FAT32's 4 GB, and a card's tail lost with a
+  // file costs one part. 0 = one file. Replays read the parts as one.
+  double record_part_mb = 2000.0;
   double record_min_free_mb = 1000.0;
   std::vector<std::string> exports{"ply", "las"};  // map files written when a session stops
   // The session journal (<session>/journal.adj): what mapping makes reaches

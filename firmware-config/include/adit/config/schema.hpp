@@ -217,6 +217,7 @@ void describe(V& v, SessionSection& s) {
   v.optional("autostart", s.autostart);
   v.optional("record_lidar", s.record_lidar);
   v.optional("record_budget_mb", s.record_budget_mb, Range<double>{0.0, 1e9});
+  v.optional("record_part_mb", s.record_part_mb, Range<double>{0.0, 4000.0});
   v.optional("record_min_free_mb", s.record_min_free_mb, Range<double>{0.0, 1e9});
   v.optional("exports", s.exports, OneOf{kMapFormats});
   v.optional("journal", s.journal);
