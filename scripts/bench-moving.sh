@@ -48,6 +48,11 @@ for drive in "${drives[@]}"; do
   # shellcheck disable=SC2086
   "$build/bin/adit" products "$folder" --out "$work/products" ${ADIT_PRODUCTS_ARGS:-} > "$work/products.txt" ||
     { echo "bench-moving: $drive: adit products failed ($work/products.txt)" >&2; exit 1; }
+  if [ ! -f "$work/products/moving_points.ply" ]; then  # turned off (--keep-moving): the products' CPU alone
+    cpu=$(python3 -c 'import json, sys; print(f"{json.load(open(sys.argv[1]))[\"cpu_s\"]:.2f}")' "$work/products/products.json")
+    printf '%-26s %9s %9s %8s %10s %9s %8s %8s %8s\n' "$name" - - - - - - - "$cpu"
+    continue
+  fi
   static=$(ls "$work"/products/map_static.* | head -1)
   "$build/bin/adit" eval moving --kept "$static" --removed "$work/products/moving_points.ply" \
     --people "$session/truth_people.csv" --ref "$session/truth_body.tum" --est "$folder/map_trajectory.tum" --json \
@@ -63,6 +68,7 @@ PY
   printf '%-26s %9s %9s %8s %10s %9s %8s %8s %8s\n' "$name" "$pp" "$pr" "$pf" "$sp" "$sr" "$sf" "$mc" "$ac"
   results+=("$row")
 done
+[ ${#results[@]} -gt 0 ] || exit 0
 printf '%s\n' "${results[@]}" | awk '
   { pf += $3; sf += $6; mc += $7; n++
     if (n == 1 || $3 < wp) wp = $3

@@ -41,7 +41,7 @@ RangeImage::RangeImage(int rings, int columns)
   ring_count_.resize(static_cast<std::size_t>(rings));
   row_elevation_.resize(static_cast<std::size_t>(rings));
   row_tangent_.resize(static_cast<std::size_t>(rings));
-  row_of_ring_.resize(static_cast<std::size_t>(rings));
+  ring_of_row_.resize(static_cast<std::size_t>(rings));
   clear();
 }
 
@@ -84,22 +84,22 @@ void RangeImage::finish() {
   for (std::size_t r = 0; r < ring_count_.size(); ++r)
     elevation[r] = ring_count_[r] > 0 ? static_cast<float>(ring_elevation_sum_[r] / ring_count_[r])
                                       : std::numeric_limits<float>::infinity();
-  std::iota(row_of_ring_.begin(), row_of_ring_.end(), 0);  // here: the ring of each row
-  std::sort(row_of_ring_.begin(), row_of_ring_.end(), [&](int a, int b) {
+  std::iota(ring_of_row_.begin(), ring_of_row_.end(), 0);
+  std::sort(ring_of_row_.begin(), ring_of_row_.end(), [&](int a, int b) {
     return elevation[static_cast<std::size_t>(a)] < elevation[static_cast<std::size_t>(b)];
   });
   const auto cols = static_cast<std::size_t>(columns_);
-  for (std::size_t row = 0; row < row_of_ring_.size(); ++row) {
-    const auto ring = static_cast<std::size_t>(row_of_ring_[row]);
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row) {
+    const auto ring = static_cast<std::size_t>(ring_of_row_[row]);
     std::copy_n(range_.begin() + static_cast<std::ptrdiff_t>(ring * cols), cols,
                 scratch_.begin() + static_cast<std::ptrdiff_t>(row * cols));
   }
   range_.swap(scratch_);
   // Elevations by row: rebuilt into scratch order through the ring indices.
-  for (std::size_t row = 0; row < row_of_ring_.size(); ++row)
-    scratch_[row] = elevation[static_cast<std::size_t>(row_of_ring_[row])];
-  std::copy_n(scratch_.begin(), row_of_ring_.size(), elevation.begin());
-  for (std::size_t row = 0; row < row_of_ring_.size(); ++row)
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row)
+    scratch_[row] = elevation[static_cast<std::size_t>(ring_of_row_[row])];
+  std::copy_n(scratch_.begin(), ring_of_row_.size(), elevation.begin());
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row)
     row_tangent_[row] = std::isfinite(elevation[row]) ? std::tan(elevation[row]) : std::numeric_limits<float>::infinity();
 }
 
@@ -201,8 +201,13 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
     const int c0 = static_cast<int>(std::floor(a / w - 0.5F));
     const int left = c0 < 0 ? c0 + cols : c0 >= cols ? c0 - cols : c0;
     const int right = left + 1 == cols ? 0 : left + 1;
-    const float r[4] = {image.range(row, left), image.range(row, right), image.range(row + 1, left),
-                        image.range(row + 1, right)};
+    float r[4] = {image.range(row, left), image.range(row, right), image.range(row + 1, left),
+                  image.range(row + 1, right)};
+    if (options_.nearest_return_only) {
+      const int col = a / w - static_cast<float>(c0) - 0.5F < 0.5F ? left : right;
+      const int nearest_row = q.z() / rho - image.row_tangent(row) < image.row_tangent(row + 1) - q.z() / rho ? row : row + 1;
+      r[0] = r[1] = r[2] = r[3] = image.range(nearest_row, col);
+    }
     float nearest = r[0];
     bool seen = false;
     bool known = true;

@@ -45,6 +45,10 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
   const config::Config config = config::load_config(config_file);
   const drivers::LidarFamily* family = drivers::lidar_family_of_model(config.lidar.model);
   if (family == nullptr) throw InputError(config_file.string(), "lidar.model", "unknown model '" + config.lidar.model + "'");
+  if (family->name == "livox") {  // its lines wander over the field of view: no rows of a range image
+    stats.skipped_because = "a Livox scans in a non-repetitive pattern, without rings for a range image";
+    return stats;
+  }
   const auto decoder = family->make_decoder(config.lidar.model, calibration_of(session_dir, config.lidar.calibration));
   drivers::ScanAssembler assembler(
       drivers::assembler_config_for(*decoder, 0, static_cast<float>(config.lidar.scan_cut_azimuth_deg)));

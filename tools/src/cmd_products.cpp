@@ -73,6 +73,11 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--moving-coarse-step", o.moving.coarse_step,
                   "Moving objects: suspects from every n-th scan first, then judged on every --moving-scan-step-th "
                   "(0: one pass over all points; default 16)");
+  cmd->add_flag("--moving-nearest-return-only", o.moving.nearest_return_only,
+                "Moving objects: compare with the one nearest return, not the four around (for measurements)");
+  cmd->add_option("--moving-through-ratio", o.moving.through_ratio,
+                  "Moving objects: scans seeing through a point must be at least this many times those seeing it "
+                  "(default 1)");
   cmd->add_option("--moving-scan-step", o.moving.scan_step, "Moving objects: use every n-th scan (default 1)");
   cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
   cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");

@@ -15,7 +15,7 @@
 // of per-voxel ray casting (OctoMap-style counting), are kept by construction.
 // A point is dynamic when it was seen through in at least `min_through` scans
 // and in at least `through_ratio` times as many scans as it was seen in (a
-// return of the quad within `seen_tolerance_m` of it). docs/decisions/dynamic-points-see-through.md.
+// return of the quad within `seen_tolerance_m` of it). docs/decisions/027-moving-objects-seen-through-in-the-recording.md.
 
 #include <cstdint>
 #include <span>
@@ -39,6 +39,10 @@ struct SeeThroughOptions {
   // candidates finds the suspects (seen through once), then every scan_step-th
   // scan judges only those. 0: one pass over all.
   int coarse_step = 16;
+  // Only the return nearest in direction is compared (a plain per-pixel range
+  // image comparison, as Removert's), not the four around: for measuring what
+  // the four buy (docs/decisions), not for use.
+  bool nearest_return_only = false;
 };
 
 // One scan in its sensor's frame: the nearest first return per ring and
@@ -68,6 +72,7 @@ class RangeImage {
   float row_elevation(int row) const { return row_elevation_[static_cast<std::size_t>(row)]; }
   // The row at or below `elevation` whose next row is above it; -1 when outside the rings.
   int row_below(float elevation) const;
+  float row_tangent(int row) const { return row_tangent_[static_cast<std::size_t>(row)]; }
   // The same by the elevation's tangent (z / horizontal distance; rings lie within ±80°).
   int row_below_tangent(float tan_elevation) const;
 
@@ -83,7 +88,7 @@ class RangeImage {
   std::vector<std::uint32_t> ring_count_;
   std::vector<float> row_elevation_;
   std::vector<float> row_tangent_;
-  std::vector<int> row_of_ring_;
+  std::vector<int> ring_of_row_;
 };
 
 // The sensor's pose over one scan: `map_to_sensor[k]` at time k·step_s after
