@@ -45,6 +45,7 @@ for drive in "${drives[@]}"; do
     touch "$work/done"
   fi
   folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+  rm -rf "$work/products"  # no file of an earlier run is scored
   # shellcheck disable=SC2086
   "$build/bin/adit" products "$folder" --out "$work/products" ${ADIT_PRODUCTS_ARGS:-} > "$work/products.txt" ||
     { echo "bench-moving: $drive: adit products failed ($work/products.txt)" >&2; exit 1; }

@@ -26,6 +26,11 @@ double thread_cpu_s() {
 }
 
 nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
+  nlohmann::json files = nlohmann::json::array();
+  if (!r.map_static_file.empty()) files.insert(files.end(), {r.map_static_file, "moving_points.ply"});
+  files.push_back("occupancy.bt");
+  if (o.write_ot) files.push_back("occupancy.ot");
+  files.insert(files.end(), {"grid.pgm", "grid.yaml", "top_view.png", "sections/"});
   return {{"points", r.points},
           {"moving_objects", {{"enabled", o.moving.enabled}, {"removed", r.moving_removed},
                               {"candidates", r.moving_candidates}, {"suspects", r.moving_suspects}, {"scans_used", r.moving_scans},
@@ -43,10 +48,7 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"top_view_bytes", r.top_view_bytes},
           {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
                         {"width_at_m", o.sections.width_at_m}}},
-          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml",
-                                                        "top_view.png", "sections/"})
-                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml", "top_view.png",
-                                                        "sections/"})},
+          {"files", files},
           {"cpu_s", r.cpu_s}};
 }
 
@@ -117,6 +119,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
       const std::filesystem::path static_file = r.out_dir / ("map_static" + map_file.extension().string());
       protocol::write_map(static_file, protocol::map_format_of(map_file), inputs.points);
       r.map_static_bytes = std::filesystem::file_size(static_file);
+      r.map_static_file = static_file.filename().string();
       protocol::write_map(r.out_dir / "moving_points.ply", protocol::MapFormat::ply, moving.removed_points);
     }
   }

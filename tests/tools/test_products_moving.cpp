@@ -58,6 +58,7 @@ TEST(ProductsMovingObjects, PeopleWhoWalkedPastLeaveTheMap) {
   EXPECT_GT(moving["removed"].get<std::size_t>(), 100u);
   EXPECT_EQ(json_file(session / "summary.json")["products"]["moving_objects"], moving);
   ASSERT_TRUE(fs::exists(work / "p" / "map_static.las"));
+  EXPECT_EQ(p["files"][0].get<std::string>(), "map_static.las");
   ASSERT_TRUE(fs::exists(work / "p" / "moving_points.ply"));
 
   const CommandRun score = adit("eval moving --kept " + (work / "p" / "map_static.las").string() + " --removed " +

@@ -45,6 +45,7 @@ struct ProductsReport {
   double moving_cpu_s = 0.0;        // of cpu_s, the moving objects' pass (decoding the recording included)
   std::string moving_skipped;       // why the moving objects were not removed (empty: they were)
   std::uintmax_t map_static_bytes = 0;  // map_static.<ext>: the map without them
+  std::string map_static_file;      // its name, empty when the removal did not run
   std::size_t without_ray = 0;  // no line of sight to the path found: occupied, casting no free space
   std::size_t ground_points = 0;
   std::size_t outliers_removed = 0;
