@@ -69,7 +69,7 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--moving-margin", o.moving.margin_m,
                   "Moving objects: how far past a point the returns around it must go (m, default 0.3)");
   cmd->add_option("--moving-max-range", o.moving.max_range_m,
-                  "Moving objects: map points farther than this from the sensor are not tested in a scan (m, default 40)");
+                  "Moving objects: map points farther than this from the sensor are not tested in a scan (m, default 25)");
   cmd->add_option("--moving-coarse-step", o.moving.coarse_step,
                   "Moving objects: suspects from every n-th scan first, then judged on every --moving-scan-step-th "
                   "(0: one pass over all points; default 16)");
