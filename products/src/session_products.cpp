@@ -93,6 +93,8 @@ void check_options(const ProductsOptions& o) {
           "moving", "margins and tolerance positive, max range above min range");
   require(o.moving.min_through >= 1 && o.moving.scan_step >= 1, "moving-min-through",
           "at least one scan seeing through, a scan step of at least 1");
+  require(o.moving.through_ratio >= 0.0 && o.moving.coarse_step >= 0, "moving-through-ratio",
+          "the ratio and the coarse step must not be negative");
 }
 
 ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
