@@ -8,7 +8,7 @@
 #include "adit/drivers/lidar/decode_stream.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/pcap_reader.hpp"
-#include "adit/eval/interpolate.hpp"
+#include "adit/slam/trajectory_interpolate.hpp"
 
 namespace adit::products {
 namespace {
@@ -80,7 +80,7 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
     const double t0 = 1e-9 * static_cast<double>(scan.start_time_ns);
     poses.step_s = static_cast<float>(1e-9 * span_ns / (kPosesPerScan - 1));
     for (int k = 0; k < kPosesPerScan; ++k) {
-      const std::optional<slam::Pose> body = eval::interpolate_pose(body_poses, t0 + k * static_cast<double>(poses.step_s));
+      const std::optional<slam::Pose> body = slam::interpolate_pose(body_poses, t0 + k * static_cast<double>(poses.step_s));
       if (!body) return;  // not mapped (before the first pose, after the last)
       poses.map_to_sensor[static_cast<std::size_t>(k)] = ((*body) * body_to_sensor).inverse().cast<float>();
     }

@@ -2,7 +2,7 @@
 // A finished session's scans again, from its raw recording (lidar.pcap,
 // decoded with drivers/ by the model and calibration in its config.yaml), each
 // as a RangeImage with the sensor's poses over it from map_trajectory.tum
-// (a pose per scan start, interpolated: eval/interpolate.hpp). This is what
+// (a pose per scan start, interpolated: slam/trajectory_interpolate.hpp). This is what
 // the moving-object pass (see_through.hpp) reads: the map keeps one point per
 // voxel and no per-point times once tiles are spilled (docs/PRODUCTS.md
 // "Rays"), the recording keeps every return with its firing time.
