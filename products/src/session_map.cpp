@@ -89,24 +89,29 @@ SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::
   return m;
 }
 
-SessionMap read_session_map(const std::filesystem::path& session_dir, const RayOptions& options) {
+SessionInputs read_session_inputs(const std::filesystem::path& session_dir) {
+  SessionInputs in;
   const std::filesystem::path map_file = map_file_of(session_dir);
-  const std::vector<protocol::MapPoint> points = protocol::read_map(map_file);
-  if (points.empty()) throw InputError(map_file.string(), "", "the map has no points");
-  const slam::Trajectory poses = slam::read_tum(session_dir / "map_trajectory.tum");
-  Eigen::Isometry3d body_to_sensor = Eigen::Isometry3d::Identity();
+  in.points = protocol::read_map(map_file);
+  if (in.points.empty()) throw InputError(map_file.string(), "", "the map has no points");
+  in.body_poses = slam::read_tum(session_dir / "map_trajectory.tum");
   const std::filesystem::path config_file = session_dir / "config.yaml";
   if (std::filesystem::exists(config_file)) {
     const config::Config c = config::load_config(config_file);
     const config::Transform& e = c.lidar.extrinsics;  // xyz, then roll-pitch-yaw Z·Y·X as aditd applies it
     const double k = M_PI / 180.0;
-    body_to_sensor.linear() = (Eigen::AngleAxisd(e.rpy_deg[2] * k, Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(e.rpy_deg[1] * k, Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(e.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
-    body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
+    in.body_to_sensor.linear() = (Eigen::AngleAxisd(e.rpy_deg[2] * k, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(e.rpy_deg[1] * k, Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(e.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
+                                     .toRotationMatrix();
+    in.body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
   }
-  return rays_from(points, poses, body_to_sensor, options);
+  return in;
+}
+
+SessionMap read_session_map(const std::filesystem::path& session_dir, const RayOptions& options) {
+  const SessionInputs in = read_session_inputs(session_dir);
+  return rays_from(in.points, in.body_poses, in.body_to_sensor, options);
 }
 
 }  // namespace adit::products

@@ -13,6 +13,8 @@
 #include "adit/products/grid_io.hpp"
 #include "adit/products/grid_projection.hpp"
 #include "adit/products/session_map.hpp"
+#include "adit/protocol/map_export.hpp"
+#include "adit/protocol/map_import.hpp"
 
 namespace adit::products {
 namespace {
@@ -24,7 +26,15 @@ double thread_cpu_s() {
 }
 
 nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
+  nlohmann::json files = nlohmann::json::array();
+  if (!r.map_static_file.empty()) files.insert(files.end(), {r.map_static_file, "moving_points.ply"});
+  files.push_back("occupancy.bt");
+  if (o.write_ot) files.push_back("occupancy.ot");
+  files.insert(files.end(), {"grid.pgm", "grid.yaml", "top_view.png", "sections/"});
   return {{"points", r.points},
+          {"moving_objects", {{"enabled", o.moving.enabled}, {"removed", r.moving_removed},
+                              {"candidates", r.moving_candidates}, {"suspects", r.moving_suspects}, {"scans_used", r.moving_scans},
+                              {"skipped_because", r.moving_skipped}, {"cpu_s", r.moving_cpu_s}, {"map_static_bytes", r.map_static_bytes}}},
           {"points_without_ray", r.without_ray},
           {"ground_points", r.ground_points},
           {"outliers_removed", r.outliers_removed},
@@ -38,10 +48,7 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"top_view_bytes", r.top_view_bytes},
           {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
                         {"width_at_m", o.sections.width_at_m}}},
-          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml",
-                                                        "top_view.png", "sections/"})
-                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml", "top_view.png",
-                                                        "sections/"})},
+          {"files", files},
           {"cpu_s", r.cpu_s}};
 }
 
@@ -81,6 +88,13 @@ void check_options(const ProductsOptions& o) {
   require(o.outliers.k >= 1 && o.outliers.stddev_mult > 0.0, "sor", "k >= 1 and a positive stddev multiple");
   require(o.ground.patch_m > 0.0 && o.ground.distance_m > 0.0, "ground", "patch and distance must be positive");
   require(o.sections.interval_m > 0.0, "section-interval", "must be positive");
+  require(o.moving.margin_m > 0.0 && o.moving.margin_fraction >= 0.0 && o.moving.seen_tolerance_m > 0.0 &&
+              o.moving.min_range_m >= 0.0 && o.moving.max_range_m > o.moving.min_range_m,
+          "moving", "margins and tolerance positive, max range above min range");
+  require(o.moving.min_through >= 1 && o.moving.scan_step >= 1, "moving-min-through",
+          "at least one scan seeing through, a scan step of at least 1");
+  require(o.moving.through_ratio >= 0.0 && o.moving.coarse_step >= 0, "moving-through-ratio",
+          "the ratio and the coarse step must not be negative");
 }
 
 ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
@@ -89,11 +103,31 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   const double cpu0 = thread_cpu_s();
   ProductsReport r;
   r.out_dir = out_dir.empty() ? session_dir / "products" : out_dir;
-  const SessionMap map = read_session_map(session_dir, options.rays);
+  SessionInputs inputs = read_session_inputs(session_dir);
+  const std::filesystem::path map_file = map_file_of(session_dir);
+  r.points_file = map_file.filename().string();
+  r.points_bytes = std::filesystem::file_size(map_file);
+  std::filesystem::create_directories(r.out_dir);
+  {
+    const double moving0 = thread_cpu_s();
+    const MovingObjectsReport moving = remove_moving_objects(session_dir, inputs, {}, options.moving);
+    r.moving_cpu_s = thread_cpu_s() - moving0;
+    r.moving_removed = moving.removed;
+    r.moving_candidates = moving.candidates;
+    r.moving_suspects = moving.suspects;
+    r.moving_scans = moving.scans_used;
+    r.moving_skipped = moving.skipped_because;
+    if (moving.ran) {
+      const std::filesystem::path static_file = r.out_dir / ("map_static" + map_file.extension().string());
+      protocol::write_map(static_file, protocol::map_format_of(map_file), inputs.points);
+      r.map_static_bytes = std::filesystem::file_size(static_file);
+      r.map_static_file = static_file.filename().string();
+      protocol::write_map(r.out_dir / "moving_points.ply", protocol::MapFormat::ply, moving.removed_points);
+    }
+  }
+  const SessionMap map = rays_from(inputs.points, inputs.body_poses, inputs.body_to_sensor, options.rays);
   r.without_ray = map.without_ray;
   r.points = map.points.size();
-  r.points_file = map_file_of(session_dir).filename().string();
-  r.points_bytes = std::filesystem::file_size(session_dir / r.points_file);
 
   const GroundSegmentation ground = segment_ground(map.points, options.ground);
   r.ground_points = ground.ground_points;
@@ -132,7 +166,6 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   r.grid_free = grid.count(kFree);
   r.grid_unknown = grid.count(kUnknown);
 
-  std::filesystem::create_directories(r.out_dir);
   r.grid_bytes = write_grid(r.out_dir / "grid", grid);
   if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
   r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");

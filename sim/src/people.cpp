@@ -1,6 +1,11 @@
 #include "adit/sim/people.hpp"
 
 #include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
 
 #include "adit/sim/hash_noise.hpp"
 #include "adit/sim/route_schedule.hpp"
@@ -44,6 +49,25 @@ Hit People::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dire
     best.reflectivity = kReflectivity;
   }
   return best;
+}
+
+void write_people_truth(const std::filesystem::path& file, const People& people, double duration_s, double step_s,
+                        std::int64_t start_time_ns) {
+  std::ofstream out(file, std::ios::trunc);
+  out << "# adit sim: the people's tracks (vertical cylinders; floor at z = 0), world frame; t on the truth files' "
+         "clock\n";
+  out << "t,id,x,y,radius_m,height_m\n";
+  const auto steps = static_cast<std::int64_t>(std::floor(duration_s / step_s + 1e-9));
+  for (std::int64_t k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * step_s;
+    for (std::size_t i = 0; i < people.size(); ++i) {
+      const Eigen::Vector2d p = people.position(i, t);
+      out << fmt::format("{:.6f},{},{:.4f},{:.4f},{},{}\n", 1e-9 * static_cast<double>(start_time_ns) + t, i, p.x(),
+                         p.y(), People::kRadius, People::kHeight);
+    }
+  }
+  out.flush();
+  if (!out) throw InputError(file.string(), "", "could not write the people's tracks");
 }
 
 People make_people(const Scene& scene, int count, std::uint64_t seed) {

@@ -336,6 +336,7 @@ SimSummary run_simulation(const SimOptions& o) {
   write_ply(o.out / "scene.ply", scene.mesh);
   if (!scene.design.triangles.empty()) write_ply_points(o.out / "bim.ply", sample_surface(scene.design, 100.0, o.seed));
   write_targets_csv(o.out / "targets.csv", targets);
+  if (!people.empty()) write_people_truth(o.out / "truth_people.csv", people, o.duration_s, 0.05, o.start_time_ns);
   write_session_config(o.out / "session.yaml", o, is_livox(o) ? std::string() : sensor.calibration_file, wheels,
                        simulated_imu(o, imu_source == SimImuSource::none ? SimImuSource::can : imu_source), imu_source,
                        lidar.extrinsics);

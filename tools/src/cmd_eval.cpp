@@ -148,6 +148,27 @@ void add_sections(CLI::App& eval, int& status) {
   });
 }
 
+void add_moving(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("moving", "Moving objects removed by adit products against the simulator's people");
+  auto o = std::make_shared<MovingEvalOptions>();
+  cmd->add_option("--kept", o->kept, "The map without them (adit products' map_static.las/.ply/.pcd)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--removed", o->removed, "The removed points (adit products' moving_points.ply)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--people", o->people, "The people's tracks (adit sim's truth_people.csv)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--ref", o->ref, "Reference body trajectory (truth_body.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--est", o->est, "The map's trajectory (map_trajectory.tum)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--margin", o->margin, "Added to the people's radius and height (m, default 0.1)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--json", o->json, "Print JSON instead of text");
+  cmd->callback([o, &status] {
+    run_eval_moving(*o);
+    status = kExitOk;
+  });
+}
+
 }  // namespace
 
 void register_eval_commands(CLI::App& app, int& status) {
@@ -158,6 +179,7 @@ void register_eval_commands(CLI::App& app, int& status) {
   add_targets(*eval, status);
   add_map(*eval, status);
   add_grid(*eval, status);
+  add_moving(*eval, status);
   add_sections(*eval, status);
 }
 

@@ -24,6 +24,12 @@ std::string kib(std::uintmax_t bytes) { return fmt::format("{:.1f} kB", static_c
 void run_products(const ProductsCommand& c) {
   const products::ProductsReport r = products::write_session_products(c.session, c.options, c.out);
   fmt::print("products of {} in {}\n", c.session, r.out_dir.string());
+  if (r.moving_skipped.empty())
+    fmt::print("moving objects    {} map points removed ({} suspects; seen through by later or earlier scans, {} "
+               "scans of the recording; {:.2f} s CPU); the rest in map_static, the removed in moving_points.ply\n",
+               r.moving_removed, r.moving_suspects, r.moving_scans, r.moving_cpu_s);
+  else
+    fmt::print("moving objects    not removed: {}\n", r.moving_skipped);
   fmt::print("points            {} ({} ground, {} outliers removed, {} without a line of sight to the path)\n", r.points,
              r.ground_points, r.outliers_removed, r.without_ray);
   fmt::print("octree            {} leaves at {} m\n", r.leaves, c.options.occupancy.resolution_m);
@@ -56,6 +62,23 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--section-interval", o.sections.interval_m, "Cross-sections every this many m of path (default 10)");
   cmd->add_option("--section-width-at", o.sections.width_at_m, "Widths measured this high above the floor (m, default 1.5)");
   cmd->add_option("--ray-candidates", o.rays.candidates, "Path positions tried for each point's line of sight (default 12)");
+  cmd->add_flag("!--keep-moving", o.moving.enabled,
+                "Keep the map points of moving objects (people, vehicles) that the raw recording's scans saw through");
+  cmd->add_option("--moving-min-through", o.moving.min_through,
+                  "Moving objects: scans that must see through a point, at least (default 2)");
+  cmd->add_option("--moving-margin", o.moving.margin_m,
+                  "Moving objects: how far past a point the returns around it must go (m, default 0.3)");
+  cmd->add_option("--moving-max-range", o.moving.max_range_m,
+                  "Moving objects: map points farther than this from the sensor are not tested in a scan (m, default 25)");
+  cmd->add_option("--moving-coarse-step", o.moving.coarse_step,
+                  "Moving objects: suspects from every n-th scan first, then judged on every --moving-scan-step-th "
+                  "(0: one pass over all points; default 16)");
+  cmd->add_flag("--moving-nearest-return-only", o.moving.nearest_return_only,
+                "Moving objects: compare with the one nearest return, not the four around (for measurements)");
+  cmd->add_option("--moving-through-ratio", o.moving.through_ratio,
+                  "Moving objects: scans seeing through a point must be at least this many times those seeing it "
+                  "(default 1)");
+  cmd->add_option("--moving-scan-step", o.moving.scan_step, "Moving objects: use every n-th scan (default 1)");
   cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
   cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");
   cmd->callback([c, &status] {

@@ -81,6 +81,16 @@ struct SectionsEvalOptions {
 
 void run_eval_sections(const SectionsEvalOptions& options);
 
+struct MovingEvalOptions {
+  std::string kept, removed;  // adit products' map_static.* and moving_points.ply
+  std::string people;         // adit sim's truth_people.csv
+  std::string ref, est;       // truth_body.tum and the map's trajectory
+  double margin = 0.10;       // m added to the people's cylinders
+  bool json = false;
+};
+
+void run_eval_moving(const MovingEvalOptions& options);
+
 // Shared by the runners.
 // The triangles of a scene mesh PLY; throws InputError when it has none.
 std::vector<eval::Triangle> scene_triangles(const std::string& file);

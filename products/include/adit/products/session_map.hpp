@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <vector>
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "adit/protocol/map_point.hpp"
 #include "adit/slam/trajectory.hpp"
@@ -43,6 +43,19 @@ struct SessionMap {
 // `body_to_sensor` in the body frame.
 SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::Trajectory& body_poses,
                      const Eigen::Isometry3d& body_to_sensor, const RayOptions& options);
+
+// What a session folder holds for the products: the map's points, the body
+// poses (map_trajectory.tum) and the LiDAR's place on the body (config.yaml's
+// lidar.extrinsics; identity without a config).
+struct SessionInputs {
+  std::vector<protocol::MapPoint> points;
+  slam::Trajectory body_poses;
+  Eigen::Isometry3d body_to_sensor = Eigen::Isometry3d::Identity();
+};
+
+// Reads the map file, map_trajectory.tum and config.yaml. Missing or bad
+// files throw adit::InputError naming the file.
+SessionInputs read_session_inputs(const std::filesystem::path& session_dir);
 
 // The session's map file: SESSION_DIR/map.las, .ply or .pcd (the first there).
 std::filesystem::path map_file_of(const std::filesystem::path& session_dir);

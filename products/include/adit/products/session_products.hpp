@@ -13,6 +13,7 @@
 
 #include "adit/products/cross_sections.hpp"
 #include "adit/products/ground.hpp"
+#include "adit/products/moving_objects.hpp"
 #include "adit/products/occupancy_3d.hpp"
 #include "adit/products/outlier_filter.hpp"
 #include "adit/products/session_map.hpp"
@@ -21,6 +22,7 @@
 namespace adit::products {
 
 struct ProductsOptions {
+  SeeThroughOptions moving;         // moving objects out of the map (moving_objects.hpp); moving.enabled
   RayOptions rays;
   Occupancy3dOptions occupancy;
   GroundOptions ground;
@@ -37,7 +39,13 @@ struct ProductsOptions {
 };
 
 struct ProductsReport {
-  std::size_t points = 0;
+  std::size_t points = 0;           // after the moving objects were removed
+  std::size_t moving_removed = 0;   // map points of moving objects taken out
+  std::size_t moving_candidates = 0, moving_suspects = 0, moving_scans = 0;
+  double moving_cpu_s = 0.0;        // of cpu_s, the moving objects' pass (decoding the recording included)
+  std::string moving_skipped;       // why the moving objects were not removed (empty: they were)
+  std::uintmax_t map_static_bytes = 0;  // map_static.<ext>: the map without them
+  std::string map_static_file;      // its name, empty when the removal did not run
   std::size_t without_ray = 0;  // no line of sight to the path found: occupied, casting no free space
   std::size_t ground_points = 0;
   std::size_t outliers_removed = 0;
@@ -58,7 +66,10 @@ struct ProductsReport {
 // Checks the options; throws adit::InputError naming the option.
 void check_options(const ProductsOptions& options);
 
-// Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
+// Takes moving objects out of the map first (when options.moving.enabled and
+// the session has its raw recording) and writes the rest as
+// OUT_DIR/map_static.<the map's extension>, the removed points as
+// OUT_DIR/moving_points.ply. Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
 // sections/section_NNN.svg and sections/sections.csv, products.json;
 // OUT_DIR defaults to SESSION_DIR/products. Adds "products" to
 // SESSION_DIR/summary.json when it exists (written to a temporary file and

@@ -5,6 +5,7 @@
 // firing time, so a LiDAR sees them move within a scan as it would.
 
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include <Eigen/Core>
@@ -42,6 +43,16 @@ class People {
   const Route* route_ = nullptr;
   std::vector<Walker> walkers_;
 };
+
+// The people's tracks as truth (truth_people.csv), one line per walker every
+// `step_s` from 0 to `duration_s`:
+//   # comment lines first, then the header
+//   t,id,x,y,radius_m,height_m
+// t in seconds on the truth files' clock (start_time_ns + seconds since the
+// start), x y the cylinder's axis in the world frame (floor at z = 0). Throws
+// adit::InputError on I/O failure.
+void write_people_truth(const std::filesystem::path& file, const People& people, double duration_s, double step_s,
+                        std::int64_t start_time_ns);
 
 // `count` walkers spread along the scene's route (the route must outlive them).
 People make_people(const Scene& scene, int count, std::uint64_t seed);

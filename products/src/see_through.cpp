@@ -1,0 +1,239 @@
+#include "adit/products/see_through.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "adit/common/error.hpp"
+
+namespace adit::products {
+namespace {
+
+constexpr float kTwoPi = 6.283185307179586F;
+
+// atan2 within 1e-5 rad (a minimax polynomial for atan on [-1, 1], octants
+// by symmetry): the columns are 3e-3 rad wide, and libm's atan2 would be most
+// of the time of a pass that projects every map point into every scan.
+inline __attribute__((always_inline)) float fast_atan2(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float big = std::max(ax, ay);
+  if (big == 0.0F) return 0.0F;
+  const float a = std::min(ax, ay) / big;
+  const float s = a * a;
+  float r = a * (0.99997726F + s * (-0.33262347F + s * (0.19354346F + s * (-0.11643287F + s * (0.05265332F + s * -0.01172120F)))));
+  if (ay > ax) r = 1.57079637F - r;
+  if (x < 0.0F) r = 3.14159274F - r;
+  return y < 0.0F ? -r : r;
+}
+
+}  // namespace
+
+RangeImage::RangeImage(int rings, int columns)
+    : rings_(rings), columns_(columns), column_width_(kTwoPi / static_cast<float>(std::max(columns, 1))) {
+  if (rings < 2 || columns < 4) throw InputError("range image", "", "needs at least 2 rings and 4 azimuth bins");
+  const auto n = static_cast<std::size_t>(rings) * static_cast<std::size_t>(columns);
+  range_.resize(n);
+  scratch_.resize(n);
+  column_time_.resize(static_cast<std::size_t>(columns));
+  column_count_.resize(static_cast<std::size_t>(columns));
+  ring_elevation_sum_.resize(static_cast<std::size_t>(rings));
+  ring_count_.resize(static_cast<std::size_t>(rings));
+  row_elevation_.resize(static_cast<std::size_t>(rings));
+  row_tangent_.resize(static_cast<std::size_t>(rings));
+  ring_of_row_.resize(static_cast<std::size_t>(rings));
+  clear();
+}
+
+void RangeImage::clear() {
+  std::fill(range_.begin(), range_.end(), 0.0F);
+  std::fill(column_time_.begin(), column_time_.end(), 0.0F);
+  std::fill(column_count_.begin(), column_count_.end(), 0U);
+  std::fill(ring_elevation_sum_.begin(), ring_elevation_sum_.end(), 0.0);
+  std::fill(ring_count_.begin(), ring_count_.end(), 0U);
+  std::fill(row_elevation_.begin(), row_elevation_.end(), std::numeric_limits<float>::infinity());
+}
+
+int RangeImage::column_of(float azimuth) const {
+  float a = azimuth;  // from atan2: within one turn of [0, 2π)
+  if (a < 0.0F) a += kTwoPi;
+  if (a >= kTwoPi) a -= kTwoPi;
+  const int c = static_cast<int>(a / column_width_);
+  return c >= columns_ ? columns_ - 1 : c;
+}
+
+void RangeImage::add(int ring, const Eigen::Vector3f& p, float time_s) {
+  if (ring < 0 || ring >= rings_) return;
+  const float range = p.norm();
+  if (!(range > 0.0F) || !std::isfinite(range)) return;
+  const int c = column_of(fast_atan2(p.y(), p.x()));
+  float& cell = range_[static_cast<std::size_t>(ring * columns_ + c)];
+  if (cell == 0.0F || range < cell) cell = range;
+  column_time_[static_cast<std::size_t>(c)] += time_s;
+  ++column_count_[static_cast<std::size_t>(c)];
+  ring_elevation_sum_[static_cast<std::size_t>(ring)] += std::asin(std::clamp(p.z() / range, -1.0F, 1.0F));
+  ++ring_count_[static_cast<std::size_t>(ring)];
+}
+
+void RangeImage::finish() {
+  for (std::size_t c = 0; c < column_time_.size(); ++c)
+    column_time_[c] = column_count_[c] > 0 ? column_time_[c] / static_cast<float>(column_count_[c])
+                                           : std::numeric_limits<float>::quiet_NaN();
+  // Rows in order of elevation (rings without returns last, at +inf: never bracketing).
+  std::vector<float>& elevation = row_elevation_;  // by ring first, then by row
+  for (std::size_t r = 0; r < ring_count_.size(); ++r)
+    elevation[r] = ring_count_[r] > 0 ? static_cast<float>(ring_elevation_sum_[r] / ring_count_[r])
+                                      : std::numeric_limits<float>::infinity();
+  std::iota(ring_of_row_.begin(), ring_of_row_.end(), 0);
+  std::sort(ring_of_row_.begin(), ring_of_row_.end(), [&](int a, int b) {
+    return elevation[static_cast<std::size_t>(a)] < elevation[static_cast<std::size_t>(b)];
+  });
+  const auto cols = static_cast<std::size_t>(columns_);
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row) {
+    const auto ring = static_cast<std::size_t>(ring_of_row_[row]);
+    std::copy_n(range_.begin() + static_cast<std::ptrdiff_t>(ring * cols), cols,
+                scratch_.begin() + static_cast<std::ptrdiff_t>(row * cols));
+  }
+  range_.swap(scratch_);
+  // Elevations by row: rebuilt into scratch order through the ring indices.
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row)
+    scratch_[row] = elevation[static_cast<std::size_t>(ring_of_row_[row])];
+  std::copy_n(scratch_.begin(), ring_of_row_.size(), elevation.begin());
+  for (std::size_t row = 0; row < ring_of_row_.size(); ++row)
+    row_tangent_[row] = std::isfinite(elevation[row]) ? std::tan(elevation[row]) : std::numeric_limits<float>::infinity();
+}
+
+int RangeImage::row_below_tangent(float tan_e) const {
+  const auto end = row_tangent_.begin() + rings_;
+  const auto above = std::upper_bound(row_tangent_.begin(), end, tan_e);
+  if (above == row_tangent_.begin() || above == end || !std::isfinite(*above)) return -1;
+  return static_cast<int>(above - row_tangent_.begin()) - 1;
+}
+
+int RangeImage::row_below(float e) const {
+  const auto end = row_elevation_.begin() + rings_;
+  const auto above = std::upper_bound(row_elevation_.begin(), end, e);
+  if (above == row_elevation_.begin() || above == end || !std::isfinite(*above)) return -1;
+  return static_cast<int>(above - row_elevation_.begin()) - 1;
+}
+
+SeeThroughCounter::SeeThroughCounter(std::span<const Eigen::Vector3f> map_points, std::span<const std::uint8_t> candidate,
+                                     const SeeThroughOptions& options)
+    : size_(map_points.size()), options_(options), through_(map_points.size(), 0), seen_(map_points.size(), 0) {
+  if (!candidate.empty() && candidate.size() != map_points.size())
+    throw InputError("see-through", "", "the candidate flags do not match the map points");
+  // The candidates grouped by cell (sorted by the cell's key), so that a scan
+  // skips whole cells out of its range and walks memory in order.
+  const auto key = [](const Eigen::Vector3f& p) {
+    const auto c = [](float v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / kCell)) + (1 << 20)) & 0x1FFFFF;
+    };
+    return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  keyed.reserve(map_points.size());
+  for (std::size_t i = 0; i < map_points.size(); ++i)
+    if (candidate.empty() || candidate[i]) keyed.emplace_back(key(map_points[i]), static_cast<std::uint32_t>(i));
+  std::sort(keyed.begin(), keyed.end());
+  sorted_.reserve(keyed.size());
+  index_.reserve(keyed.size());
+  for (std::size_t k = 0; k < keyed.size(); ++k) {
+    const Eigen::Vector3f& p = map_points[keyed[k].second];
+    if (k == 0 || keyed[k].first != keyed[k - 1].first) {
+      cells_.push_back({p, p, static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k)});
+    }
+    Cell& c = cells_.back();
+    c.low = c.low.cwiseMin(p);
+    c.high = c.high.cwiseMax(p);
+    c.end = static_cast<std::uint32_t>(k + 1);
+    sorted_.push_back(p);
+    index_.push_back(keyed[k].second);
+  }
+}
+
+void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses) {
+  if (poses.map_to_sensor.empty()) return;
+  ++scans_;
+  const std::size_t mid = poses.map_to_sensor.size() / 2;
+  const Eigen::Isometry3f& middle = poses.map_to_sensor[mid];
+  const Eigen::Vector3f centre = middle.inverse().translation();
+  const float min2 = static_cast<float>(options_.min_range_m * options_.min_range_m);
+  const float max2 = static_cast<float>(options_.max_range_m * options_.max_range_m);
+  const float w = image.column_width_rad();
+  const int cols = image.columns();
+  const auto margin = static_cast<float>(options_.margin_m);
+  const auto fraction = static_cast<float>(options_.margin_fraction);
+  const auto tolerance = static_cast<float>(options_.seen_tolerance_m);
+  const int last_pose = static_cast<int>(poses.map_to_sensor.size()) - 1;
+  const float inverse_step = poses.step_s > 0.0F ? 1.0F / poses.step_s : 0.0F;
+  for (const Cell& cell : cells_) {
+    // The nearest and farthest distances of the cell's box from the sensor.
+    const Eigen::Vector3f near = centre.cwiseMax(cell.low).cwiseMin(cell.high) - centre;
+    const Eigen::Vector3f far = (centre - cell.low).cwiseAbs().cwiseMax((cell.high - centre).cwiseAbs());
+    if (near.squaredNorm() > max2 || far.squaredNorm() < min2) continue;
+    for (std::uint32_t s = cell.begin; s < cell.end; ++s) {
+    const Eigen::Vector3f& p = sorted_[s];
+    const std::size_t i = index_[s];
+    const float d2 = (p - centre).squaredNorm();
+    if (d2 < min2 || d2 > max2) continue;
+    // The sensor's pose when this azimuth was fired.
+    Eigen::Vector3f q = middle * p;
+    float azimuth = fast_atan2(q.y(), q.x());
+    if (inverse_step > 0.0F) {
+      const float t = image.column_time(image.column_of(azimuth));
+      if (std::isfinite(t)) {
+        const int k = std::clamp(static_cast<int>(t * inverse_step + 0.5F), 0, last_pose);
+        if (k != static_cast<int>(mid)) {
+          q = poses.map_to_sensor[static_cast<std::size_t>(k)] * p;
+          azimuth = fast_atan2(q.y(), q.x());
+        }
+      }
+    }
+    const float rho2 = q.x() * q.x() + q.y() * q.y();
+    const float rho = std::sqrt(rho2);
+    const float range = std::sqrt(rho2 + q.z() * q.z());
+    if (!(rho > 0.0F)) continue;
+    const int row = image.row_below_tangent(q.z() / rho);
+    if (row < 0) continue;
+    // The columns whose centres bracket the azimuth.
+    float a = azimuth;
+    if (a < 0.0F) a += kTwoPi;
+    const int c0 = static_cast<int>(std::floor(a / w - 0.5F));
+    const int left = c0 < 0 ? c0 + cols : c0 >= cols ? c0 - cols : c0;
+    const int right = left + 1 == cols ? 0 : left + 1;
+    float r[4] = {image.range(row, left), image.range(row, right), image.range(row + 1, left),
+                  image.range(row + 1, right)};
+    if (options_.nearest_return_only) {
+      const int col = a / w - static_cast<float>(c0) - 0.5F < 0.5F ? left : right;
+      const int nearest_row = q.z() / rho - image.row_tangent(row) < image.row_tangent(row + 1) - q.z() / rho ? row : row + 1;
+      r[0] = r[1] = r[2] = r[3] = image.range(nearest_row, col);
+    }
+    float nearest = r[0];
+    bool seen = false;
+    bool known = true;
+    for (const float x : r) {
+      known = known && x > 0.0F;
+      nearest = std::min(nearest, x);
+      seen = seen || std::abs(x - range) <= tolerance;
+    }
+    if (!known) continue;  // a bin without a return says nothing
+    if (seen) {
+      if (seen_[i] < std::numeric_limits<std::uint16_t>::max()) ++seen_[i];
+    } else if (nearest > range + std::max(margin, fraction * range)) {
+      if (through_[i] < std::numeric_limits<std::uint16_t>::max()) ++through_[i];
+    }
+    }
+  }
+}
+
+std::vector<std::uint8_t> SeeThroughCounter::dynamic() const {
+  std::vector<std::uint8_t> out(size_, 0);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = through_[i] >= options_.min_through &&
+                     static_cast<double>(through_[i]) >= options_.through_ratio * static_cast<double>(seen_[i])
+                 ? 1
+                 : 0;
+  return out;
+}
+
+}  // namespace adit::products
