@@ -27,14 +27,7 @@ for drive in "${drives[@]}"; do
   work="$runs/$name"
   rm -rf "$work"
   mkdir -p "$work"
-  # The simulator's own session.yaml, with absolute paths, this run's state
-  # folder and no real-time pacing.
-  sed -e "s#  state_dir: state#  state_dir: $work/state#" \
-      -e "s#  pcap: lidar.pcap#  pcap: $session/lidar.pcap#" \
-      -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
-      -e "s#  log: can.log#  log: $session/can.log#" \
-      -e "s#  replay_speed: 1.0#  replay_speed: 0#" "$session/session.yaml" > "$work/aditd.yaml"
-  printf 'threads:\n  lock_memory: false\n' >> "$work/aditd.yaml"
+  aditd_config "$session" "$work" > "$work/aditd.yaml"
   [ -z "${ADIT_BENCH_YAML:-}" ] || printf '%s\n' "$ADIT_BENCH_YAML" >> "$work/aditd.yaml"
   "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
     { echo "bench-map: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }

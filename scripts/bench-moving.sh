@@ -12,7 +12,7 @@
 # ADIT_PEOPLE: walkers per drive (default 5). ADIT_PRODUCTS_ARGS: extra options for `adit products`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=$(realpath "${ADIT_BUILD_DIR:-build}")
+source scripts/sim-sessions.sh  # build, aditd_config
 people=${ADIT_PEOPLE:-5}
 drives=("$@")
 [ ${#drives[@]} -gt 0 ] || drives=(mine:robot:60:1 mine:robot:60:2 mine:robot:60:3 building:robot:60:1
@@ -34,12 +34,7 @@ for drive in "${drives[@]}"; do
   if [ ! -f "$work/done" ]; then  # aditd's map is made once per drive; products and scores every run
     rm -rf "$work"
     mkdir -p "$work"
-    sed -e "s#  state_dir: state#  state_dir: $work/state#" \
-        -e "s#  pcap: lidar.pcap#  pcap: $session/lidar.pcap#" \
-        -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
-        -e "s#  log: can.log#  log: $session/can.log#" \
-        -e "s#  replay_speed: 1.0#  replay_speed: 0#" "$session/session.yaml" > "$work/aditd.yaml"
-    printf 'threads:\n  lock_memory: false\n' >> "$work/aditd.yaml"
+    aditd_config "$session" "$work" > "$work/aditd.yaml"
     "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
       { echo "bench-moving: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
     touch "$work/done"

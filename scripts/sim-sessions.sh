@@ -37,3 +37,18 @@ sim_session() {
   fi
   echo "$session"
 }
+
+# aditd_config SESSION WORK [REPLAY_SPEED [PCAP [CAN_LOG]]]: prints aditd's
+# configuration for a simulated session: the simulator's own session.yaml with
+# absolute paths, WORK/state as the state folder, the replay pace (default 0:
+# as fast as it goes; a replay waits for each stage, so nothing is dropped) and
+# the recordings to replay (default: the session's own).
+aditd_config() {
+  local session=$1 work=$2 speed=${3:-0} pcap=${4:-$1/lidar.pcap} can=${5:-$1/can.log}
+  sed -e "s#  state_dir: state#  state_dir: $work/state#" \
+      -e "s#  pcap: lidar.pcap#  pcap: $pcap#" \
+      -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
+      -e "s#  log: can.log#  log: $can#" \
+      -e "s#  replay_speed: 1.0#  replay_speed: $speed#" "$session/session.yaml"
+  printf 'threads:\n  lock_memory: false\n'
+}

@@ -31,17 +31,11 @@ session=$(sim_session "mine:robot:$seconds:$seed" "$work") || exit $?
 adit="$build/bin/adit"
 faketime_lib=/usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1
 
-# aditd's configuration for a run: the simulator's session.yaml with absolute
-# paths, this run's state folder and recordings, its own LCM port.
+# aditd's configuration for a run: the simulator's session.yaml for aditd
+# (sim-sessions.sh), with this run's recordings, pace, payload id and LCM port.
 config_for() {  # RUN PCAP CAN_LOG REPLAY_SPEED PAYLOAD URL
-  sed -e "s#  state_dir: state#  state_dir: $work/$1/state#" \
-      -e "s#  pcap: lidar.pcap#  pcap: $2#" \
-      -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
-      -e "s#  log: can.log#  log: $3#" \
-      -e "s#  replay_speed: 1.0#  replay_speed: $4#" \
-      -e "s#  id: sim-.*#  id: $5#" \
-      -e "s#  url: udpm://.*#  url: $6#" "$session/session.yaml"
-  printf 'threads:\n  lock_memory: false\nsession:\n  record_lidar: false\n'
+  aditd_config "$session" "$work/$1" "$4" "$2" "$3" | sed -e "s#  id: sim-.*#  id: $5#" -e "s#  url: udpm://.*#  url: $6#"
+  printf 'session:\n  record_lidar: false\n'
 }
 
 map_within() {  # RUN: percent of map points within 5 cm of the scene

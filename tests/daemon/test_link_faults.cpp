@@ -14,6 +14,7 @@
 #include "adit/config/load.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "daemon_process.hpp"
+#include "pipeline_run.hpp"
 #include "run_program.hpp"
 #include "sim_sessions.hpp"
 #include "shared_data.hpp"
@@ -48,27 +49,12 @@ struct LinkRun {
 };
 
 LinkRun map_with(const std::filesystem::path& pcap, const std::filesystem::path& work) {
-  const std::filesystem::path session = test::mine_drive_12s();
-  std::filesystem::create_directories(work);
-  const std::filesystem::path file = work / "aditd.yaml";
-  std::ofstream(file) << test::aditd_yaml_for(session, work / "state", {"", "", true, "threads:\n  lock_memory: false\n"});
-  config::Config c = config::load_config(file);
-  c.lidar.pcap = pcap.string();
-  PipelineOptions options;
-  options.trajectory_file = work / "trajectory.tum";
-  Pipeline pipeline(c, options);
-  pipeline.start();
-  pipeline.join();
-  const PipelineStats& s = pipeline.stats();
-  LinkRun run{s.poses.load(), s.missing_packets.load(), s.duplicate_packets.load(), s.late_packets.load(),
-              s.silences.load(), 0.0, 1e-9 * static_cast<double>(s.longest_silence_ns.load())};
-  const test::CommandRun eval = test::run_adit(fmt::format("eval traj --ref {} --est {} --json",
-                                                           (session / "truth_body.tum").string(),
-                                                           (work / "trajectory.tum").string()));
-  EXPECT_EQ(eval.status, 0) << eval.output;
-  const nlohmann::json j = nlohmann::json::parse(eval.output.substr(eval.output.find('{')), nullptr, false);
-  run.ape_rmse_m = j.is_object() ? j["ape"]["translation_m"]["rmse"].get<double>() : 1e9;
-  return run;
+  const test::ScoredRun scored =
+      test::run_and_score(test::mine_drive_12s(), work, [&](config::Config& c) { c.lidar.pcap = pcap.string(); });
+  const PipelineStats& s = scored.pipeline->stats();
+  return {s.poses.load(),    s.missing_packets.load(), s.duplicate_packets.load(),
+          s.late_packets.load(), s.silences.load(),     scored.ape_rmse_m,
+          1e-9 * static_cast<double>(s.longest_silence_ns.load())};
 }
 
 TEST(LinkFaults, LostRepeatedLateAndCutPacketsAreCountedAndTheTrajectoryHolds) {

@@ -20,6 +20,7 @@
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/can/bus_status.hpp"
 #include "daemon_process.hpp"
+#include "pipeline_run.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
 #include "sim_sessions.hpp"
@@ -47,17 +48,9 @@ struct FaultRun {
 };
 
 FaultRun map_with(const std::filesystem::path& session, const std::filesystem::path& can_log,
-             const std::filesystem::path& work) {
-  std::filesystem::create_directories(work);
-  const std::filesystem::path file = work / "aditd.yaml";
-  std::ofstream(file) << test::aditd_yaml_for(session, work / "state", {"", "", true, "threads:\n  lock_memory: false\n"});
-  config::Config c = config::load_config(file);
-  c.can.log = can_log.string();
-  PipelineOptions options;
-  options.trajectory_file = work / "trajectory.tum";
-  Pipeline pipeline(c, options);
-  pipeline.start();
-  pipeline.join();
+                  const std::filesystem::path& work) {
+  const test::ScoredRun scored = test::run_and_score(session, work, [&](config::Config& c) { c.can.log = can_log.string(); });
+  const Pipeline& pipeline = *scored.pipeline;
   FaultRun run;
   run.poses = pipeline.stats().poses.load();
   if (const CanFeedStats* can = pipeline.can_stats()) {
@@ -70,13 +63,8 @@ FaultRun map_with(const std::filesystem::path& session, const std::filesystem::p
   run.imu_gaps = imu.count(ImuProblem::gap);
   run.longest_imu_gap_s = imu.longest_gap_s.load();
   run.imu_problems = describe_problems(imu, "can");
-  const test::CommandRun eval = test::run_adit(fmt::format("eval traj --ref {} --est {} --json",
-                                                           (session / "truth_body.tum").string(),
-                                                           (work / "trajectory.tum").string()));
-  EXPECT_EQ(eval.status, 0) << eval.output;
-  const nlohmann::json j = nlohmann::json::parse(eval.output.substr(eval.output.find('{')), nullptr, false);
-  run.ape_rmse_m = j.is_object() ? j["ape"]["translation_m"]["rmse"].get<double>() : 1e9;
-  run.end_error_m = j.is_object() ? j["ape"]["translation_m"]["max"].get<double>() : 1e9;
+  run.ape_rmse_m = scored.ape_rmse_m;
+  run.end_error_m = scored.ape_max_m;
   return run;
 }
 
