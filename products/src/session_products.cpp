@@ -23,6 +23,14 @@ double thread_cpu_s() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+nlohmann::json files_of(const ProductsReport& r, const ProductsOptions& o) {
+  nlohmann::json files = nlohmann::json::array({"occupancy.bt"});
+  if (o.write_ot) files.push_back("occupancy.ot");
+  for (const char* f : {"grid.pgm", "grid.yaml", "top_view.png", "sections/"}) files.push_back(f);
+  if (r.targets_note.empty()) files.push_back("targets.csv");
+  return files;
+}
+
 nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
   return {{"points", r.points},
           {"points_without_ray", r.without_ray},
@@ -38,10 +46,8 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"top_view_bytes", r.top_view_bytes},
           {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
                         {"width_at_m", o.sections.width_at_m}}},
-          {"files", o.write_ot ? nlohmann::json::array({"occupancy.bt", "occupancy.ot", "grid.pgm", "grid.yaml",
-                                                        "top_view.png", "sections/"})
-                               : nlohmann::json::array({"occupancy.bt", "grid.pgm", "grid.yaml", "top_view.png",
-                                                        "sections/"})},
+          {"targets", {{"found", r.targets}, {"note", r.targets_note}}},
+          {"files", files_of(r, o)},
           {"cpu_s", r.cpu_s}};
 }
 
@@ -137,8 +143,19 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
   r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");
   r.leaves = occupancy.leaf_count();
-  r.top_view_bytes =
-      write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, {}, options.top_view).bytes;
+  // Targets by intensity (target_finder.hpp); a map without intensities has none to find.
+  std::vector<Eigen::Vector3d> target_centres;
+  if (std::any_of(map.intensities.begin(), map.intensities.end(), [](float i) { return i > 0.0F; })) {
+    const std::vector<FoundTarget> found = find_targets(map.points, map.intensities, map.sensor_path, options.targets);
+    write_targets_csv(r.out_dir / "targets.csv", found);
+    for (const FoundTarget& t : found) target_centres.push_back(t.centre);
+    r.targets = found.size();
+  } else {
+    r.targets_note = "the map has no intensities: targets cannot be found";
+  }
+  r.top_view_bytes = write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, target_centres,
+                                    options.top_view)
+                         .bytes;
   const std::vector<CrossSection> sections = cut_sections(map.points, map.sensor_path, options.sections);
   std::filesystem::create_directories(r.out_dir / "sections");
   for (const CrossSection& c : sections) {

@@ -16,6 +16,7 @@
 #include "adit/products/occupancy_3d.hpp"
 #include "adit/products/outlier_filter.hpp"
 #include "adit/products/session_map.hpp"
+#include "adit/products/target_finder.hpp"
 #include "adit/products/top_view.hpp"
 
 namespace adit::products {
@@ -34,6 +35,7 @@ struct ProductsOptions {
   double fill_step_m = 1.0;         // a viewpoint every metre of path
   TopViewOptions top_view;
   SectionOptions sections;
+  TargetOptions targets;            // targets.csv, drawn on the top view
 };
 
 struct ProductsReport {
@@ -51,6 +53,8 @@ struct ProductsReport {
   std::uintmax_t grid_bytes = 0;    // PGM + YAML
   std::uintmax_t top_view_bytes = 0;
   std::size_t sections = 0, sections_measured = 0;  // measured: width and height both found
+  std::size_t targets = 0;          // found by intensity (targets.csv)
+  std::string targets_note;         // why none were looked for ("" when they were)
   double cpu_s = 0.0;               // this thread's CPU time for all of it
   std::filesystem::path out_dir;
 };
@@ -59,7 +63,8 @@ struct ProductsReport {
 void check_options(const ProductsOptions& options);
 
 // Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
-// sections/section_NNN.svg and sections/sections.csv, products.json;
+// sections/section_NNN.svg and sections/sections.csv, targets.csv (when the
+// map has intensities; else the report says so and the rest is written), products.json;
 // OUT_DIR defaults to SESSION_DIR/products. Adds "products" to
 // SESSION_DIR/summary.json when it exists (written to a temporary file and
 // renamed). Throws adit::InputError for a missing or bad session file.
