@@ -167,6 +167,7 @@ std::vector<int> match_by_geometry(const std::vector<Eigen::Vector3d>& control,
             best_count = count;
             best_error = error;
           }
+          if (best_count == n && best_error <= tolerance_m) return best;  // every point, closely: done
         }
   return best;
 }
