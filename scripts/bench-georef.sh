@@ -12,6 +12,7 @@
 # by ref(t0)·est(t0)⁻¹, as scripts/bench-targets.sh) only to choose controls
 # and to score; georef itself sees no truth.
 # Usage: scripts/bench-georef.sh [DRIVE ...]  (default: the three 300 s mine loops of docs/LOOPS.md)
+# ADIT_GEOREF_ARGS: extra options for `adit georef`, e.g. --level.
 # ADIT_BENCH_YAML: YAML appended to aditd's configuration (e.g. $'map:\n  loops_move_map: true');
 # runs then go to build/bench-georef-<hash of it>.
 set -euo pipefail
@@ -22,7 +23,7 @@ suffix=""
 [ -z "$extra" ] || suffix="-$(printf '%s' "$extra" | md5sum | cut -c1-8)"
 use_drives "bench-georef$suffix" "$@"
 [ $# -gt 0 ] || drives=(mine:robot:300:5 mine:robot:300:6 mine:robot:300:7)
-printf '%-22s %6s %6s %9s %9s %9s %s\n' drive found checks rms_m worst_m ctrl_rms shifted-10cm
+printf '%-22s %6s %6s %9s %9s %9s %9s %9s %s\n' drive found checks rms_m worst_m ctrl_rms horiz_rms vert_rms shifted-10cm
 for drive in "${drives[@]}"; do
   IFS=: read -r scene platform seconds seed <<< "$drive"
   name="$scene-$platform-$seconds-s$seed"
@@ -89,18 +90,22 @@ open(work+"/checks.txt","w").write("\n".join(f"{fid} "+" ".join(f"{v:.4f}" for v
 open(work+"/shifted_id.txt","w").write(f"CP{truth[pairs[ctrl[1]][0]][0]}\n")
 PY
   [ -f "$work/control.csv" ] || continue
-  "$build/bin/adit" georef "$folder" --control "$work/control.csv" --targets "$work/found.csv" --out "$work/georef" \
+  # shellcheck disable=SC2086
+  "$build/bin/adit" georef "$folder" --control "$work/control.csv" --targets "$work/found.csv" --out "$work/georef" ${ADIT_GEOREF_ARGS:-} \
     > "$work/georef.txt" 2>&1 || { echo "$drive: adit georef failed ($work/georef.txt)" >&2; cat "$work/georef.txt" >&2; continue; }
-  "$build/bin/adit" georef "$folder" --control "$work/control_shifted.csv" --targets "$work/found.csv" \
+  # shellcheck disable=SC2086
+  "$build/bin/adit" georef "$folder" --control "$work/control_shifted.csv" --targets "$work/found.csv" ${ADIT_GEOREF_ARGS:-} \
     --out "$work/georef-shifted" > "$work/georef-shifted.txt" 2>&1 || true
   python3 - "$work" "$name" <<'PY'
 import sys, math, json
 work, name = sys.argv[1:3]
 fitted={l.split(',')[0]:list(map(float,l.split(',')[1:4])) for l in open(work+"/georef/targets.csv").readlines()[1:]}
-errs=[]
+errs=[]; horiz=[]; vert=[]
 for l in open(work+"/checks.txt"):
     if not l.strip(): continue
-    fid,*p=l.split(); errs.append(math.dist(fitted[fid],list(map(float,p))))
+    fid,*p=l.split(); p=list(map(float,p)); errs.append(math.dist(fitted[fid],p))
+    horiz.append(math.hypot(fitted[fid][0]-p[0],fitted[fid][1]-p[1])); vert.append(abs(fitted[fid][2]-p[2]))
+r=lambda a: math.sqrt(sum(x*x for x in a)/len(a)) if a else float('nan')
 g=json.load(open(work+"/georef/georef.json"))
 shifted=open(work+"/shifted_id.txt").read().strip()
 try:
@@ -110,7 +115,8 @@ try:
 except Exception as e:
     verdict=f"georef failed: {open(work+'/georef-shifted.txt').read().strip().splitlines()[-1]}"
 rms=math.sqrt(sum(e*e for e in errs)/len(errs)) if errs else float('nan')
-print(f"{name:22s} {len(fitted):6d} {len(errs):6d} {rms:9.4f} {max(errs) if errs else float('nan'):9.4f} {g['rms_m']:9.4f} {verdict}")
+print(f"{name:22s} {len(fitted):6d} {len(errs):6d} {rms:9.4f} {max(errs) if errs else float('nan'):9.4f} {g['rms_m']:9.4f} "
+      f"{r(horiz):9.4f} {r(vert):9.4f} {verdict}")
 open(work+"/score.txt","w").write(f"{rms} {max(errs) if errs else float('nan')} {len(errs)}\n")
 PY
 done

@@ -22,8 +22,39 @@ struct Pairs {
   std::vector<std::size_t> target;   // index into targets
 };
 
+// The level fit: a turn about the vertical only, the 2D case of Umeyama's
+// closed form on E, N (theta = atan2 of the summed cross and dot products of
+// the centred points), and H by the mean difference; the scale, when fitted,
+// from E, N and used for H too.
+std::optional<Similarity> level_fit(const std::vector<Eigen::Vector3d>& map, const std::vector<Eigen::Vector3d>& site,
+                                    const std::vector<std::size_t>& use, bool with_scale) {
+  if (use.size() < 2) return std::nullopt;
+  Eigen::Vector3d mean_map = Eigen::Vector3d::Zero(), mean_site = Eigen::Vector3d::Zero();
+  for (const std::size_t i : use) {
+    mean_map += map[i];
+    mean_site += site[i];
+  }
+  mean_map /= static_cast<double>(use.size());
+  mean_site /= static_cast<double>(use.size());
+  double dot = 0.0, cross = 0.0, spread = 0.0;
+  for (const std::size_t i : use) {
+    const Eigen::Vector2d a = (map[i] - mean_map).head<2>(), b = (site[i] - mean_site).head<2>();
+    dot += a.dot(b);
+    cross += a.x() * b.y() - a.y() * b.x();
+    spread += a.squaredNorm();
+  }
+  if (spread < 1e-12) return std::nullopt;  // the points coincide in plan: no heading
+  const double theta = std::atan2(cross, dot);
+  Similarity f;
+  f.rotation = Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  f.scale = with_scale ? std::hypot(dot, cross) / spread : 1.0;
+  f.translation = mean_site - f.scale * (f.rotation * mean_map);
+  return f;
+}
+
 std::optional<Similarity> fit_subset(const std::vector<Eigen::Vector3d>& map, const std::vector<Eigen::Vector3d>& site,
-                                     const std::vector<std::size_t>& use, bool with_scale) {
+                                     const std::vector<std::size_t>& use, bool with_scale, bool level = false) {
+  if (level) return level_fit(map, site, use, with_scale);
   Eigen::Matrix3Xd from(3, static_cast<Eigen::Index>(use.size()));
   Eigen::Matrix3Xd to(3, static_cast<Eigen::Index>(use.size()));
   for (std::size_t k = 0; k < use.size(); ++k) {
@@ -220,7 +251,7 @@ Georeference georeference(const ControlFile& control, const std::vector<Target>&
   const auto scaled = fit_subset(map, site, all_of(n), true);
   if (!scaled) throw InputError(file, "", "the matched control points lie on one line: the rotation about it is not determined");
   check_units(control, scaled->scale);
-  const auto first = fit_subset(map, site, all_of(n), options.with_scale);
+  const auto first = fit_subset(map, site, all_of(n), options.with_scale, options.level);
   if (!first) throw InputError(file, "", "the matched control points lie on one line: the rotation about it is not determined");
   const double median = median_residual(map, site, *first);
   const double tilt = tilt_deg(*first);
@@ -229,7 +260,7 @@ Georeference georeference(const ControlFile& control, const std::vector<Target>&
     // targets lying near one level) follows by turning the map upside down.
     std::vector<Eigen::Vector3d> mirrored = site;
     for (Eigen::Vector3d& p : mirrored) std::swap(p.x(), p.y());
-    const auto swapped = fit_subset(map, mirrored, all_of(n), options.with_scale);
+    const auto swapped = fit_subset(map, mirrored, all_of(n), options.with_scale);  // a mirror needs the full fit
     const std::size_t line = control.header_line != 0 ? control.header_line : control.points[pairs.control[0]].line;
     if (swapped && median_residual(map, mirrored, *swapped) <= options.match_tolerance_m &&
         tilt_deg(*swapped) <= options.max_tilt_deg)
@@ -256,7 +287,7 @@ Georeference georeference(const ControlFile& control, const std::vector<Target>&
     for (const std::size_t k : in_fit)
       if (k != i) rest.push_back(k);
     if (rest.size() < kMinFitPoints) return std::nullopt;
-    const auto fit = fit_subset(map, site, rest, options.with_scale);
+    const auto fit = fit_subset(map, site, rest, options.with_scale, options.level);
     if (!fit) return std::nullopt;
     return Eigen::Vector3d(site[i] - fit->apply(map[i]));
   };
@@ -271,7 +302,7 @@ Georeference georeference(const ControlFile& control, const std::vector<Target>&
     if (worst == n) break;
     in_fit.erase(std::find(in_fit.begin(), in_fit.end(), worst));
   }
-  const auto fit = fit_subset(map, site, in_fit, options.with_scale);
+  const auto fit = fit_subset(map, site, in_fit, options.with_scale, options.level);
   if (!fit) throw InputError(file, "", "the control points left in the fit lie on one line");
   result.fit = *fit;
 

@@ -121,6 +121,30 @@ TEST(Georeference, GeometryMatchesRenamedTargetsAndFitsSiteCoordinates) {
   }
 }
 
+TEST(Georeference, LevelFitTurnsAboutTheVerticalOnly) {
+  // A map whose heights drift (+2 cm per 10 m along x): the full fit tilts the
+  // map to follow the control points, the level fit only shifts it in H.
+  std::vector<Target> drifted = map_targets();
+  for (Target& t : drifted) t.position.z() += 0.002 * t.position.x();
+  Similarity level_site = site_transform();
+  level_site.rotation = Eigen::AngleAxisd(37.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::string csv;
+  for (const int k : {1, 3, 5, 8}) {
+    const Eigen::Vector3d p = level_site.apply(map_targets()[static_cast<std::size_t>(k - 1)].position);
+    csv += fmt::format("CP{},{:.4f},{:.4f},{:.4f}\n", k, p.x(), p.y(), p.z());
+  }
+  GeorefOptions level;
+  level.level = true;
+  const Georeference g = georeference(parse(csv), drifted, level);
+  EXPECT_NEAR(g.fit.rotation(2, 2), 1.0, 1e-12);
+  const Eigen::Matrix3d r = g.fit.rotation;
+  EXPECT_NEAR(std::atan2(r(1, 0), r(0, 0)) * 180.0 / std::numbers::pi, 37.0, 0.01);
+  // Plan positions exact; heights off by the drift about its mean over the control points.
+  for (const ControlResidual& p : g.points) EXPECT_LT(p.delta.head<2>().norm(), 1e-3) << p.id;
+  const Georeference full = georeference(parse(csv), drifted, {});
+  EXPECT_GT(std::acos(full.fit.rotation(2, 2)), 0.001);  // the full fit tilts
+}
+
 TEST(Georeference, MatchesByIdWhenEveryIdIsATarget) {
   std::vector<Target> targets = map_targets();
   for (Target& t : targets) t.id = "CP" + t.id;

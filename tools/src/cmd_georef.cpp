@@ -41,7 +41,7 @@ void print_table(const eval::Georeference& g, const GeorefCommand& c, std::size_
   std::size_t in_fit = 0;
   for (const auto& r : g.points) in_fit += r.in_fit ? 1 : 0;
   fmt::print("control points {}: {} of {} matched to targets by {}; {} fit on {}, tolerance {:.3f} m\n", c.control,
-             g.points.size(), control_points, g.matched_by, c.options.with_scale ? "similarity" : "rigid", in_fit,
+             g.points.size(), control_points, g.matched_by, fmt::format("{}{}", c.options.level ? "level " : "", c.options.with_scale ? "similarity" : "rigid"), in_fit,
              c.options.tolerance_m);
   fmt::print("{:<12} {:<8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "point", "target", "dE [m]", "dN [m]", "dH [m]", "3D [m]",
              "check [m]");
@@ -83,6 +83,7 @@ nlohmann::json to_json(const eval::Georeference& g, const GeorefCommand& c) {
   return {{"control", c.control},
           {"matched_by", g.matched_by},
           {"with_scale", c.options.with_scale},
+          {"level", c.options.level},
           {"tolerance_m", c.options.tolerance_m},
           {"epsg", c.epsg == 0 ? nlohmann::json(nullptr) : nlohmann::json(c.epsg)},
           {"map_to_site", {{"rotation", rotation},
@@ -157,6 +158,7 @@ void register_georef_commands(CLI::App& app, int& status) {
   cmd->add_option("--control", c->control, "Total-station CSV: id,E,N,H (header optional, names the column order)")->required();
   cmd->add_option("--targets", c->targets, "Targets found in the map: id,x,y,z[,sigma_m] (default SESSION/products/targets.csv)");
   cmd->add_flag("--scale", c->options.with_scale, "Fit a scale too (similarity), not only rotation and translation");
+  cmd->add_flag("--level", c->options.level, "Turn the map about the vertical only (its z is up: IMU); H by a shift");
   cmd->add_option("--tolerance", c->options.tolerance_m, "Flag residuals and check residuals above this (m, default 0.05)");
   cmd->add_option("--match", c->match, "How control points find their targets: auto (ids if they all match), id, geometry")
       ->check(CLI::IsMember({"auto", "id", "geometry"}));
