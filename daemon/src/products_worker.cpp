@@ -47,6 +47,14 @@ void ProductsWorker::stop() {
                 queue_.size(), queue_.front().string());
     queue_.clear();
     stopping_ = true;
+    if (busy_) {
+      cancel_ = true;
+      // Back to normal priority so the check is reached on a busy machine (EPERM for an unprivileged
+      // thread without RLIMIT_NICE: it then reaches it at idle priority).
+      sched_param param{};
+      param.sched_priority = 0;
+      if (thread_.joinable()) (void)pthread_setschedparam(thread_.native_handle(), SCHED_OTHER, &param);
+    }
   }
   changed_.notify_all();
   if (thread_.joinable()) thread_.join();
@@ -60,6 +68,11 @@ void ProductsWorker::wait_idle() {
 std::size_t ProductsWorker::made() const {
   const std::lock_guard lock(mutex_);
   return made_;
+}
+
+std::size_t ProductsWorker::cancelled() const {
+  const std::lock_guard lock(mutex_);
+  return cancelled_;
 }
 
 std::size_t ProductsWorker::failed() const {
@@ -80,17 +93,24 @@ void ProductsWorker::run() {
       queue_.pop_front();
       busy_ = true;
     }
-    bool ok = false;
+    enum class Outcome { made, failed, cancelled } outcome = Outcome::failed;
     const std::filesystem::path partial = dir / "products.partial";
     const std::filesystem::path done = dir / "products";
     try {
       std::filesystem::remove_all(partial);  // a run cut short before
-      const products::ProductsReport r = products::write_session_products(dir, products::ProductsOptions{}, partial);
+      products::ProductsOptions options;
+      options.cancel = &cancel_;
+      const products::ProductsReport r = products::write_session_products(dir, options, partial);
       std::filesystem::remove_all(done);
       std::filesystem::rename(partial, done);
       log::info("session {}: products in {} ({:.1f} s of CPU; {} targets{})", dir.filename().string(), done.string(),
                 r.cpu_s, r.targets, r.targets_note.empty() ? "" : "; " + r.targets_note);
-      ok = true;
+      outcome = Outcome::made;
+    } catch (const products::Cancelled&) {
+      log::warn("session {}: products cancelled at shutdown (`adit products` makes them)", dir.filename().string());
+      outcome = Outcome::cancelled;
+      std::error_code ec;
+      std::filesystem::remove_all(partial, ec);
     } catch (const std::exception& e) {
       log::error("session {}: products failed: {}", dir.filename().string(), e.what());
       std::error_code ec;
@@ -98,7 +118,7 @@ void ProductsWorker::run() {
     }
     {
       const std::lock_guard lock(mutex_);
-      (ok ? made_ : failed_) += 1;
+      (outcome == Outcome::made ? made_ : outcome == Outcome::failed ? failed_ : cancelled_) += 1;
       busy_ = false;
     }
     changed_.notify_all();

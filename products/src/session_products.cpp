@@ -92,6 +92,9 @@ void check_options(const ProductsOptions& o) {
 ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
                                       const std::filesystem::path& out_dir) {
   check_options(options);
+  const auto check_cancel = [&options] {
+    if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) throw Cancelled();
+  };
   const double cpu0 = thread_cpu_s();
   ProductsReport r;
   r.out_dir = out_dir.empty() ? session_dir / "products" : out_dir;
@@ -100,9 +103,11 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   r.points = map.points.size();
   r.points_file = map_file_of(session_dir).filename().string();
   r.points_bytes = std::filesystem::file_size(session_dir / r.points_file);
+  check_cancel();
 
   const GroundSegmentation ground = segment_ground(map.points, options.ground);
   r.ground_points = ground.ground_points;
+  check_cancel();
   std::vector<std::uint8_t> non_ground(map.points.size());
   for (std::size_t i = 0; i < non_ground.size(); ++i) non_ground[i] = ground.is_ground[i] ? 0 : 1;
   const std::vector<std::uint8_t> kept = statistical_inliers(map.points, non_ground, options.outliers);
@@ -117,7 +122,9 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return map.origin[a] < map.origin[b]; });
   Occupancy3d occupancy(options.occupancy);
   std::vector<Eigen::Vector3f> hits, passes;
+  check_cancel();
   for (std::size_t begin = 0; begin < order.size();) {
+    check_cancel();
     std::size_t end = begin;
     hits.clear();
     passes.clear();
@@ -134,6 +141,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
                                 {options.grid_resolution_m, options.band_low_m, options.band_high_m});
   if (options.line_of_sight_fill)
     r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
+  check_cancel();
   r.grid_occupied = grid.count(kOccupied);
   r.grid_free = grid.count(kFree);
   r.grid_unknown = grid.count(kUnknown);

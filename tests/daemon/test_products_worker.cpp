@@ -99,14 +99,16 @@ TEST(ProductsWorker, AFailedSessionIsCountedAndTheNextIsMade) {
   std::filesystem::remove_all(good);
 }
 
-TEST(ProductsWorker, StopDropsWhatHasNotBegun) {
+TEST(ProductsWorker, StopCancelsTheOneBegunAndDropsTheRest) {
   std::vector<std::filesystem::path> dirs;
   for (int i = 0; i < 6; ++i) dirs.push_back(corridor_session("stop" + std::to_string(i)));
   {
     ProductsWorker worker;
     for (const auto& d : dirs) worker.enqueue(d);
-    worker.stop();  // the one begun (if any) is finished; the others are dropped
-    EXPECT_LT(worker.made(), dirs.size());
+    std::this_thread::sleep_for(30ms);  // the first is begun
+    worker.stop();  // it is cancelled (or done, on a fast machine); the others are dropped
+    EXPECT_LE(worker.made() + worker.cancelled(), 1U);
+    EXPECT_EQ(worker.failed(), 0U);
     worker.enqueue(dirs[0]);  // after stop: ignored, never waits
   }
   for (const auto& d : dirs) {
@@ -120,6 +122,9 @@ TEST(ProductsWorker, StopDropsWhatHasNotBegun) {
 // map, trajectory and summary are as they were (or the summary has gained
 // "products" whole), and the next run makes the products.
 TEST(ProductsWorker, AKillDuringProductsLeavesTheSessionWhole) {
+#if defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "fork() of a process that has run threads: not under ThreadSanitizer";
+#endif
   for (const int after_ms : {0, 5, 20, 60, 150}) {
     const auto dir = corridor_session("kill");
     const std::string map_before = contents(dir / "map.las");

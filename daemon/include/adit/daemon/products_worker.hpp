@@ -13,11 +13,14 @@
 // at most a products.partial folder (removed when the session is queued
 // again; `adit products SESSION` makes its products by hand).
 //
-// stop() (and the destructor) drops the sessions not yet begun, saying so in
-// the log, and waits for the one being made: the library has no cancellation
-// point, and a half-made products folder would only be removed again.
+// stop() (and the destructor) drops the sessions not yet begun and cancels
+// the one being made (ProductsOptions::cancel: between steps and every octree
+// batch; the rays to the path finish first), saying so in the log; it raises
+// the thread back to SCHED_OTHER first, when the kernel allows, so that a busy
+// machine does not keep an idle-priority thread from reaching its check.
 // Measured: 2.7-5.8 s of CPU for a 60-90 s drive (docs/PRODUCTS.md).
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -37,13 +40,14 @@ class ProductsWorker {
 
   // Queues a session folder whose summary.json is written; never waits.
   void enqueue(std::filesystem::path session_dir);
-  // Drops what has not begun, waits for the one being made, ends the thread.
+  // Drops what has not begun, cancels the one being made, ends the thread.
   void stop();
   // Blocks until nothing is queued or being made (tests, `aditd --once`).
   void wait_idle();
 
   std::size_t made() const;    // sessions whose products were written
   std::size_t failed() const;  // sessions whose products failed (logged)
+  std::size_t cancelled() const;  // begun and cancelled by stop()
 
  private:
   void run();
@@ -53,7 +57,8 @@ class ProductsWorker {
   std::deque<std::filesystem::path> queue_;
   bool busy_ = false;
   bool stopping_ = false;
-  std::size_t made_ = 0, failed_ = 0;
+  std::size_t made_ = 0, failed_ = 0, cancelled_ = 0;
+  std::atomic<bool> cancel_{false};
   std::thread thread_;  // last: started once the rest exists
 };
 

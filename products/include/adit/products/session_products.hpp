@@ -7,7 +7,9 @@
 // of its own (the next session may start meanwhile); `adit products` calls
 // it for any session folder. docs/PRODUCTS.md says how each step works.
 
+#include <atomic>
 #include <cstdint>
+#include <stdexcept>
 #include <filesystem>
 #include <string>
 
@@ -36,6 +38,15 @@ struct ProductsOptions {
   TopViewOptions top_view;
   SectionOptions sections;
   TargetOptions targets;            // targets.csv, drawn on the top view
+  // Set from another thread to stop early (aditd's shutdown): checked between
+  // the steps and every octree batch; the rays to the path (read_session_map)
+  // run to their end first. Null: never.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// Thrown by write_session_products() when `cancel` was set; nothing more is written.
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("cancelled") {}
 };
 
 struct ProductsReport {
