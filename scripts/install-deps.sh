@@ -31,6 +31,7 @@ packages=(
   libpcl-dev mpi-default-dev  # PCL GICP, the odometry benchmark's baseline (PCL's VTK config needs MPI); products' SOR filter
   liboctomap-dev         # session products: 3D occupancy by ray casting, .bt/.ot files (products/)
   libpng-dev             # session products: the top-down picture of the map (products/)
+  libproj-dev            # adit georef: an EPSG code as OGC WKT in LAS files (tools/src/crs_wkt.cpp; pulls proj-data, its database)
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   libfaketime            # tests: the wall clock stepped under aditd (tests/daemon/test_clock_steps.cpp)

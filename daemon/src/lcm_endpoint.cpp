@@ -16,6 +16,7 @@
 #include "adit/common/log.hpp"
 #include "adit/command_ack_t.hpp"
 #include "adit/daemon/handoff.hpp"
+#include "adit/daemon/product_file_server.hpp"
 #include "adit/daemon/tile_publisher.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/channels.hpp"
@@ -93,7 +94,7 @@ struct LcmEndpoint::Impl final : TileSink {
   EndpointOptions options;
   SessionHooks hooks;
   lcm::LCM lcm;
-  std::array<std::string, 7> channels;
+  std::array<std::string, protocol::kChannelCount> channels;
   Handoff<PoseSample> poses;
   Handoff<StatusSample> statuses;
   Handoff<TileUpdate> tiles;
@@ -135,9 +136,10 @@ struct LcmEndpoint::Impl final : TileSink {
       throw InputError("tile parameters", "tiles", problem);
     if (!lcm.good()) throw std::runtime_error(fmt::format("LCM cannot open '{}'", options.lcm_url));
     load_keys();
-    for (int c = 0; c < 7; ++c) channels[c] = protocol::channel_name(options.payload_id, static_cast<Channel>(c));
+    for (int c = 0; c < protocol::kChannelCount; ++c) channels[c] = protocol::channel_name(options.payload_id, static_cast<Channel>(c));
     lcm.subscribe(channel(Channel::command), &Impl::on_command, this);
     lcm.subscribe(channel(Channel::tile_request), &Impl::on_tile_request, this);
+    lcm.subscribe(channel(Channel::file_request), &Impl::on_file_request, this);
     thread = std::thread([this] { run(); });
   }
 
@@ -415,6 +417,19 @@ struct LcmEndpoint::Impl final : TileSink {
     }
     ++counters.tile_requests;
     publisher.answer(r);
+  }
+
+  // A stored session's product file (product_file_server.hpp); "" names the last session.
+  void on_file_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    file_request_t r;
+    if (!protocol::checked_decode(rbuf->data, rbuf->data_size, r) || r.payload_id != options.payload_id) {
+      ++counters.file_requests_malformed;
+      return;
+    }
+    ++counters.file_requests;
+    counters.file_chunks_published += answer_file_request(r, r.session_id.empty() ? session_id : r.session_id,
+                                                          hooks.session_folder,
+                                                          [this](const file_chunk_t& c) { send(Channel::file, c); });
   }
 };
 

@@ -32,6 +32,7 @@
 #include "adit/drivers/can/bus_status.hpp"
 #include "adit/drivers/pcap_replay.hpp"
 #include "adit/daemon/journal_writer.hpp"
+#include "adit/daemon/products_worker.hpp"
 #include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/tum.hpp"
@@ -173,6 +174,7 @@ PoseSample pose_sample_of(const slam::OdometryResult& r) {
 Sessions::Sessions(const config::Config& config, Outputs outputs)
     : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {
   standby_ = build_pipeline();
+  if (config_.session.products) products_ = std::make_unique<ProductsWorker>();
   if (!interrupted_sessions(root_).empty()) recoverer_ = std::thread([this] { recover_interrupted(); });
 }
 
@@ -209,6 +211,7 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
 
 Sessions::~Sessions() {
   stop_and_wait();
+  if (products_) products_->stop();  // waits for the session being made, drops the rest
   if (recoverer_.joinable()) recoverer_.join();
 }
 
@@ -430,6 +433,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       std::error_code ec;
       std::filesystem::remove(journal->file(), ec);
     }
+    if (products_) products_->enqueue(dir);  // made in the background; the next START does not wait
     log::info("session {}: stopped; {} poses, {} map points in {} tiles; files in {}", id, s.poses.load(), map.size(),
               map.tile_count(), dir.string());
     if (config_.imu.enabled) {

@@ -25,6 +25,7 @@ std::vector<Target> read_targets_csv(std::istream& in, const std::filesystem::pa
   std::vector<std::string_view> fields;
   std::string line;
   bool header = false;
+  std::size_t columns = 4;  // 5 with sigma_m (`adit targets find`), not read
   for (std::size_t number = 1; std::getline(in, line); ++number) {
     if (detail::is_comment_or_blank(line)) continue;
     const std::string where = fmt::format("{}:{}", path.string(), number);
@@ -33,13 +34,16 @@ std::vector<Target> read_targets_csv(std::istream& in, const std::filesystem::pa
       std::string joined;
       for (const auto f : fields) joined += std::string(f) + ",";
       std::transform(joined.begin(), joined.end(), joined.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (joined != "id,x,y,z,")
-        throw InputError(where, "header", fmt::format("expected 'id,x,y,z', found '{}'", line));
+      if (joined == "id,x,y,z,sigma_m,") {
+        columns = 5;
+      } else if (joined != "id,x,y,z,") {
+        throw InputError(where, "header", fmt::format("expected 'id,x,y,z' or 'id,x,y,z,sigma_m', found '{}'", line));
+      }
       header = true;
       continue;
     }
-    if (fields.size() != 4)
-      throw InputError(where, "", fmt::format("expected 4 fields (id,x,y,z), found {}", fields.size()));
+    if (fields.size() != columns)
+      throw InputError(where, "", fmt::format("expected {} fields, found {}", columns, fields.size()));
     if (fields[0].empty()) throw InputError(where, "id", "is empty");
     Target t{std::string(fields[0]), {}};
     for (int k = 0; k < 3; ++k) {

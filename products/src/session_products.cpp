@@ -31,6 +31,7 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
   files.push_back("occupancy.bt");
   if (o.write_ot) files.push_back("occupancy.ot");
   files.insert(files.end(), {"grid.pgm", "grid.yaml", "top_view.png", "sections/"});
+  if (r.targets_note.empty()) files.push_back("targets.csv");
   return {{"points", r.points},
           {"moving_objects", {{"enabled", o.moving.enabled}, {"removed", r.moving_removed},
                               {"candidates", r.moving_candidates}, {"suspects", r.moving_suspects}, {"scans_used", r.moving_scans},
@@ -48,6 +49,7 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"top_view_bytes", r.top_view_bytes},
           {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
                         {"width_at_m", o.sections.width_at_m}}},
+          {"targets", {{"found", r.targets}, {"note", r.targets_note}}},
           {"files", files},
           {"cpu_s", r.cpu_s}};
 }
@@ -100,6 +102,9 @@ void check_options(const ProductsOptions& o) {
 ProductsReport write_session_products(const std::filesystem::path& session_dir, const ProductsOptions& options,
                                       const std::filesystem::path& out_dir) {
   check_options(options);
+  const auto check_cancel = [&options] {
+    if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) throw Cancelled();
+  };
   const double cpu0 = thread_cpu_s();
   ProductsReport r;
   r.out_dir = out_dir.empty() ? session_dir / "products" : out_dir;
@@ -108,6 +113,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   r.points_file = map_file.filename().string();
   r.points_bytes = std::filesystem::file_size(map_file);
   std::filesystem::create_directories(r.out_dir);
+  check_cancel();
   {
     const double moving0 = thread_cpu_s();
     const MovingObjectsReport moving = remove_moving_objects(session_dir, inputs, {}, options.moving);
@@ -128,9 +134,11 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   const SessionMap map = rays_from(inputs.points, inputs.body_poses, inputs.body_to_sensor, options.rays);
   r.without_ray = map.without_ray;
   r.points = map.points.size();
+  check_cancel();
 
   const GroundSegmentation ground = segment_ground(map.points, options.ground);
   r.ground_points = ground.ground_points;
+  check_cancel();
   std::vector<std::uint8_t> non_ground(map.points.size());
   for (std::size_t i = 0; i < non_ground.size(); ++i) non_ground[i] = ground.is_ground[i] ? 0 : 1;
   const std::vector<std::uint8_t> kept = statistical_inliers(map.points, non_ground, options.outliers);
@@ -145,7 +153,9 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return map.origin[a] < map.origin[b]; });
   Occupancy3d occupancy(options.occupancy);
   std::vector<Eigen::Vector3f> hits, passes;
+  check_cancel();
   for (std::size_t begin = 0; begin < order.size();) {
+    check_cancel();
     std::size_t end = begin;
     hits.clear();
     passes.clear();
@@ -162,6 +172,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
                                 {options.grid_resolution_m, options.band_low_m, options.band_high_m});
   if (options.line_of_sight_fill)
     r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
+  check_cancel();
   r.grid_occupied = grid.count(kOccupied);
   r.grid_free = grid.count(kFree);
   r.grid_unknown = grid.count(kUnknown);
@@ -170,8 +181,19 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
   r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");
   r.leaves = occupancy.leaf_count();
-  r.top_view_bytes =
-      write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, {}, options.top_view).bytes;
+  // Targets by intensity (target_finder.hpp); a map without intensities has none to find.
+  std::vector<Eigen::Vector3d> target_centres;
+  if (std::any_of(map.intensities.begin(), map.intensities.end(), [](float i) { return i > 0.0F; })) {
+    const std::vector<FoundTarget> found = find_targets(map.points, map.intensities, map.sensor_path, options.targets);
+    write_targets_csv(r.out_dir / "targets.csv", found);
+    for (const FoundTarget& t : found) target_centres.push_back(t.centre);
+    r.targets = found.size();
+  } else {
+    r.targets_note = "the map has no intensities: targets cannot be found";
+  }
+  r.top_view_bytes = write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, target_centres,
+                                    options.top_view)
+                         .bytes;
   const std::vector<CrossSection> sections = cut_sections(map.points, map.sensor_path, options.sections);
   std::filesystem::create_directories(r.out_dir / "sections");
   for (const CrossSection& c : sections) {

@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <fstream>
 #include <limits>
 #include <unordered_map>
 
 #include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+
+#include "adit/common/error.hpp"
 
 namespace adit::products {
 namespace {
@@ -95,6 +99,15 @@ std::vector<FoundTarget> find_targets(std::span<const Eigen::Vector3f> points, s
     out.push_back(t);
   }
   return out;
+}
+
+void write_targets_csv(const std::filesystem::path& file, std::span<const FoundTarget> targets) {
+  std::ofstream out(file);
+  if (!out) throw InputError(file.string(), "", "cannot open for writing");
+  out << "id,x,y,z,sigma_m\n";
+  for (const FoundTarget& t : targets)
+    out << fmt::format("{},{:.4f},{:.4f},{:.4f},{:.4f}\n", t.id, t.centre.x(), t.centre.y(), t.centre.z(), t.sigma_m);
+  if (!out) throw InputError(file.string(), "", "write failed");
 }
 
 }  // namespace adit::products

@@ -23,6 +23,8 @@ std::string_view channel_kind(Channel channel) {
     case Channel::tile_index: return "TILE_INDEX";
     case Channel::tile: return "TILE";
     case Channel::tile_request: return "TILE_REQUEST";
+    case Channel::file_request: return "FILE_REQUEST";
+    case Channel::file: return "FILE";
   }
   return "UNKNOWN";
 }

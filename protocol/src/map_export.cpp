@@ -8,6 +8,7 @@
 #include <ctime>
 #include <fstream>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -38,11 +39,11 @@ class Bytes {
   std::vector<std::uint8_t> data_;
 };
 
-std::string ply_header(std::uint64_t n) {
+std::string ply_header(std::uint64_t n, bool doubles) {
   return fmt::format(
-      "ply\nformat binary_little_endian 1.0\ncomment adit map\nelement vertex {}\n"
-      "property float x\nproperty float y\nproperty float z\nproperty float intensity\nend_header\n",
-      n);
+      "ply\nformat binary_little_endian 1.0\ncomment adit map\nelement vertex {0}\n"
+      "property {1} x\nproperty {1} y\nproperty {1} z\nproperty float intensity\nend_header\n",
+      n, doubles ? "double" : "float");
 }
 
 // PCD v0.7 (pointclouds.org file format): ASCII header, binary records.
@@ -60,10 +61,22 @@ void put_float_xyzi(Bytes& b, const MapPoint& p) {
   b.put(p.intensity);
 }
 
+void put_double_xyz_float_i(Bytes& b, const MapPoint& p) {
+  b.put(p.x);
+  b.put(p.y);
+  b.put(p.z);
+  b.put(p.intensity);
+}
+
+// The VLR bytes before the points: one WKT record, or nothing.
+std::size_t las_vlr_size(const std::string& wkt) { return wkt.empty() ? 0 : kLasVlrHeaderSize + wkt.size() + 1; }
+
 // LAS 1.4 R15 (ASPRS, 2019), Table 3 (public header block, 375 bytes) and
-// Table 13 (point data record format 6, 30 bytes). No VLRs, no EVLRs.
+// Table 13 (point data record format 6, 30 bytes). No EVLRs; one VLR (the
+// CRS as WKT, Table 4 and "OGC Coordinate System WKT Record") when `wkt` is
+// given, else none.
 Bytes las_header(std::uint64_t n, const std::array<double, 3>& offset, const std::array<double, 3>& lo,
-                 const std::array<double, 3>& hi) {
+                 const std::array<double, 3>& hi, const std::string& wkt) {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
@@ -85,8 +98,8 @@ Bytes las_header(std::uint64_t n, const std::array<double, 3>& offset, const std
   b.put<std::uint16_t>(static_cast<std::uint16_t>(utc.tm_yday + 1));
   b.put<std::uint16_t>(static_cast<std::uint16_t>(utc.tm_year + 1900));
   b.put<std::uint16_t>(kLasHeaderSize);
-  b.put<std::uint32_t>(kLasHeaderSize);  // offset to point data: no VLRs
-  b.put<std::uint32_t>(0);               // number of VLRs
+  b.put<std::uint32_t>(static_cast<std::uint32_t>(kLasHeaderSize + las_vlr_size(wkt)));  // offset to point data
+  b.put<std::uint32_t>(wkt.empty() ? 0 : 1);                                              // number of VLRs
   b.put<std::uint8_t>(6);                // point data record format
   b.put<std::uint16_t>(kLasPointFormat6Length);
   b.put<std::uint32_t>(0);  // legacy point count: must be 0 for formats 6-10
@@ -103,6 +116,15 @@ Bytes las_header(std::uint64_t n, const std::array<double, 3>& offset, const std
   b.put<std::uint64_t>(n);
   b.put<std::uint64_t>(n);  // every point is return 1 of 1
   for (int i = 1; i < 15; ++i) b.put<std::uint64_t>(0);
+  if (!wkt.empty()) {  // Table 4: the VLR header, then the record
+    b.put<std::uint16_t>(0);  // reserved
+    b.put_text("LASF_Projection", 16);
+    b.put<std::uint16_t>(kLasWktRecordId);
+    b.put<std::uint16_t>(static_cast<std::uint16_t>(wkt.size() + 1));
+    b.put_text("OGC coordinate system WKT", 32);
+    b.append(wkt);
+    b.put<std::uint8_t>(0);
+  }
   return b;
 }
 
@@ -137,13 +159,16 @@ std::optional<MapFormat> parse_map_format(std::string_view name) {
 }
 
 MapFileWriter::MapFileWriter(const std::filesystem::path& file, MapFormat format, std::uint64_t n_points,
-                             const std::array<double, 3>& las_offset)
-    : file_(file), format_(format), n_points_(n_points), offset_(las_offset), out_(file, std::ios::binary | std::ios::trunc) {
+                             const std::array<double, 3>& las_offset, MapFileExtras extras)
+    : file_(file), format_(format), n_points_(n_points), offset_(las_offset), extras_(std::move(extras)) {
+  if (extras_.crs_wkt.size() >= 65535)
+    throw InputError(file_.string(), "crs", fmt::format("the WKT is {} bytes: a LAS VLR holds at most 65534", extras_.crs_wkt.size()));
+  out_.open(file, std::ios::binary | std::ios::trunc);
   Bytes header(kLasHeaderSize);
   switch (format_) {
-    case MapFormat::ply: header.append(ply_header(n_points)); break;
+    case MapFormat::ply: header.append(ply_header(n_points, extras_.ply_double)); break;
     case MapFormat::pcd: header.append(pcd_header(n_points)); break;
-    case MapFormat::las: header = las_header(n_points, offset_, lo_, hi_); break;
+    case MapFormat::las: header = las_header(n_points, offset_, lo_, hi_, extras_.crs_wkt); break;
   }
   save(header.data());
 }
@@ -155,7 +180,7 @@ void MapFileWriter::save(std::span<const std::uint8_t> bytes) {
 
 void MapFileWriter::write(std::span<const MapPoint> points) {
   if (points.empty()) return;
-  Bytes b(points.size() * kLasPointFormat6Length);
+  Bytes b(points.size() * kLasPointFormat6Length);  // the largest record (PLY with doubles: 28 bytes)
   for (const MapPoint& p : points) {
     if (format_ == MapFormat::las) {
       put_las_point(b, p, offset_);
@@ -164,6 +189,8 @@ void MapFileWriter::write(std::span<const MapPoint> points) {
         lo_[a] = written_ == 0 ? v[a] : std::min(lo_[a], v[a]);
         hi_[a] = written_ == 0 ? v[a] : std::max(hi_[a], v[a]);
       }
+    } else if (format_ == MapFormat::ply && extras_.ply_double) {
+      put_double_xyz_float_i(b, p);
     } else {
       put_float_xyzi(b, p);
     }
@@ -177,13 +204,14 @@ void MapFileWriter::finish() {
     throw InputError(file_.string(), "", fmt::format("{} points written, {} announced", written_, n_points_));
   if (format_ == MapFormat::las) {  // the bounds are known now
     out_.seekp(0);
-    save(las_header(n_points_, offset_, lo_, hi_).data());
+    save(las_header(n_points_, offset_, lo_, hi_, extras_.crs_wkt).data());
   }
   out_.close();
   if (!out_) throw InputError(file_.string(), "", "cannot write the map file");
 }
 
-void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points) {
+void write_map(const std::filesystem::path& file, MapFormat format, std::span<const MapPoint> points,
+               const MapFileExtras& extras) {
   // Offsets at whole metres below the minimum keep the integers small and
   // positive; 1 mm scale then spans 2 147 km, far beyond any survey.
   std::array<double, 3> offset{0, 0, 0};
@@ -192,7 +220,7 @@ void write_map(const std::filesystem::path& file, MapFormat format, std::span<co
     for (std::size_t a = 0; a < 3; ++a) offset[a] = i == 0 ? v[a] : std::min(offset[a], v[a]);
   }
   for (double& o : offset) o = std::floor(o);
-  MapFileWriter writer(file, format, points.size(), offset);
+  MapFileWriter writer(file, format, points.size(), offset, extras);
   writer.write(points);
   writer.finish();
 }

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <random>
 #include <set>
 #include <thread>
 #include <tuple>
@@ -29,6 +30,8 @@
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/tile_segment_t.hpp"
+#include "adit/file_chunk_t.hpp"
+#include "adit/file_request_t.hpp"
 #include "map_readers.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
@@ -80,7 +83,8 @@ struct Harness {
   std::atomic<int> stops{0};
   std::unique_ptr<LcmEndpoint> endpoint;
 
-  explicit Harness(double drop = 0.0, const std::filesystem::path& key_file = {}, std::size_t command_window = 1024) {
+  explicit Harness(double drop = 0.0, const std::filesystem::path& key_file = {}, std::size_t command_window = 1024,
+                   const std::filesystem::path& sessions_root = {}) {
     EndpointOptions o;
     o.lcm_url = url;
     o.payload_id = payload;
@@ -95,6 +99,8 @@ struct Harness {
     // (the test does that from its own thread, like the daemon's main loop).
     hooks.stop = [this] { ++stops; };
     hooks.sessions = [] { return std::vector<std::string>{"s0", "s1"}; };
+    if (!sessions_root.empty())
+      hooks.session_folder = [sessions_root](const std::string& id) { return sessions_root / id; };
     endpoint = std::make_unique<LcmEndpoint>(o, hooks);
   }
 
@@ -121,6 +127,11 @@ struct Sniffer {
   std::mutex mutex;
   std::vector<command_ack_t> acks;
   std::vector<std::pair<std::int64_t, std::int32_t>> chunk_versions;
+  std::vector<std::string> file_errors;
+  std::string file_error() {
+    const std::lock_guard lock(mutex);
+    return file_errors.empty() ? "" : file_errors.back();
+  }
   std::thread thread;
 
   explicit Sniffer(const std::string& url) : lcm(url) {
@@ -142,6 +153,9 @@ struct Sniffer {
     if (channel.ends_with("/ACK")) {
       command_ack_t ack;
       if (ack.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) acks.push_back(ack);
+    } else if (channel.ends_with("/FILE")) {
+      file_chunk_t c;
+      if (c.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && !c.error.empty()) file_errors.push_back(c.error);
     } else if (channel.ends_with("/TILE")) {
       tile_segment_t c;
       if (c.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0) chunk_versions.emplace_back(c.tile_id, c.version);
@@ -405,6 +419,75 @@ TEST(LcmEndpoint, DownloadOfASessionTheDaemonDoesNotHoldSaysSo) {
   const auto r = h.adit({"download", "--session", "s9", "--format", "ply", "--out", "/nonexistent/x.ply"}, 2);
   EXPECT_EQ(r.exit_status, 1);
   EXPECT_NE(r.err.find("download failed: session 's9' is not held by this daemon"), std::string::npos) << r.err;
+}
+
+std::string file_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The products of a stored session over real LCM: every product file whole
+// (one of 3.5 MB: more than one request's 64 chunks), nothing else of the
+// session folder, and clear errors.
+TEST(LcmEndpoint, DownloadOfProductsFetchesTheProductFilesOnly) {
+  const auto root = std::filesystem::temp_directory_path() / fmt::format("adit-products-{}", ::getpid());
+  std::filesystem::remove_all(root);
+  const auto products = root / "s7" / "products";
+  std::filesystem::create_directories(products / "sections");
+  std::filesystem::create_directories(root / "s8");
+  std::mt19937 rng(3);
+  std::string big(3'500'000, '\0');
+  for (char& c : big) c = static_cast<char>(rng());
+  std::ofstream(products / "top_view.png", std::ios::binary) << big;
+  std::ofstream(products / "grid.yaml") << "image: grid.pgm\nresolution: 0.05\n";
+  std::ofstream(products / "grid.pgm", std::ios::binary) << "P5\n2 1\n255\n" << std::string("\0\xfe", 2);
+  std::ofstream(products / "sections" / "section_001.svg") << "<svg/>";
+  std::ofstream(products / "secret.txt") << "not a product";
+  std::ofstream(root / "s7" / "map.las") << "LASF";
+  Harness h(0.0, {}, 1024, root);
+
+  const auto out = root / "fetched";
+  const auto all = h.adit({"download", "--session", "s7", "--products", "--out", out.string()}, 10);
+  ASSERT_EQ(all.exit_status, 0) << all.out << all.err;
+  EXPECT_NE(all.out.find("4 product files of session s7"), std::string::npos) << all.out;
+  for (const char* f : {"top_view.png", "grid.yaml", "grid.pgm", "sections/section_001.svg"})
+    EXPECT_EQ(file_bytes(out / f), file_bytes(products / f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(out / "secret.txt"));
+
+  const auto one = h.adit({"download", "--session", "s7", "--product", "grid.yaml", "--out", (root / "one").string()});
+  ASSERT_EQ(one.exit_status, 0) << one.err;
+  EXPECT_EQ(file_bytes(root / "one" / "grid.yaml"), file_bytes(products / "grid.yaml"));
+
+  const auto outside = h.adit({"download", "--session", "s7", "--product", "../map.las", "--out", (root / "x").string()});
+  EXPECT_EQ(outside.exit_status, 2);
+  EXPECT_NE(outside.err.find("is not a product file"), std::string::npos) << outside.err;
+  const auto missing = h.adit({"download", "--session", "s7", "--product", "occupancy.bt", "--out", (root / "x").string()}, 2);
+  EXPECT_EQ(missing.exit_status, 1);
+  EXPECT_NE(missing.err.find("session 's7' has no products/occupancy.bt"), std::string::npos) << missing.err;
+  const auto none = h.adit({"download", "--session", "s8", "--products", "--out", (root / "x").string()}, 2);
+  EXPECT_EQ(none.exit_status, 1);
+  EXPECT_NE(none.err.find("session 's8' has no products (yet): aditd makes them after STOP"), std::string::npos) << none.err;
+
+  // A request the client would not send: the daemon refuses it too.
+  Sniffer sniffer(h.url);
+  lcm::LCM lcm(h.url);
+  file_request_t r{};
+  r.schema = 1;
+  r.request_id = 42;
+  r.payload_id = h.payload;
+  r.session_id = "s7";
+  r.path = "products/../map.las";
+  r.n_chunks = 64;
+  lcm.publish(protocol::channel_name(h.payload, Channel::file_request), &r);
+  std::string error;
+  for (int i = 0; i < 200 && error.empty(); ++i) {
+    std::this_thread::sleep_for(10ms);
+    error = sniffer.file_error();
+  }
+  EXPECT_NE(error.find("is not a product file"), std::string::npos) << error;
+  EXPECT_LT(sniffer.largest.load(), protocol::kMaxMessageBytes);
+  EXPECT_GT(h.endpoint->counters().file_chunks_published.load(), 73U);
+  std::filesystem::remove_all(root);
 }
 
 TEST(LcmEndpoint, ClientSaysSoWhenNoPayloadAnswers) {

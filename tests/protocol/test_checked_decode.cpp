@@ -85,6 +85,18 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   request.chunks = {-1, 3};
   request.n_entries = 2;
   expect_round_trip(request);
+
+  file_request_t file_request{};
+  file_request.path = "products/top_view.png";
+  file_request.n_chunks = 64;
+  expect_round_trip(file_request);
+
+  file_chunk_t chunk{};
+  chunk.path = "products/grid.yaml";
+  chunk.data = {1, 2, 3};
+  chunk.size = 3;
+  chunk.n_chunks = 1;
+  expect_round_trip(chunk);
 }
 
 // Byte offset of n_args in sample_command(): hash, utime, schema, request id,

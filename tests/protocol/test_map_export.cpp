@@ -3,9 +3,14 @@
 
 #include <unistd.h>
 
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/map_export.hpp"
+#include "adit/protocol/map_import.hpp"
 #include "map_readers.hpp"
 
 namespace adit::protocol {
@@ -68,6 +73,47 @@ TEST(MapExport, LasHeaderFieldsAndPointsFollowTheSpecification) {
     EXPECT_NEAR(back[i].gps_time, points[i].time - 315964800.0 + 18.0 - 1e9, 1e-6);
   }
   std::filesystem::remove(file);
+}
+
+// A map in site coordinates (`adit georef`): LAS keeps millimetres at
+// E 512 345, N 7 012 345 and carries the CRS as one WKT VLR (LAS 1.4 R15,
+// "OGC Coordinate System WKT Record"); PLY keeps them as doubles.
+TEST(MapExport, SiteCoordinatesKeepMillimetresAndLasCarriesTheWkt) {
+  std::vector<MapPoint> points;
+  for (int i = 0; i < 50; ++i)
+    points.push_back({512345.6781 + 0.0137 * i, 7012345.4322 - 0.0291 * i, 1234.5 + 0.001 * i, 10.0F, 1.7637e9});
+  const std::string wkt = R"(PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84"],UNIT["metre",1]])";
+  const auto las = temp_file("site.las");
+  write_map(las, MapFormat::las, points, {.crs_wkt = wkt, .ply_double = false});
+  std::ifstream in(las, std::ios::binary);
+  const std::string b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto u16 = [&](std::size_t at) { std::uint16_t v; std::memcpy(&v, b.data() + at, 2); return v; };
+  const auto u32 = [&](std::size_t at) { std::uint32_t v; std::memcpy(&v, b.data() + at, 4); return v; };
+  EXPECT_EQ(u16(6) & (1u << 4), 1u << 4);  // global encoding: WKT
+  EXPECT_EQ(u32(96), kLasHeaderSize + kLasVlrHeaderSize + wkt.size() + 1);  // offset to point data
+  EXPECT_EQ(u32(100), 1u);                                                   // one VLR
+  EXPECT_EQ(b.substr(kLasHeaderSize + 2, 16), std::string("LASF_Projection\0", 16));
+  EXPECT_EQ(u16(kLasHeaderSize + 18), 2112u);
+  EXPECT_EQ(u16(kLasHeaderSize + 20), wkt.size() + 1);
+  EXPECT_EQ(b.substr(kLasHeaderSize + kLasVlrHeaderSize, wkt.size() + 1), wkt + std::string(1, '\0'));
+  EXPECT_EQ(b.size(), u32(96) + points.size() * kLasPointFormat6Length);
+  const auto back = read_map(las);
+  ASSERT_EQ(back.size(), points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_NEAR(back[i].x, points[i].x, 0.0005 + 1e-9);
+    EXPECT_NEAR(back[i].y, points[i].y, 0.0005 + 1e-9);
+    EXPECT_NEAR(back[i].z, points[i].z, 0.0005 + 1e-9);
+  }
+  const auto ply = temp_file("site.ply");
+  write_map(ply, MapFormat::ply, points, {.crs_wkt = {}, .ply_double = true});
+  const auto back_ply = read_map(ply);
+  ASSERT_EQ(back_ply.size(), points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_DOUBLE_EQ(back_ply[i].x, points[i].x);
+    EXPECT_DOUBLE_EQ(back_ply[i].y, points[i].y);
+  }
+  std::filesystem::remove(las);
+  std::filesystem::remove(ply);
 }
 
 TEST(MapExport, EmptyMapsAreValidFiles) {

@@ -2,7 +2,6 @@
 // in a session's map (products/target_finder.hpp), as id,x,y,z,sigma_m in the
 // map frame (docs/PRODUCTS.md).
 
-#include <fstream>
 #include <memory>
 
 #include <fmt/format.h>
@@ -38,12 +37,7 @@ void run_targets_find(const TargetsCommand& c) {
   if (brightest <= 0.0F)
     throw InputError(map_file.string(), "intensity", "the map has no intensities: targets cannot be found");
   const std::vector<products::FoundTarget> found = products::find_targets(points, intensities, path, c.options);
-  std::ofstream out(c.out);
-  if (!out) throw InputError(c.out, "", "cannot open for writing");
-  out << "id,x,y,z,sigma_m\n";
-  for (const products::FoundTarget& t : found)
-    out << fmt::format("{},{:.4f},{:.4f},{:.4f},{:.4f}\n", t.id, t.centre.x(), t.centre.y(), t.centre.z(), t.sigma_m);
-  if (!out) throw InputError(c.out, "", "write failed");
+  products::write_targets_csv(c.out, found);
   fmt::print("{} targets in {} (intensity >= {}), written to {}\n", found.size(), map_file.string(),
              c.options.min_intensity, c.out);
 }

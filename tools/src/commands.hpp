@@ -29,6 +29,8 @@ void register_sim_commands(CLI::App& app, int& status);
 void register_replay_commands(CLI::App& app, int& status);
 void register_products_commands(CLI::App& app, int& status);
 void register_targets_commands(CLI::App& app, int& status);
+// georef: a session in site coordinates from total-station control points
+void register_georef_commands(CLI::App& app, int& status);
 void register_prior_map_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

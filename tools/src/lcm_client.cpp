@@ -18,6 +18,9 @@
 #include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
+#include "adit/file_chunk_t.hpp"
+#include "adit/file_request_t.hpp"
+#include "adit/protocol/product_files.hpp"
 
 namespace adit::tools {
 namespace {
@@ -237,6 +240,75 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
     }
     impl_->handle_for(0.05);
   }
+  return result;
+}
+
+LcmClient::FileResult LcmClient::fetch_file(const std::string& session, const std::string& path) {
+  FileResult result;
+  result.session = session;
+  std::vector<std::optional<std::string>> chunks;  // sized once the first answer says how many
+  std::size_t have = 0;
+  std::set<std::int64_t> my_requests;
+  std::string error;
+  auto last_progress = Clock::now();
+  auto last_chunk = Clock::now();
+  const Listen listen(impl_->lcm, impl_->channel(Channel::file), [&](const lcm::ReceiveBuffer* rbuf) {
+    const auto m = decode<file_chunk_t>(rbuf);
+    if (!m || m->payload_id != impl_->options.payload_id || my_requests.count(m->request_id) == 0) return;
+    last_chunk = Clock::now();
+    if (!m->error.empty()) {
+      error = m->error;
+      return;
+    }
+    if (m->n_chunks <= 0 || m->chunk < 0 || m->chunk >= m->n_chunks || m->size != static_cast<std::int32_t>(m->data.size()))
+      return;
+    if (chunks.empty()) {
+      chunks.resize(static_cast<std::size_t>(m->n_chunks));
+      result.session = m->session_id;
+    }
+    if (m->session_id != result.session || chunks.size() != static_cast<std::size_t>(m->n_chunks)) return;
+    auto& slot = chunks[static_cast<std::size_t>(m->chunk)];
+    if (slot) return;
+    slot.emplace(m->data.begin(), m->data.end());
+    ++have;
+    last_progress = last_chunk;
+  });
+  auto last_send = Clock::now() - std::chrono::seconds(10);
+  while (true) {
+    if (!error.empty()) {
+      result.error = error;
+      return result;
+    }
+    if (!chunks.empty() && have == chunks.size()) break;
+    if (seconds_since(last_progress) > impl_->options.timeout_s) {
+      result.error = chunks.empty() ? fmt::format("no payload '{}' answered within {} s", impl_->options.payload_id,
+                                                  impl_->options.timeout_s)
+                                    : fmt::format("no data for {} s ({} of {} chunks)", impl_->options.timeout_s, have,
+                                                  chunks.size());
+      return result;
+    }
+    if (seconds_since(last_chunk) > 0.3 && seconds_since(last_send) > 0.5) {
+      // The first chunk still missing and the window after it.
+      std::int32_t first = 0;
+      while (static_cast<std::size_t>(first) < chunks.size() && chunks[static_cast<std::size_t>(first)]) ++first;
+      file_request_t r;
+      r.utime = realtime_us();
+      r.schema = 1;
+      r.request_id = impl_->new_request_id();
+      r.payload_id = impl_->options.payload_id;
+      r.session_id = result.session;
+      r.path = path;
+      r.first_chunk = first;
+      r.n_chunks = protocol::kMaxChunksPerRequest;
+      my_requests.insert(r.request_id);
+      impl_->lcm.publish(impl_->channel(Channel::file_request), &r);
+      ++result.requests;
+      last_send = Clock::now();
+    }
+    impl_->handle_for(0.05);
+  }
+  for (const auto& c : chunks) result.bytes += *c;
+  result.ok = true;
   return result;
 }
 

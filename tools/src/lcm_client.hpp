@@ -73,6 +73,18 @@ class LcmClient {
   DownloadResult download(const std::string& session, protocol::TileAssembler& tiles,
                           const std::function<void(std::size_t, std::size_t)>& progress);
 
+  struct FileResult {
+    bool ok = false;
+    std::string error;
+    std::string session;  // the session answered for (the daemon's last when none was named)
+    std::string bytes;
+    std::size_t requests = 0;
+  };
+  // Fetches one product file of a stored session (file_request_t; `path` as
+  // protocol::product_path_problem() accepts, "products/" for the list),
+  // asking again for the chunks lost until complete or no progress for the timeout.
+  FileResult fetch_file(const std::string& session, const std::string& path);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

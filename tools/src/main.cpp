@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
     adit::tools::register_replay_commands(app, status);
     adit::tools::register_products_commands(app, status);
     adit::tools::register_targets_commands(app, status);
+    adit::tools::register_georef_commands(app, status);
     adit::tools::register_prior_map_commands(app, status);
     try {
       app.parse(argc, argv);

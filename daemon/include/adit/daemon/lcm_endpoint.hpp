@@ -108,6 +108,9 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> chunk_bytes_published{0};
   std::atomic<std::uint64_t> index_published{0};
   std::atomic<std::uint64_t> segment_read_errors{0};  // tile segments whose file could not be read
+  std::atomic<std::uint64_t> file_requests{0};  // product files (file_request_t)
+  std::atomic<std::uint64_t> file_requests_malformed{0};
+  std::atomic<std::uint64_t> file_chunks_published{0};
   std::atomic<std::uint64_t> commands_executed{0};
   std::atomic<std::uint64_t> commands_rejected{0};
   std::atomic<std::uint64_t> commands_replayed{0};

@@ -14,6 +14,9 @@
 //   keyframes.tum    keyframe poses; keyframes/<stamp_ns>.ply the scans of older keyframes
 //   summary.json     counts, timings, files; config.yaml the effective configuration
 //   lidar.pcap       raw packets, when session.record_lidar is true
+//   products/        after summary.json, on a low-priority thread of its own
+//                    (session.products; products_worker.hpp): occupancy,
+//                    grid, top view, cross-sections, targets
 //   journal.adj      while mapping (session.journal): the map as it is made,
 //                    durable within session.journal_sync_s; removed once
 //                    summary.json is on the disk. A folder with a journal and
@@ -41,6 +44,8 @@ namespace adit::daemon {
 
 // Converts an odometry result to the pose the tablet gets (flags: pose_t.FLAG_*).
 PoseSample pose_sample_of(const slam::OdometryResult& result);
+
+class ProductsWorker;
 
 class Sessions {
  public:
@@ -119,6 +124,7 @@ class Sessions {
   // status says about them while idle (until the next session starts).
   std::thread recoverer_;
   std::string recovery_notice_;  // under mutex_
+  std::unique_ptr<ProductsWorker> products_;  // null when session.products is off
 };
 
 }  // namespace adit::daemon

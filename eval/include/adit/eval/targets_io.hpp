@@ -1,6 +1,7 @@
 #pragma once
 // Target lists as CSV with the header "id,x,y,z" (metres), one target per
-// line. Malformed lines and duplicate ids throw adit::InputError("file:line").
+// line, or "id,x,y,z,sigma_m" as `adit targets find` writes them (sigma not
+// kept). Malformed lines and duplicate ids throw adit::InputError("file:line").
 
 #include <filesystem>
 #include <iosfwd>

@@ -211,6 +211,10 @@ struct SessionSection {
   bool journal = true;
   double journal_sync_s = 0.5;
   bool keep_journal = false;  // after a clean stop (the map files hold it all then): for audits and tests
+  // After a stop, the session's products (<session>/products: occupancy .bt,
+  // 2D grid, top view, cross-sections, targets.csv) on a SCHED_IDLE thread
+  // (daemon/products_worker.hpp, docs/PRODUCTS.md "In aditd").
+  bool products = true;
 };
 
 // A prior map (BIM export, design model, earlier survey) prepared by

@@ -7,7 +7,9 @@
 // of its own (the next session may start meanwhile); `adit products` calls
 // it for any session folder. docs/PRODUCTS.md says how each step works.
 
+#include <atomic>
 #include <cstdint>
+#include <stdexcept>
 #include <filesystem>
 #include <string>
 
@@ -17,6 +19,7 @@
 #include "adit/products/occupancy_3d.hpp"
 #include "adit/products/outlier_filter.hpp"
 #include "adit/products/session_map.hpp"
+#include "adit/products/target_finder.hpp"
 #include "adit/products/top_view.hpp"
 
 namespace adit::products {
@@ -36,6 +39,16 @@ struct ProductsOptions {
   double fill_step_m = 1.0;         // a viewpoint every metre of path
   TopViewOptions top_view;
   SectionOptions sections;
+  TargetOptions targets;            // targets.csv, drawn on the top view
+  // Set from another thread to stop early (aditd's shutdown): checked between
+  // the steps and every octree batch; the rays to the path (read_session_map)
+  // run to their end first. Null: never.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// Thrown by write_session_products() when `cancel` was set; nothing more is written.
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("cancelled") {}
 };
 
 struct ProductsReport {
@@ -59,6 +72,8 @@ struct ProductsReport {
   std::uintmax_t grid_bytes = 0;    // PGM + YAML
   std::uintmax_t top_view_bytes = 0;
   std::size_t sections = 0, sections_measured = 0;  // measured: width and height both found
+  std::size_t targets = 0;          // found by intensity (targets.csv)
+  std::string targets_note;         // why none were looked for ("" when they were)
   double cpu_s = 0.0;               // this thread's CPU time for all of it
   std::filesystem::path out_dir;
 };
@@ -70,7 +85,8 @@ void check_options(const ProductsOptions& options);
 // the session has its raw recording) and writes the rest as
 // OUT_DIR/map_static.<the map's extension>, the removed points as
 // OUT_DIR/moving_points.ply. Writes OUT_DIR/occupancy.bt (and .ot), grid.pgm, grid.yaml, top_view.png,
-// sections/section_NNN.svg and sections/sections.csv, products.json;
+// sections/section_NNN.svg and sections/sections.csv, targets.csv (when the
+// map has intensities; else the report says so and the rest is written), products.json;
 // OUT_DIR defaults to SESSION_DIR/products. Adds "products" to
 // SESSION_DIR/summary.json when it exists (written to a temporary file and
 // renamed). Throws adit::InputError for a missing or bad session file.

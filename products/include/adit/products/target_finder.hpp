@@ -10,6 +10,7 @@
 // points to their best-fit plane and v the map's voxel (the quantisation of
 // where a point sits in its voxel).
 
+#include <filesystem>
 #include <span>
 #include <vector>
 
@@ -38,5 +39,10 @@ struct FoundTarget {
 // Ids in order along the path (the nearest path pose's index), from 1.
 std::vector<FoundTarget> find_targets(std::span<const Eigen::Vector3f> points, std::span<const float> intensities,
                                       const slam::Trajectory& sensor_path, const TargetOptions& options);
+
+// `id,x,y,z,sigma_m` (map frame, 0.1 mm), what `adit targets find` and the
+// session products write. Throws adit::InputError naming the file when it
+// cannot be written.
+void write_targets_csv(const std::filesystem::path& file, std::span<const FoundTarget> targets);
 
 }  // namespace adit::products
