@@ -129,7 +129,14 @@ TEST(LcmFlood, GarbageIsCountedInTheStatusAndCommandsStillAckWithin100ms) {
   std::printf("flood: %llu garbage messages in 3 s; PING acks %.1f ms median, %.1f ms worst; %d resent\n",
               static_cast<unsigned long long>(sent.load()), latencies_ms[latencies_ms.size() / 2], latencies_ms.back(),
               resent);
-  EXPECT_LT(latencies_ms.back(), 100.0) << "every PING acknowledged within 100 ms during the flood";
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // A sanitizer build decodes the garbage several times slower: it checks
+  // memory here; the 100 ms is the optimised build's.
+  const double limit_ms = 1000.0;
+#else
+  const double limit_ms = 100.0;
+#endif
+  EXPECT_LT(latencies_ms.back(), limit_ms) << "every PING acknowledged within 100 ms during the flood";
   EXPECT_GT(sent.load(), 1000U);
   EXPECT_NE(status.output.find("malformed commands"), std::string::npos) << status.output;
   EXPECT_NE(status.output.find("IDLE"), std::string::npos) << "garbage changed no state: " << status.output;
