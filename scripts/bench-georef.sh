@@ -33,21 +33,7 @@ for drive in "${drives[@]}"; do
       --targets 20 --out "$session" > "$runs/$name-sim.log" 2>&1 || { echo "$drive: adit sim failed" >&2; exit 1; }
   fi
   work="$runs/$name"
-  if [ ! -f "$work/done" ]; then
-    rm -rf "$work"
-    mkdir -p "$work"
-    sed -e "s#  state_dir: state#  state_dir: $work/state#" \
-        -e "s#  pcap: lidar.pcap#  pcap: $session/lidar.pcap#" \
-        -e "s#  calibration: VLP16.yaml#  calibration: $session/VLP16.yaml#" \
-        -e "s#  log: can.log#  log: $session/can.log#" \
-        -e "s#  replay_speed: 1.0#  replay_speed: 0#" "$session/session.yaml" > "$work/aditd.yaml"
-    printf 'threads:\n  lock_memory: false\nsession:\n  products: false  # adit targets find is what this scores\n' >> "$work/aditd.yaml"
-    [ -z "$extra" ] || printf '%s\n' "$extra" >> "$work/aditd.yaml"
-    "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
-      { echo "$drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
-    touch "$work/done"
-  fi
-  folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+  folder=$(map_once "$session" "$work" "$extra") || exit 1
   "$build/bin/adit" targets find "$folder" --out "$work/found.csv" > /dev/null
   python3 - "$work" "$work/found.csv" "$session/targets.csv" "$session/truth_body.tum" "$folder/map_trajectory.tum" <<'PY'
 import sys, math, bisect

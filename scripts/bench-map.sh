@@ -25,13 +25,8 @@ for drive in "${drives[@]}"; do
   session=$(sim_session "$drive" "$runs") || exit $?
   name=$(basename "$session")
   work="$runs/$name"
-  rm -rf "$work"
-  mkdir -p "$work"
-  aditd_config "$session" "$work" > "$work/aditd.yaml"
-  [ -z "${ADIT_BENCH_YAML:-}" ] || printf '%s\n' "$ADIT_BENCH_YAML" >> "$work/aditd.yaml"
-  "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
-    { echo "bench-map: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
-  folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+  rm -rf "$work"  # mapped again on every run: the map is what this scores
+  folder=$(map_once "$session" "$work" "${ADIT_BENCH_YAML:-}") || exit 1
   "$build/bin/adit" eval map --map "$folder/map.ply" --scene "$session/scene.ply" --ref "$session/truth_body.tum" \
     --est "$folder/trajectory.tum" --within 0.05 > "$work/eval.txt" ||
     { echo "bench-map: $drive: adit eval map failed ($work/eval.txt)" >&2; exit 1; }

@@ -31,15 +31,7 @@ for drive in "${drives[@]}"; do
       --people "$people" --out "$session" > "$runs/$name-sim.log" 2>&1 || { echo "$drive: adit sim failed" >&2; exit 1; }
   fi
   work="$runs/$name"
-  if [ ! -f "$work/done" ]; then  # aditd's map is made once per drive; products and scores every run
-    rm -rf "$work"
-    mkdir -p "$work"
-    aditd_config "$session" "$work" > "$work/aditd.yaml"
-    "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
-      { echo "bench-moving: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
-    touch "$work/done"
-  fi
-  folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+  folder=$(map_once "$session" "$work") || exit 1  # aditd's map once per drive; products and scores every run
   rm -rf "$work/products"  # no file of an earlier run is scored
   # shellcheck disable=SC2086
   "$build/bin/adit" products "$folder" --out "$work/products" ${ADIT_PRODUCTS_ARGS:-} > "$work/products.txt" ||

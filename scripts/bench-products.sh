@@ -23,15 +23,7 @@ for drive in "${drives[@]}"; do
   session=$(sim_session "$drive" "$runs") || exit $?
   name=$(basename "$session")
   work="$runs/$name"
-  if [ ! -f "$work/done" ]; then  # aditd's map is made once per drive; products and scores every run
-    rm -rf "$work"
-    mkdir -p "$work"
-    aditd_config "$session" "$work" > "$work/aditd.yaml"
-    "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
-      { echo "bench-products: $drive: aditd failed ($work/aditd.log)" >&2; exit 1; }
-    touch "$work/done"
-  fi
-  folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+  folder=$(map_once "$session" "$work") || exit 1  # aditd's map once per drive; products and scores every run
   # shellcheck disable=SC2086
   "$build/bin/adit" products "$folder" --out "$work/products" ${ADIT_PRODUCTS_ARGS:-} > "$work/products.txt" ||
     { echo "bench-products: $drive: adit products failed ($work/products.txt)" >&2; exit 1; }

@@ -52,3 +52,21 @@ aditd_config() {
       -e "s#  replay_speed: 1.0#  replay_speed: $speed#" "$session/session.yaml"
   printf 'threads:\n  lock_memory: false\n'
 }
+
+# map_once SESSION WORK [EXTRA_YAML]: aditd maps the session once (`--once`, as
+# fast as it goes) into WORK, reused while WORK/done exists; the benchmark makes
+# its own products, so aditd makes none. Prints the session folder aditd wrote.
+map_once() {
+  local session=$1 work=$2 extra=${3:-}
+  if [ ! -f "$work/done" ]; then
+    rm -rf "$work"
+    mkdir -p "$work"
+    aditd_config "$session" "$work" > "$work/aditd.yaml"
+    printf 'session:\n  products: false\n' >> "$work/aditd.yaml"
+    [ -z "$extra" ] || printf '%s\n' "$extra" >> "$work/aditd.yaml"
+    "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
+      { echo "$session: aditd failed ($work/aditd.log)" >&2; return 1; }
+    touch "$work/done"
+  fi
+  ls -d "$work"/state/sessions/*/ | head -1
+}
