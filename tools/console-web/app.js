@@ -112,8 +112,9 @@ function applySnapshot(s) {
   if (s.status) health.show(s.status, Date.now());
   if (s.pose) onPose(s.pose, false);
   // Tiles only grow within a session: a console that is still catching up
-  // (restarted) lists fewer, and the ones held stay.
-  if (s.session !== mapSession) { view.clear(); queue.clear(); mapSession = s.session; }
+  // (restarted) lists fewer, and the ones held stay. A console that has not
+  // heard the payload yet knows no session (""): that is no new session.
+  if (s.session && s.session !== mapSession) { view.clear(); queue.clear(); mapSession = s.session; }
   if (s.path.length >= view.pathCount) view.setPath(s.path);  // a restarted console knows less of it
   mapPoints = Math.max(mapPoints, s.map_points);
   for (const t of s.tiles) wantTile(t.id, t.v);
