@@ -15,6 +15,7 @@
 #include "adit/config/load.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "daemon_process.hpp"
+#include "pipeline_run.hpp"
 #include "sim_sessions.hpp"
 #include "shared_data.hpp"
 
@@ -24,11 +25,7 @@ namespace {
 using namespace std::chrono_literals;
 
 config::Config session_config(const std::filesystem::path& work, const std::string& extra) {
-  std::filesystem::create_directories(work);
-  const std::filesystem::path file = work / "aditd.yaml";
-  std::ofstream(file) << test::aditd_yaml_for(test::mine_drive_12s(), work / "state",
-                                              {"", "", true, "threads:\n  lock_memory: false\n" + extra});
-  return config::load_config(file);
+  return test::replay_config(test::mine_drive_12s(), work, extra);
 }
 
 // Polls until the replay ends, asks for the stop, polls until the files are written.

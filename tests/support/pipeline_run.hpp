@@ -25,12 +25,19 @@ struct ScoredRun {
   double ape_max_m = 1e9;
 };
 
-inline ScoredRun run_and_score(const std::filesystem::path& session, const std::filesystem::path& work,
-                               const std::function<void(config::Config&)>& edit) {
+// aditd's configuration replaying a simulated session as fast as it goes
+// (`--once`-like), its state under work/state; `extra` YAML appended.
+inline config::Config replay_config(const std::filesystem::path& session, const std::filesystem::path& work,
+                                    const std::string& extra = "") {
   std::filesystem::create_directories(work);
   const std::filesystem::path file = work / "aditd.yaml";
-  std::ofstream(file) << aditd_yaml_for(session, work / "state", {"", "", true, "threads:\n  lock_memory: false\n"});
-  config::Config c = config::load_config(file);
+  std::ofstream(file) << aditd_yaml_for(session, work / "state", {"", "", true, "threads:\n  lock_memory: false\n" + extra});
+  return config::load_config(file);
+}
+
+inline ScoredRun run_and_score(const std::filesystem::path& session, const std::filesystem::path& work,
+                               const std::function<void(config::Config&)>& edit) {
+  config::Config c = replay_config(session, work);
   edit(c);
   daemon::PipelineOptions options;
   options.trajectory_file = work / "trajectory.tum";
