@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/slam/tum.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "sim_sessions.hpp"
@@ -25,14 +26,6 @@ namespace {
 using namespace std::chrono_literals;
 
 constexpr const char* kFaketime = "/usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1";
-
-std::vector<double> stamps_of(const std::filesystem::path& tum) {
-  std::vector<double> stamps;
-  std::ifstream in(tum);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line.substr(0, line.find(' '))));
-  return stamps;
-}
 
 TEST(ClockSteps, WallClockSteppedAheadAndBackLeavesTheTrajectoryContinuousAndIsCounted) {
   if (!std::filesystem::exists(kFaketime)) GTEST_SKIP() << "libfaketime is absent (scripts/install-deps.sh installs it)";
@@ -84,7 +77,7 @@ TEST(ClockSteps, WallClockSteppedAheadAndBackLeavesTheTrajectoryContinuousAndIsC
 
   // Every pose follows the one before by about a scan period (0.1 s; a scan
   // dropped in between makes 0.2 s), never 2 s more or less.
-  const std::vector<double> stamps = stamps_of(dir / "trajectory.tum");
+  const std::vector<double> stamps = slam::read_tum(dir / "trajectory.tum").stamps;
   ASSERT_GT(stamps.size(), 90U) << "12 s at 10 Hz";
   double widest = 0.0;
   double narrowest = 1e9;
