@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Georeferencing on loop drives (docs/PRODUCTS.md, "Georeferencing"): for each
+# Georeferencing on loop drives (docs/GEOREF.md): for each
 # drive the simulator places 20 targets; aditd maps it (`aditd --once`, loop
 # closure on, its default); `adit targets find` finds them in the map; four of
 # the found ones (spread along the route) get control points: the simulator's

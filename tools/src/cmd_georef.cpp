@@ -1,7 +1,7 @@
 // adit georef SESSION_DIR --control FILE.csv: the session's map and trajectory
 // in site coordinates, fitted on control points measured by total station on
 // the targets found in the map (eval/georeference.hpp), with the residual
-// table survey software prints (docs/PRODUCTS.md, "Georeferencing").
+// table survey software prints (docs/GEOREF.md).
 
 #include <cmath>
 #include <filesystem>
