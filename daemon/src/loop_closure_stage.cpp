@@ -11,6 +11,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/common/log.hpp"
+#include "adit/slam/gravity.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -23,8 +24,16 @@ constexpr int kNice = 10;  // below every other stage under SCHED_OTHER
 // odometry's): the graph keeps them too, so that a loop's vertical gap is
 // closed in height, not by tilting the whole route about its start (which
 // moved the middle of a 254 m loop by 0.25 m in z on mine:robot:300:5).
+//
+// Those ups are the accelerometer's, bias and all: its bias walks
+// (imu.accel_bias_walk), and b/g rad of tilt climbs b/g of the distance
+// driven (0.12 m/s² on mine:robot:300:5: 1.2 cm a metre). The graph lets the
+// ups' tilt walk as much (PoseGraph::tilt_walk_rad_per_sqrt_s), so a loop
+// that closes in height corrects the tilt along the route.
 slam::LoopClosureConfig loop_config_of(const config::Config& config, slam::LoopClosureConfig loops) {
   if (config.imu.enabled && loops.gravity_sigma_rad <= 0.0) loops.gravity_sigma_rad = 0.002;
+  if (config.imu.enabled && loops.tilt_walk_rad_per_sqrt_s <= 0.0 && config.map.loops_tilt_walk)
+    loops.tilt_walk_rad_per_sqrt_s = config.imu.accel_bias_walk / slam::kStandardGravity;
   return loops;
 }
 

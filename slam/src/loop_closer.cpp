@@ -20,7 +20,9 @@ double yaw_of(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), 
 
 }  // namespace
 
-LoopCloser::LoopCloser(const LoopClosureConfig& config) : config_(config), guard_(config.consistency) {}
+LoopCloser::LoopCloser(const LoopClosureConfig& config) : config_(config), guard_(config.consistency) {
+  graph_.tilt_walk_rad_per_sqrt_s = config.tilt_walk_rad_per_sqrt_s;
+}
 
 bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
                               std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body) {
@@ -46,7 +48,8 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
     variance_.push_back(variance_.back() + 1.0 / information(0, 0));
   }
   if (up_body && config_.gravity_sigma_rad > 0.0)
-    graph_.gravity.push_back({k, *up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad)});
+    graph_.gravity.push_back(
+        {k, *up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad), 1e-9 * static_cast<double>(stamp_ns)});
   odometry_.push_back(odometry_pose);
   stamps_.push_back(stamp_ns);
   points_.push_back(std::move(kept));

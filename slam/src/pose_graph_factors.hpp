@@ -68,4 +68,47 @@ struct GravityFactor {
   double s;
 };
 
+// Gravity with a tilt offset δ (rad about the body's x and y axes) on the
+// measured up: R·normalise(u_b + [δx, δy, 0] × u_b) − e_z.
+struct TiltedGravityFactor {
+  TiltedGravityFactor(const Eigen::Vector3d& up_body, double sqrt_information) : u_b(up_body), s(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* q_, const T* delta_, T* r_) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    const Eigen::Matrix<T, 3, 1> d(delta_[0], delta_[1], T(0.0));
+    const Eigen::Matrix<T, 3, 1> u = u_b.template cast<T>();
+    const Eigen::Matrix<T, 3, 1> turned = (u + d.cross(u)).normalized();
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(r_);
+    r = T(s) * (q * turned - Eigen::Matrix<T, 3, 1>::UnitZ());
+    return true;
+  }
+
+  static ceres::CostFunction* create(const Eigen::Vector3d& up_body, double information) {
+    return new ceres::AutoDiffCostFunction<TiltedGravityFactor, 3, 4, 2>(
+        new TiltedGravityFactor(up_body, std::sqrt(information)));
+  }
+
+  Eigen::Vector3d u_b;
+  double s;
+};
+
+// The tilt offset's random walk between two gravity priors: (δ_b − δ_a)/σ.
+struct TiltWalkFactor {
+  explicit TiltWalkFactor(double sigma) : inverse_sigma(1.0 / sigma) {}
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    r[0] = T(inverse_sigma) * (b[0] - a[0]);
+    r[1] = T(inverse_sigma) * (b[1] - a[1]);
+    return true;
+  }
+
+  static ceres::CostFunction* create(double sigma) {
+    return new ceres::AutoDiffCostFunction<TiltWalkFactor, 2, 2, 2>(new TiltWalkFactor(sigma));
+  }
+
+  double inverse_sigma;
+};
+
 }  // namespace adit::slam::detail

@@ -1,6 +1,8 @@
 // Ceres optimisation of a pose graph (pose_graph_solver.hpp).
 #include "adit/slam/pose_graph_solver.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -40,10 +42,26 @@ PoseGraphSolution optimize(PoseGraph& graph, const PoseGraphSolverConfig& config
     problem.AddResidualBlock(detail::RelativePoseFactor::create(e.measurement, sqrt_information(e.information)), loss,
                              q[e.from].coeffs().data(), p[e.from].data(), q[e.to].coeffs().data(), p[e.to].data());
   }
-  for (const GravityPriorEdge& g : graph.gravity) {
+  // Tilt offsets (PoseGraph::tilt_walk_rad_per_sqrt_s), started from the last solve's.
+  const bool walk = graph.tilt_walk_rad_per_sqrt_s > 0.0 && !graph.gravity.empty();
+  std::vector<Eigen::Vector2d> delta(walk ? graph.gravity.size() : 0, Eigen::Vector2d::Zero());
+  for (std::size_t i = 0; i < std::min(delta.size(), graph.tilt_offsets.size()); ++i) delta[i] = graph.tilt_offsets[i];
+  for (std::size_t i = 0; i < graph.gravity.size(); ++i) {
+    const GravityPriorEdge& g = graph.gravity[i];
     if (g.node >= n || g.information <= 0.0) continue;
-    problem.AddResidualBlock(detail::GravityFactor::create(g.up_body, g.information), nullptr, q[g.node].coeffs().data());
+    if (!walk) {
+      problem.AddResidualBlock(detail::GravityFactor::create(g.up_body, g.information), nullptr,
+                               q[g.node].coeffs().data());
+      continue;
+    }
+    problem.AddResidualBlock(detail::TiltedGravityFactor::create(g.up_body, g.information), nullptr,
+                             q[g.node].coeffs().data(), delta[i].data());
+    if (i == 0) continue;
+    const double dt = std::max(graph.gravity[i].stamp_s - graph.gravity[i - 1].stamp_s, 1e-3);
+    problem.AddResidualBlock(detail::TiltWalkFactor::create(graph.tilt_walk_rad_per_sqrt_s * std::sqrt(dt)), nullptr,
+                             delta[i - 1].data(), delta[i].data());
   }
+  if (walk && problem.HasParameterBlock(delta[0].data())) problem.SetParameterBlockConstant(delta[0].data());
   for (std::size_t i = 0; i < n; ++i) {
     if (!problem.HasParameterBlock(q[i].coeffs().data())) {
       problem.AddParameterBlock(q[i].coeffs().data(), 4);
@@ -71,6 +89,7 @@ PoseGraphSolution optimize(PoseGraph& graph, const PoseGraphSolverConfig& config
     graph.nodes[i].linear() = q[i].normalized().toRotationMatrix();
     graph.nodes[i].translation() = p[i];
   }
+  graph.tilt_offsets = delta;
   for (const PoseGraphEdge& e : graph.edges) {
     if (e.kind != EdgeKind::loop || e.from >= n || e.to >= n) continue;
     const Eigen::Isometry3d err = e.measurement.inverse() * graph.nodes[e.from].inverse() * graph.nodes[e.to];

@@ -187,6 +187,10 @@ struct MapSection {
   // map's drift sat in the last 60 m, so the map lost 5-23 points of 100
   // within 5 cm on two drives of three (docs/LOOPS.md, "Measured").
   bool loops_move_map = false;
+  // With an IMU, the graph lets the keyframes' measured up wander as the
+  // accelerometer's bias walks (imu.accel_bias_walk): a loop that closes in
+  // height then levels the route (docs/LOOPS.md). false = the ups as measured.
+  bool loops_tilt_walk = true;
 };
 
 // Sessions: what is kept in the session folder and how a session begins.

@@ -205,6 +205,7 @@ void describe(V& v, MapSection& s) {
   v.optional("refine", s.refine);
   v.optional("loop_closure", s.loop_closure);
   v.optional("loops_move_map", s.loops_move_map);
+  v.optional("loops_tilt_walk", s.loops_tilt_walk);
 }
 
 template <typename V>

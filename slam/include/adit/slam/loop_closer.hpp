@@ -41,6 +41,7 @@ struct LoopClosureConfig {
   float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
   double gravity_sigma_rad = 0.0;    // > 0: a roll/pitch prior per keyframe with an `up`
+  double tilt_walk_rad_per_sqrt_s = 0.0;  // the ups' tilt walk (PoseGraph::tilt_walk_rad_per_sqrt_s)
 };
 
 // One candidate's fate, for the log and summary.json.

@@ -35,12 +35,23 @@ struct GravityPriorEdge {
   std::size_t node = 0;
   Eigen::Vector3d up_body = Eigen::Vector3d::UnitZ();
   double information = 0.0;  // 1/σ², σ the tilt error in rad
+  double stamp_s = 0.0;      // when it was measured (the tilt walk's time step)
 };
 
 struct PoseGraph {
   std::vector<Eigen::Isometry3d> nodes;  // node 0 is held fixed: it defines the map frame
   std::vector<PoseGraphEdge> edges;
   std::vector<GravityPriorEdge> gravity;
+  // The measured ups may be off by a tilt that wanders: an accelerometer's
+  // bias b walks (its random walk, in m/s³/√Hz), and the up it gives is off
+  // by b/g rad. > 0: each gravity prior's up is turned by a tilt offset δ
+  // (about the body's x and y axes, where the bias lives) that walks between
+  // consecutive priors with σ = this·√Δt, the first held at zero (it defines
+  // the map's level with node 0). Loops that close in height then tell the
+  // graph the tilt, as bias states do in visual-inertial graphs (Forster et
+  // al., T-RO 2017, eq. 40). 0 = the ups as measured.
+  double tilt_walk_rad_per_sqrt_s = 0.0;
+  std::vector<Eigen::Vector2d> tilt_offsets;  // per gravity prior, after optimize() (and its next start)
 
   std::size_t loop_count() const {
     std::size_t n = 0;
