@@ -1,6 +1,7 @@
 // Fuzzes the text readers `adit eval` trusts with user files: TUM, KITTI,
 // EuRoC CSV, target CSV, the simulator's people tracks and a session's loops
-// (summary.json). Bad input must end in adit::InputError, nothing else (no crash, no other exception, no sanitizer report).
+// (summary.json). Bad input must end in adit::InputError, nothing else (no
+// crash, no other exception, no sanitizer report).
 
 #include <cstddef>
 #include <cstdint>
