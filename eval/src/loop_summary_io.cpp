@@ -47,7 +47,7 @@ std::vector<LoopEdgeRecord> read_loop_edges(std::istream& in, const std::filesys
     throw InputError(where, "", fmt::format("not JSON: {}", e.what()));
   }
   const json& loops = member(root, "loops", where, "");
-  if (loops.is_object() && loops.value("enabled", true) == false)
+  if (loops.is_object() && loops.contains("enabled") && loops["enabled"] == false)
     throw InputError(where, "loops.enabled", "loop closure was off in this session");
   const json& edges = member(loops, "edges", where, "loops");
   if (!edges.is_array())

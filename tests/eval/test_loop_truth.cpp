@@ -189,6 +189,9 @@ TEST(LoopSummary, BadInputNamesFileAndKey) {
   EXPECT_EQ(key_of(R"({"scans": {}})"), "loops");
   EXPECT_EQ(key_of(R"({"loops": {"enabled": false}})"), "loops.enabled");
   EXPECT_EQ(key_of(R"({"loops": {"enabled": true, "events": []}})"), "loops.edges");
+  EXPECT_EQ(key_of(R"({"loops": {"enabled": 1, "edges": {}}})"), "loops.edges");
+  EXPECT_EQ(key_of(R"({"loops": [1, 2]})"), "loops.edges");
+  EXPECT_EQ(key_of(summary_with(R"([7])")), "loops.edges[0].from");
   EXPECT_EQ(key_of(summary_with(R"([{"from": -1, "to": 2}])")), "loops.edges[0].from");
   EXPECT_EQ(key_of(summary_with(R"([{"from": 1, "to": 2, "measurement": [0, 0, 0, 0, 0, 0, 0], "information": [1]}])")),
             "loops.edges[0].measurement");
