@@ -85,6 +85,18 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
                         {"outcome", e.outcome}, {"inlier_ratio", e.inlier_ratio}, {"rmse_m", e.rmse_m},
                         {"conditioning", e.conditioning}});
   }
+  // Every loop in the graph (events' "waiting" may have been accepted later):
+  // T_from⁻¹·T_to as x y z qx qy qz qw and its 6×6 information ([v; ω]; a
+  // partial loop's is singular along its free axis), for `adit eval loops`.
+  nlohmann::json loop_edges = nlohmann::json::array();
+  for (const slam::PoseGraphEdge& e : loops->closer().graph().edges) {
+    if (e.kind != slam::EdgeKind::loop) continue;
+    const Eigen::Vector3d t = e.measurement.translation();
+    const Eigen::Quaterniond q(e.measurement.linear());
+    const std::vector<double> information(e.information.data(), e.information.data() + 36);  // symmetric
+    loop_edges.push_back({{"from", e.from}, {"to", e.to}, {"measurement", {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}},
+                          {"information", information}});
+  }
   const Eigen::Isometry3d last = track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back();
   return {{"enabled", true},
           {"map_moved", moved},
@@ -109,7 +121,8 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
                           {"last_rotation_deg", Eigen::AngleAxisd(last.linear()).angle() * 180.0 / M_PI},
                           {"max_translation_m", track.max_translation_m()},
                           {"max_rotation_deg", track.max_rotation_rad() * 180.0 / M_PI}}},
-          {"events", events}};
+          {"events", events},
+          {"edges", loop_edges}};
 }
 
 // summary.json's "journal": what the crash-safety journal wrote (it is

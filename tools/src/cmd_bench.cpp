@@ -29,6 +29,7 @@
 #include "bench_attitude.hpp"
 #include "bench_baseline.hpp"
 #include "bench_pipeline.hpp"
+#include "bench_loops.hpp"
 #include "bench_prior_map.hpp"
 #include "bench_scans.hpp"
 #include "commands.hpp"
@@ -283,6 +284,7 @@ void register_bench_commands(CLI::App& app, int& status) {
   add_bench_pipeline_command(*bench, status);
   add_bench_attitude_command(*bench, status);
   add_bench_prior_map_command(*bench, status);
+  add_bench_loops_command(*bench, status);
 }
 
 }  // namespace adit::tools

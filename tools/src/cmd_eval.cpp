@@ -171,8 +171,32 @@ void add_moving(CLI::App& eval, int& status) {
 
 }  // namespace
 
+void add_loops(CLI::App& eval, int& status) {
+  auto* cmd = eval.add_subcommand("loops", "Loop detection of an aditd session against the simulator's truth: precision, recall, error");
+  auto o = std::make_shared<LoopsEvalOptions>();
+  cmd->add_option("--session", o->session, "aditd's session folder (summary.json, keyframes.tum)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--truth", o->truth, "The simulator's truth_body.tum")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--revisit", o->revisit_m, "True revisit: keyframes' true positions within this (m, default 3)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-path", o->min_path_m, "... and at least this far apart along the true path (m, default 30)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--false-beyond", o->false_beyond_m, "An accepted loop whose keyframes lie farther apart is false (m, default 10)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-error", o->max_error_m, "... or whose measurement is off the truth by more (m, default 0.3)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-error-deg", o->max_error_deg, "... or by more (degrees, default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--window", o->window, "Recall: a true loop within this many keyframes of a revisit (default 5)");
+  cmd->add_flag("--json", o->json, "Print JSON instead of a table");
+  cmd->callback([o, &status] {
+    run_eval_loops(*o);
+    status = kExitOk;
+  });
+}
+
 void register_eval_commands(CLI::App& app, int& status) {
-  auto* eval = app.add_subcommand("eval", "Accuracy evaluation: trajectories, end-to-end drift, survey targets, map against scene");
+  auto* eval = app.add_subcommand("eval", "Accuracy evaluation: trajectories, end-to-end drift, survey targets, map against scene, loops");
   eval->require_subcommand(1);
   add_traj(*eval, status);
   add_endpoint(*eval, status);
@@ -181,6 +205,7 @@ void register_eval_commands(CLI::App& app, int& status) {
   add_grid(*eval, status);
   add_moving(*eval, status);
   add_sections(*eval, status);
+  add_loops(*eval, status);
 }
 
 }  // namespace adit::tools

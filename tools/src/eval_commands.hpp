@@ -91,6 +91,20 @@ struct MovingEvalOptions {
 
 void run_eval_moving(const MovingEvalOptions& options);
 
+struct LoopsEvalOptions {
+  std::string session;  // aditd's session folder: summary.json ("loops"."edges") and keyframes.tum
+  std::string truth;    // adit sim's truth_body.tum
+  double revisit_m = 3.0;
+  double min_path_m = 30.0;
+  double false_beyond_m = 10.0;
+  double max_error_m = 0.3;
+  double max_error_deg = 1.0;
+  std::size_t window = 5;
+  bool json = false;
+};
+
+void run_eval_loops(const LoopsEvalOptions& options);
+
 // Shared by the runners.
 // The triangles of a scene mesh PLY; throws InputError when it has none.
 std::vector<eval::Triangle> scene_triangles(const std::string& file);
