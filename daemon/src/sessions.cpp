@@ -106,6 +106,7 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
           {"accepted", s.accepted},
           {"rejected", s.rejected_verification + s.rejected_inconsistent},
           {"rejected_by_verification", s.rejected_verification},
+          {"readings_set_aside_by_heading", s.set_aside_readings},
           {"rejected_inconsistent", s.rejected_inconsistent},
           {"unconfirmed", loops->closer().unconfirmed()},
           {"verified_partial", s.partial},

@@ -99,7 +99,10 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
   const ScanContextMatch m = compare(descriptors_[c.query], descriptors_[c.candidate]);
   if (m.alternative_distance <= config_.search.max_descriptor_distance)
     guesses.push_back(yawed(graph_guess, c.alternative_yaw_rad));
-  const LoopVerification v = verify_loop(query_points_[c.query], submap, guesses, config_.verification);
+  LoopVerificationConfig verification = config_.verification;
+  verification.heading_gate_rad = config_.heading_gate_rad;
+  const LoopVerification v = verify_loop(query_points_[c.query], submap, guesses, verification);
+  stats_.set_aside_readings += static_cast<std::size_t>(v.set_aside);
   event.inlier_ratio = v.registration.inlier_ratio;
   event.rmse_m = v.registration.rmse_m;
   event.conditioning = v.registration.weakest_eigenvalue;

@@ -1,6 +1,7 @@
 // Registration-based verification of loop candidates (loop_verification.hpp).
 #include "adit/slam/loop_verification.hpp"
 
+#include <algorithm>
 #include <vector>
 
 namespace adit::slam {
@@ -75,6 +76,16 @@ LoopVerification verify_loop(std::span<const Eigen::Vector3f> query_points, cons
   }
   out.passing_guesses = static_cast<int>(passing.size());
   if (passing.empty()) return out;
+  if (config.heading_gate_rad > 0.0) {
+    const auto outside = [&](const RegistrationResult& r) {
+      return Eigen::AngleAxisd(guesses.front().linear().transpose() * r.pose.linear()).angle() > config.heading_gate_rad;
+    };
+    const auto inside_count = std::count_if(passing.begin(), passing.end(), [&](const auto& r) { return !outside(r); });
+    if (inside_count > 0) {
+      out.set_aside = static_cast<int>(passing.size()) - static_cast<int>(inside_count);
+      std::erase_if(passing, outside);
+    }
+  }
   // The best-fitting solution, then: does another passing one disagree with it?
   std::size_t best = 0;
   for (std::size_t i = 1; i < passing.size(); ++i)

@@ -96,8 +96,10 @@ TEST(LoopCloser, ClosesAReverseRevisit) {
 
 // Out and back along a plain straight tunnel: every revisit looks right and
 // none can be measured along the axis. Loops get in only as partial ones
-// (across the tunnel and in attitude), so the graph leaves the odometry's
-// error along the axis as it is: no wrong information reaches the map.
+// (across the tunnel and in attitude; on the way back the reading turned half
+// round is set aside by the graph's heading), so no wrong information reaches
+// the map: along the axis no keyframe ends farther from the truth than the
+// odometry put it (the loops' attitude may move it a little, towards the truth).
 TEST(LoopCloser, AlongAPlainSymmetricTunnelNoLoopMovesTheAxis) {
   const std::vector<Eigen::Vector3f> tunnel = test::tunnel(150'000, 9, 200.0F);
   const auto path = [](double s) { return s <= 40.0 ? pose_at(s - 20.0, 0, 0) : pose_at(60.0 - s, 0, M_PI); };
@@ -108,8 +110,13 @@ TEST(LoopCloser, AlongAPlainSymmetricTunnelNoLoopMovesTheAxis) {
   EXPECT_GT(closer.stats().candidates, 0U);  // the descriptor does see revisits
   EXPECT_GT(closer.stats().accepted, 0U);                       // and some got in
   EXPECT_EQ(closer.stats().verified, closer.stats().partial);  // only partial ones pass
-  for (std::size_t k = 0; k < d.truth.size(); ++k)
-    EXPECT_NEAR(closer.poses()[k].translation().x(), d.odometry[k].translation().x(), 0.03) << k;
+  for (std::size_t k = 0; k < d.truth.size(); ++k) {
+    const double graph_error = std::abs(closer.poses()[k].translation().x() - d.truth[k].translation().x());
+    const double odometry_error = std::abs(d.odometry[k].translation().x() - d.truth[k].translation().x());
+    EXPECT_LE(graph_error, odometry_error + 0.01) << k;
+    EXPECT_NEAR(closer.poses()[k].translation().x(), d.odometry[k].translation().x(), 0.06) << k;
+  }
+  EXPECT_GT(closer.stats().set_aside_readings, 0U);  // the half-turned readings on the way back
 }
 
 }  // namespace

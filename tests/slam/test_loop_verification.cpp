@@ -87,6 +87,28 @@ TEST(LoopVerification, TwoReadingsThatBothFitAreAmbiguous) {
   EXPECT_EQ(v.verdict, LoopVerdict::ambiguous) << to_string(v.verdict);
 }
 
+// The same room with the heading gate: the graph's guess (the first) holds
+// the heading to within the gate, so the half-turned reading is set aside and
+// the one the graph allows is measured. A gate that lets both through keeps
+// the room ambiguous.
+TEST(LoopVerification, TheHeadingGateSetsTheHalfTurnedReadingAside) {
+  const std::vector<Eigen::Vector3f> room = test::room(60'000, 5, 6.0F, 4.0F, 2.0F, false);
+  const Eigen::Isometry3d candidate = pose_at(0.0, 0.0, 0.0);
+  const Eigen::Isometry3d query = pose_at(0.2, 0.1, 0.05);
+  const std::vector<Eigen::Isometry3d> guesses{pose_at(0.1, 0.0, 0.0), pose_at(0.2, 0.1, 0.05 + M_PI)};
+  LoopVerificationConfig config;
+  config.heading_gate_rad = M_PI / 4;
+  const LoopVerification v = verify_loop(test::scan_of(room, query, 61), submap_of(room, candidate, 70), guesses, config);
+  EXPECT_EQ(v.passing_guesses, 2);
+  EXPECT_EQ(v.set_aside, 1);
+  ASSERT_EQ(v.verdict, LoopVerdict::accepted) << to_string(v.verdict);
+  EXPECT_LT((v.relative.translation() - query.translation()).norm(), 0.03);
+  EXPECT_LT(Eigen::AngleAxisd(v.relative.linear().transpose() * query.linear()).angle(), 0.005);
+  config.heading_gate_rad = 3.5;  // wider than a half turn: both readings pass the gate
+  EXPECT_EQ(verify_loop(test::scan_of(room, query, 61), submap_of(room, candidate, 70), guesses, config).verdict,
+            LoopVerdict::ambiguous);
+}
+
 // The query is elsewhere (the other side of the ring): little overlap.
 TEST(LoopVerification, AnotherPlaceHasNoOverlap) {
   const Eigen::Isometry3d candidate = pose_at(12.0, 0.0, 0.0);

@@ -11,6 +11,7 @@
 // of keyframe k, G_k, starts as G_{k-1}·(O_{k-1}⁻¹·O_k); the correction
 // map→odometry is G_k·O_k⁻¹ of the newest keyframe.
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -42,6 +43,11 @@ struct LoopClosureConfig {
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
   double gravity_sigma_rad = 0.0;    // > 0: a roll/pitch prior per keyframe with an `up`
   double tilt_walk_rad_per_sqrt_s = 0.0;  // the ups' tilt walk (PoseGraph::tilt_walk_rad_per_sqrt_s)
+  // Verification's heading gate (LoopVerificationConfig::heading_gate_rad):
+  // Scan Context's other reading lies ≥ 90° away, the graph's heading within
+  // a few degrees over a session (σ_r ≈ 1.5 mrad a keyframe: 3.6° over the
+  // 1,729 keyframes of a 30-minute drive); 45° lies between them.
+  double heading_gate_rad = M_PI / 4;
 };
 
 // One candidate's fate, for the log and summary.json.
@@ -64,6 +70,7 @@ struct LoopClosureStats {
   std::size_t partial = 0;                // of which partial (one direction unobserved)
   std::size_t accepted = 0;               // in the graph
   std::size_t rejected_verification = 0;  // failed registration (overlap, fit, conditioning, ambiguity)
+  std::size_t set_aside_readings = 0;     // passing readings outside the heading gate, set aside
   std::size_t rejected_inconsistent = 0;  // failed the guard
   std::size_t optimizations = 0;
   double last_optimization_s = 0.0;

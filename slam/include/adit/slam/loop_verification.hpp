@@ -20,7 +20,12 @@
 //   - is unambiguous: registered from every initial guess (the graph's
 //     relative pose and Scan Context's two yaw readings), no two guesses
 //     converge to different poses that both pass (a symmetric or repetitive
-//     section matches two ways; neither is trusted).
+//     section matches two ways; neither is trusted). With heading_gate_rad,
+//     a passing pose turned farther than that from the first guess (the
+//     graph's) is not a reading the graph allows and is set aside before
+//     this check: a tunnel symmetric under a half turn, driven back the
+//     other way, matches at 0° and 180°, and the graph's heading, good to a
+//     few degrees, says which.
 // The accepted measurement's information is fixed σ (covariance_sigma_*),
 // not the registration's covariance: that one is scaled by the odometry's
 // deliberately loose point σ (decision 010) and optimistic in its shape
@@ -49,6 +54,9 @@ struct LoopVerificationConfig {
   double min_conditioning = 0.02;       // twice the odometry's degeneracy threshold (RegistrationConfig)
   double ambiguity_m = 0.5;             // two passing solutions this far apart: ambiguous
   double ambiguity_rad = 0.1;
+  // > 0: passing poses whose rotation differs from guesses[0]'s by more are
+  // set aside (LoopVerification::set_aside) when one within it passes.
+  double heading_gate_rad = 0.0;
   double covariance_sigma_m = 0.05;     // σ of an accepted loop's translation, per axis
   double covariance_sigma_rad = 0.005;  // and rotation
   bool allow_partial = true;            // an ill-conditioned fit becomes a partial loop (above)
@@ -67,6 +75,7 @@ struct LoopVerification {
   Eigen::Vector3d free_axis = Eigen::Vector3d::Zero();  // partial: the unobserved translation, candidate frame (unit)
   RegistrationResult registration;                             // the best guess's
   int passing_guesses = 0;
+  int set_aside = 0;  // passing poses outside the heading gate
 };
 
 // Adds `points` (a keyframe's scan, its body frame) placed at `pose` into `submap`.
