@@ -67,6 +67,7 @@ void LoopClosureStage::loop() {
       continue;
     }
     const std::size_t accepted_before = closer_.stats().accepted;
+    const std::size_t file_errors_before = closer_.scans().read_errors() + closer_.scans().write_errors();
     // The up the map pose holds, in the body frame: R⁻¹·e_z.
     const std::optional<Eigen::Vector3d> up =
         gravity_ ? std::optional<Eigen::Vector3d>(k->pose.linear().transpose() * Eigen::Vector3d::UnitZ()) : std::nullopt;
@@ -76,6 +77,8 @@ void LoopClosureStage::loop() {
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,
                 closer_.stats().last_optimization_s, c.translation().norm());
     }
+    if (closer_.scans().read_errors() + closer_.scans().write_errors() > file_errors_before)
+      log::warn("loops: {}", closer_.scans().last_error());
     update_stats();
   }
   if (thread_.stopping()) return;

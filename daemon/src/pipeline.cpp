@@ -104,6 +104,7 @@ void Pipeline::start(const SessionFiles& files) {
   if (i.started) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.map_trajectory_file, files.record_file);
   if (i.mapping) i.mapping->spill_to(files.tiles_dir, files.keyframes_dir);
+  if (i.loops && !files.keyframes_dir.empty()) i.loops->spill_to(files.keyframes_dir / "loops");
   if (i.mapping && !files.journal_file.empty()) {
     i.journal.emplace(files.journal_file, i.config.session.journal_sync_s, i.stop);
     i.journal->start(files.journal_header);

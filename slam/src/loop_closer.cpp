@@ -20,7 +20,8 @@ double yaw_of(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), 
 
 }  // namespace
 
-LoopCloser::LoopCloser(const LoopClosureConfig& config) : config_(config), guard_(config.consistency) {
+LoopCloser::LoopCloser(const LoopClosureConfig& config)
+    : config_(config), guard_(config.consistency), scans_(config.scans_in_ram) {
   graph_.tilt_walk_rad_per_sqrt_s = config.tilt_walk_rad_per_sqrt_s;
 }
 
@@ -52,8 +53,8 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
         {k, *up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad), 1e-9 * static_cast<double>(stamp_ns)});
   odometry_.push_back(odometry_pose);
   stamps_.push_back(stamp_ns);
-  points_.push_back(std::move(kept));
-  query_points_.push_back(std::move(query));
+  scans_.add(std::move(kept));
+  query_points_ = std::move(query);
   ++stats_.keyframes;
 
   const KeyframeIndexView view{descriptors_, graph_.nodes, path_m_, variance_};
@@ -88,7 +89,14 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
   const Eigen::Isometry3d candidate_inverse = graph_.nodes[c.candidate].inverse();
   for (std::size_t m = first; m <= last; ++m) {
     if (path_m_[c.query] - path_m_[m] < config_.search.min_path_separation_m) continue;  // not the query's own past
-    add_to_submap(submap, points_[m], candidate_inverse * graph_.nodes[m]);
+    if (!scans_.read(m, neighbour_)) {
+      if (m != c.candidate) continue;  // a neighbour's damaged scan: a smaller submap
+      ++stats_.rejected_unreadable;    // the candidate's own: no loop here
+      event.outcome = "keyframe_unreadable";
+      events_.push_back(event);
+      return false;
+    }
+    add_to_submap(submap, neighbour_, candidate_inverse * graph_.nodes[m]);
   }
   // Guesses: the graph's; Scan Context's yaw at the graph's position, and its
   // other reading when the descriptor finds that one plausible as well.
@@ -101,7 +109,7 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
     guesses.push_back(yawed(graph_guess, c.alternative_yaw_rad));
   LoopVerificationConfig verification = config_.verification;
   verification.heading_gate_rad = config_.heading_gate_rad;
-  const LoopVerification v = verify_loop(query_points_[c.query], submap, guesses, verification);
+  const LoopVerification v = verify_loop(query_points_, submap, guesses, verification);
   stats_.set_aside_readings += static_cast<std::size_t>(v.set_aside);
   event.inlier_ratio = v.registration.inlier_ratio;
   event.rmse_m = v.registration.rmse_m;

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 
 #include "adit/slam/loop_closer.hpp"
@@ -79,6 +82,44 @@ TEST(LoopCloser, ClosesARingDrivenTwice) {
   EXPECT_LT(o.end_after, 0.3 * o.end_before);
   EXPECT_LT(o.error_after, o.error_before);
   EXPECT_GE(o.stats.optimizations, 1U);
+}
+
+// The same drive with all but the newest 5 keyframe scans on disk closes the
+// same loops; the scans of the first lap damaged on disk before the second:
+// each such candidate is refused as unreadable, none reaches the graph, the
+// closer goes on.
+TEST(LoopCloser, ScansOnDiskCloseTheSameLoopsAndDamagedOnesAreRefused) {
+  const Drive d = drive([](double s) { return test::ring_pose(kSide, s); }, 1.3 * 4 * kSide, 2.0);
+  const auto run = [&d](bool damage) {
+    const std::filesystem::path folder = std::filesystem::temp_directory_path() / "adit_test_loop_closer_scans";
+    std::filesystem::remove_all(folder);
+    LoopClosureConfig config;
+    config.scans_in_ram = 5;
+    LoopCloser closer(config);
+    closer.spill_scans_to(folder);
+    for (std::size_t k = 0; k < d.truth.size(); ++k) {
+      if (damage && k == 48)  // the first lap done: every scan on disk gets a flipped byte
+        for (std::size_t j = 0; j < closer.scans().spilled(); ++j) {
+          std::fstream f(closer.scans().file_of(j), std::ios::in | std::ios::out | std::ios::binary);
+          f.seekp(40);
+          f.put('\x7f');
+        }
+      closer.add_keyframe(static_cast<std::int64_t>(k) * 1'000'000'000, d.odometry[k],
+                          test::scan_of(ring_world(), d.truth[k], 1000 + static_cast<unsigned>(k)));
+    }
+    std::filesystem::remove_all(folder);
+    return std::pair{closer.stats(), closer.events()};
+  };
+  const Outcome in_ram = close_loops(ring_world(), d);
+  const auto [on_disk, events] = run(false);
+  EXPECT_EQ(on_disk.accepted, in_ram.stats.accepted);
+  EXPECT_EQ(on_disk.candidates, in_ram.stats.candidates);
+  EXPECT_EQ(on_disk.rejected_unreadable, 0U);
+  const auto [damaged, damaged_events] = run(true);
+  EXPECT_GT(damaged.rejected_unreadable, 0U);
+  EXPECT_LT(damaged.accepted, in_ram.stats.accepted);
+  EXPECT_TRUE(std::any_of(damaged_events.begin(), damaged_events.end(),
+                          [](const LoopEvent& e) { return e.outcome == "keyframe_unreadable"; }));
 }
 
 // Out 40 m along the ring and back the other way: revisits in reverse,

@@ -12,6 +12,7 @@
 // once more before the exports.
 
 #include <atomic>
+#include <filesystem>
 #include <mutex>
 #include <vector>
 
@@ -30,6 +31,8 @@ class LoopClosureStage {
                    const slam::LoopClosureConfig& loops = {});
 
   KeyframeQueue& input() { return keyframes_; }
+  // Before start(): keyframe scans beyond the closer's window go to `folder`.
+  void spill_to(const std::filesystem::path& folder) { closer_.spill_scans_to(folder); }
   void start();
   // After the mapping stage has joined: closes the queue, lets the thread
   // drain it and refine, and joins.

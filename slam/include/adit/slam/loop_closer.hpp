@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <span>
 #include <string>
@@ -22,6 +23,7 @@
 #include <Eigen/Geometry>
 
 #include "adit/slam/correction_track.hpp"
+#include "adit/slam/keyframe_scan_store.hpp"
 #include "adit/slam/loop_consistency.hpp"
 #include "adit/slam/loop_verification.hpp"
 #include "adit/slam/place_recognition.hpp"
@@ -39,6 +41,9 @@ struct LoopClosureConfig {
   PoseGraphSolverConfig solver;
   OdometryNoise odometry;
   int submap_keyframes = 5;          // each side of the candidate go into its submap
+  // Keyframe scans kept in RAM (the newest); older ones go to the folder
+  // given to spill_scans_to() (none: all stay in RAM).
+  std::size_t scans_in_ram = 200;
   float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
   double gravity_sigma_rad = 0.0;    // > 0: a roll/pitch prior per keyframe with an `up`
@@ -70,6 +75,7 @@ struct LoopClosureStats {
   std::size_t partial = 0;                // of which partial (one direction unobserved)
   std::size_t accepted = 0;               // in the graph
   std::size_t rejected_verification = 0;  // failed registration (overlap, fit, conditioning, ambiguity)
+  std::size_t rejected_unreadable = 0;    // the candidate's scan could not be read back (KeyframeScanStore)
   std::size_t set_aside_readings = 0;     // passing readings outside the heading gate, set aside
   std::size_t rejected_inconsistent = 0;  // failed the guard
   std::size_t optimizations = 0;
@@ -106,6 +112,10 @@ class LoopCloser {
   const PoseGraph& graph() const { return graph_; }
   // A last optimisation of the whole graph (session end).
   void refine();
+  // Before the first keyframe: keyframe scans beyond config.scans_in_ram go
+  // to `folder` (slam/keyframe_scan_store.hpp).
+  void spill_scans_to(const std::filesystem::path& folder) { scans_.spill_to(folder); }
+  const KeyframeScanStore& scans() const { return scans_; }
 
  private:
   bool try_candidate(const LoopCandidate& candidate);
@@ -115,8 +125,9 @@ class LoopCloser {
   LoopGuard guard_;
   std::vector<Eigen::Isometry3d> odometry_;
   std::vector<std::int64_t> stamps_;
-  std::vector<std::vector<Eigen::Vector3f>> points_;
-  std::vector<std::vector<Eigen::Vector3f>> query_points_;
+  KeyframeScanStore scans_;                  // each keyframe's scan at points_voxel_m (submaps)
+  std::vector<Eigen::Vector3f> query_points_;  // the newest keyframe's at query_voxel_m: only it is ever a query
+  std::vector<Eigen::Vector3f> neighbour_;     // a submap keyframe's scan, read back
   std::vector<ScanContext> descriptors_;
   std::vector<double> path_m_;
   std::vector<double> variance_;

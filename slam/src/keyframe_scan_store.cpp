@@ -1,0 +1,108 @@
+// The loop closer's keyframe scans, in RAM and on disk (keyframe_scan_store.hpp).
+#include "adit/slam/keyframe_scan_store.hpp"
+
+#include <array>
+#include <cstring>
+#include <fstream>
+
+#include <fmt/format.h>
+
+namespace adit::slam {
+namespace {
+
+constexpr std::array<char, 8> kTag{'A', 'D', 'I', 'T', 'K', 'F', 'S', '1'};
+constexpr std::uint64_t kMaxPoints = std::uint64_t{1} << 26;  // far above any keyframe: a count beyond is damage
+
+// FNV-1a, 64 bit (Fowler, Noll, Vo): enough to tell a damaged file, not a
+// cryptographic check.
+std::uint64_t fnv1a(const void* data, std::size_t size) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= bytes[i];
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+std::size_t bytes_of(const std::vector<Eigen::Vector3f>& points) { return points.capacity() * sizeof(Eigen::Vector3f); }
+
+}  // namespace
+
+std::filesystem::path KeyframeScanStore::file_of(std::size_t k) const {
+  return folder_ / fmt::format("{:06}.kfs", k);
+}
+
+void KeyframeScanStore::add(std::vector<Eigen::Vector3f> points) {
+  points.shrink_to_fit();  // a downsampled scan keeps its input's capacity otherwise (1.5× on the mine drives)
+  bytes_in_ram_ += bytes_of(points);
+  scans_.push_back({std::move(points), false});
+  if (folder_.empty()) return;
+  while (next_to_spill_ + in_ram_ < scans_.size()) spill(next_to_spill_++);
+}
+
+void KeyframeScanStore::spill(std::size_t k) {
+  Slot& slot = scans_[k];
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  const std::filesystem::path file = file_of(k);
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  const std::uint64_t n = slot.points.size();
+  const std::size_t payload = n * 3 * sizeof(float);
+  std::vector<float> xyz(n * 3);
+  for (std::size_t i = 0; i < n; ++i) std::memcpy(&xyz[3 * i], slot.points[i].data(), 3 * sizeof(float));
+  const std::uint64_t hash = fnv1a(xyz.data(), payload);
+  out.write(kTag.data(), kTag.size());
+  out.write(reinterpret_cast<const char*>(&n), sizeof n);
+  out.write(reinterpret_cast<const char*>(xyz.data()), static_cast<std::streamsize>(payload));
+  out.write(reinterpret_cast<const char*>(&hash), sizeof hash);
+  out.close();
+  if (!out) {
+    ++write_errors_;
+    last_error_ = fmt::format("{}: cannot write the keyframe's scan (kept in RAM)", file.string());
+    return;
+  }
+  bytes_in_ram_ -= bytes_of(slot.points);
+  std::vector<Eigen::Vector3f>().swap(slot.points);
+  slot.on_disk = true;
+  ++spilled_;
+}
+
+bool KeyframeScanStore::read(std::size_t k, std::vector<Eigen::Vector3f>& out) {
+  out.clear();
+  if (k >= scans_.size()) {
+    ++read_errors_;
+    last_error_ = fmt::format("keyframe {} is not stored", k);
+    return false;
+  }
+  const Slot& slot = scans_[k];
+  if (!slot.on_disk) {
+    out = slot.points;
+    return true;
+  }
+  const std::filesystem::path file = file_of(k);
+  const auto fail = [&](std::string_view why) {
+    ++read_errors_;
+    last_error_ = fmt::format("{}: {}", file.string(), why);
+    out.clear();
+    return false;
+  };
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return fail("cannot open the keyframe's scan");
+  std::array<char, 8> tag{};
+  std::uint64_t n = 0;
+  if (!in.read(tag.data(), tag.size()) || tag != kTag) return fail("not a keyframe scan (tag)");
+  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > kMaxPoints) return fail("damaged (point count)");
+  std::vector<float> xyz(n * 3);
+  std::uint64_t hash = 0;
+  if (!in.read(reinterpret_cast<char*>(xyz.data()), static_cast<std::streamsize>(xyz.size() * sizeof(float))) ||
+      !in.read(reinterpret_cast<char*>(&hash), sizeof hash))
+    return fail("damaged (short)");
+  if (in.peek() != std::ifstream::traits_type::eof()) return fail("damaged (longer than its count)");
+  if (hash != fnv1a(xyz.data(), xyz.size() * sizeof(float))) return fail("damaged (hash)");
+  out.resize(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = Eigen::Vector3f(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  return true;
+}
+
+}  // namespace adit::slam

@@ -1,0 +1,98 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "adit/slam/keyframe_scan_store.hpp"
+#include "adit/slam/loop_closer.hpp"
+
+namespace adit::slam {
+namespace {
+
+std::vector<Eigen::Vector3f> scan(int k, int n = 500) {
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < n; ++i) points.emplace_back(static_cast<float>(k), 0.01F * static_cast<float>(i), -1.5F);
+  return points;
+}
+
+struct Folder {
+  std::filesystem::path path;
+  explicit Folder(const std::string& name) : path(std::filesystem::temp_directory_path() / name) {
+    std::filesystem::remove_all(path);
+  }
+  ~Folder() { std::filesystem::remove_all(path); }
+};
+
+TEST(KeyframeScanStore, WithoutAFolderEveryScanStaysInRam) {
+  KeyframeScanStore store(2);
+  for (int k = 0; k < 5; ++k) store.add(scan(k));
+  EXPECT_EQ(store.spilled(), 0U);
+  EXPECT_GE(store.bytes_in_ram(), 5 * 500 * sizeof(Eigen::Vector3f));
+  std::vector<Eigen::Vector3f> out;
+  ASSERT_TRUE(store.read(0, out));
+  EXPECT_EQ(out, scan(0));
+  EXPECT_FALSE(store.read(5, out));
+}
+
+TEST(KeyframeScanStore, OlderScansGoToDiskAndComeBackTheSame) {
+  const Folder folder("adit_test_kfs_roundtrip");
+  KeyframeScanStore store(3);
+  store.spill_to(folder.path);
+  for (int k = 0; k < 10; ++k) store.add(scan(k, 100 + k));
+  EXPECT_EQ(store.spilled(), 7U);  // all but the newest 3
+  EXPECT_GE(store.bytes_in_ram(), (107 + 108 + 109) * sizeof(Eigen::Vector3f));  // three scans' worth, not ten
+  EXPECT_LE(store.bytes_in_ram(), 3 * 128 * sizeof(Eigen::Vector3f));            // (capacity: 128 each)
+  EXPECT_TRUE(std::filesystem::exists(store.file_of(0)));
+  EXPECT_FALSE(std::filesystem::exists(store.file_of(9)));
+  std::vector<Eigen::Vector3f> out;
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_TRUE(store.read(static_cast<std::size_t>(k), out)) << store.last_error();
+    EXPECT_EQ(out, scan(k, 100 + k)) << k;
+  }
+  EXPECT_EQ(store.read_errors(), 0U);
+}
+
+TEST(KeyframeScanStore, ADamagedOrMissingFileIsRefusedNamingIt) {
+  const Folder folder("adit_test_kfs_damaged");
+  KeyframeScanStore store(1);
+  store.spill_to(folder.path);
+  for (int k = 0; k < 6; ++k) store.add(scan(k));
+  std::vector<Eigen::Vector3f> out;
+  {  // a flipped byte amid the points
+    std::fstream f(store.file_of(0), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('\x5a');
+  }
+  EXPECT_FALSE(store.read(0, out));
+  EXPECT_NE(store.last_error().find(store.file_of(0).string()), std::string::npos);
+  EXPECT_NE(store.last_error().find("hash"), std::string::npos);
+  EXPECT_TRUE(out.empty());
+  std::filesystem::resize_file(store.file_of(1), 40);  // cut short
+  EXPECT_FALSE(store.read(1, out));
+  EXPECT_NE(store.last_error().find("short"), std::string::npos);
+  { std::ofstream(store.file_of(2), std::ios::binary | std::ios::trunc) << "PLY not this"; }  // another file
+  EXPECT_FALSE(store.read(2, out));
+  EXPECT_NE(store.last_error().find("tag"), std::string::npos);
+  std::filesystem::remove(store.file_of(3));
+  EXPECT_FALSE(store.read(3, out));
+  EXPECT_EQ(store.read_errors(), 4U);
+  ASSERT_TRUE(store.read(4, out));  // the others are unharmed
+  EXPECT_EQ(out, scan(4));
+}
+
+TEST(KeyframeScanStore, AFolderThatCannotBeWrittenKeepsTheScansInRam) {
+  const Folder folder("adit_test_kfs_unwritable");
+  std::filesystem::create_directories(folder.path);
+  { std::ofstream(folder.path / "file") << "x"; }
+  KeyframeScanStore store(1);
+  store.spill_to(folder.path / "file" / "below");  // under a regular file: cannot be made
+  for (int k = 0; k < 4; ++k) store.add(scan(k));
+  EXPECT_EQ(store.spilled(), 0U);
+  EXPECT_EQ(store.write_errors(), 3U);
+  std::vector<Eigen::Vector3f> out;
+  ASSERT_TRUE(store.read(0, out));
+  EXPECT_EQ(out, scan(0));
+}
+
+}  // namespace
+}  // namespace adit::slam
