@@ -18,6 +18,7 @@ namespace {
 
 constexpr int kNice = 10;  // below every other stage under SCHED_OTHER
 
+}  // namespace
 
 // With an accelerometer the map's poses hold roll and pitch by gravity
 // (decision 008; the map refiner keeps them within σ 0.002 rad of the
@@ -30,21 +31,19 @@ constexpr int kNice = 10;  // below every other stage under SCHED_OTHER
 // driven (0.12 m/s² on mine:robot:300:5: 1.2 cm a metre). The graph lets the
 // ups' tilt walk as much (PoseGraph::tilt_walk_rad_per_sqrt_s), so a loop
 // that closes in height corrects the tilt along the route.
-slam::LoopClosureConfig loop_config_of(const config::Config& config, slam::LoopClosureConfig loops) {
+slam::LoopClosureConfig loop_closure_config(const config::Config& config, slam::LoopClosureConfig loops) {
   if (config.imu.enabled && loops.gravity_sigma_rad <= 0.0) loops.gravity_sigma_rad = 0.002;
   if (config.imu.enabled && loops.tilt_walk_rad_per_sqrt_s <= 0.0 && config.map.loops_tilt_walk)
     loops.tilt_walk_rad_per_sqrt_s = config.imu.accel_bias_walk / slam::kStandardGravity;
   return loops;
 }
 
-}  // namespace
-
 LoopClosureStage::LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
                                    const slam::LoopClosureConfig& loops)
     : stats_(stats),
       thread_("loops", config::ThreadSettings{}, stop),  // SCHED_OTHER whatever the other stages use, never FIFO
-      closer_(loop_config_of(config, loops)),
-      gravity_(loop_config_of(config, loops).gravity_sigma_rad > 0.0) {}
+      closer_(loop_closure_config(config, loops)),
+      gravity_(loop_closure_config(config, loops).gravity_sigma_rad > 0.0) {}
 
 void LoopClosureStage::start() {
   thread_.start([this] { loop(); });

@@ -35,6 +35,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
+#include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "adit/slam/loop_closer.hpp"
 #include "adit/slam/pose_graph.hpp"
@@ -82,13 +83,16 @@ slam::PoseGraph square_graph(int nodes) {
   slam::PoseGraph g;
   const Eigen::Isometry3d bias = planar(0.0, 0.0, 0.05 * M_PI / 180);
   g.nodes.push_back(on_square(0));
-  g.gravity.push_back({0, Eigen::Vector3d::UnitZ(), 1.0 / (0.002 * 0.002)});
+  g.gravity.push_back({0, Eigen::Vector3d::UnitZ(), 1.0 / (0.002 * 0.002), 0.0});
+  config::Config with_imu;  // the graph of a payload with an accelerometer: gravity priors and the tilt walk, as aditd's
+  with_imu.imu.enabled = true;
+  g.tilt_walk_rad_per_sqrt_s = daemon::loop_closure_config(with_imu).tilt_walk_rad_per_sqrt_s;
   for (int k = 1; k < nodes; ++k) {
     const Eigen::Isometry3d motion = on_square(k - 1).inverse() * on_square(k);
     const auto from = static_cast<std::size_t>(k - 1), to = static_cast<std::size_t>(k);
     g.edges.push_back({from, to, motion * bias, slam::odometry_information(motion), slam::EdgeKind::odometry});
     g.nodes.push_back(g.nodes.back() * motion * bias);
-    g.gravity.push_back({to, Eigen::Vector3d::UnitZ(), 1.0 / (0.002 * 0.002)});
+    g.gravity.push_back({to, Eigen::Vector3d::UnitZ(), 1.0 / (0.002 * 0.002), static_cast<double>(k)});  // 1 m/s
   }
   slam::Vector6d d;
   d << Eigen::Vector3d::Constant(1.0 / (0.05 * 0.05)), Eigen::Vector3d::Constant(1.0 / (0.005 * 0.005));
@@ -146,8 +150,7 @@ int bench_loops(const Options& o) {
   const double odometry_ms = figures.odometry_median_ms;
 
   // 2. The loop closer, keyframe by keyframe, as aditd's loops thread feeds it.
-  slam::LoopClosureConfig loops;
-  if (config.imu.enabled) loops.gravity_sigma_rad = 0.002;  // as daemon/src/loop_closure_stage.cpp
+  const slam::LoopClosureConfig loops = daemon::loop_closure_config(config);
   slam::LoopCloser closer(loops);
   Series search, verification, optimisation, per_keyframe_cpu;
   const std::size_t count = o.max_keyframes > 0 ? std::min(o.max_keyframes, keyframes.size()) : keyframes.size();

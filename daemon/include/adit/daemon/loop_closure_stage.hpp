@@ -25,6 +25,10 @@
 
 namespace adit::daemon {
 
+// The loop closer's settings for `config`: `loops` with, given an IMU, the
+// gravity priors and the tilt walk (the stage's; `adit bench loops` uses it too).
+slam::LoopClosureConfig loop_closure_config(const config::Config& config, slam::LoopClosureConfig loops = {});
+
 class LoopClosureStage {
  public:
   LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
