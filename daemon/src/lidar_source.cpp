@@ -5,7 +5,7 @@
 #include "adit/daemon/lidar_source.hpp"
 
 #include <algorithm>
-#include <array>
+#include <vector>
 #include <cstring>
 #include <span>
 
@@ -26,7 +26,6 @@
 namespace adit::daemon {
 namespace {
 
-constexpr std::size_t kMaxDatagram = 65'536;
 constexpr std::size_t kPacketSlots = 512;  // ~0.4 s of the busiest sensor (Ouster, 1280 packets/s)
 
 struct Packet {
@@ -36,8 +35,30 @@ struct Packet {
   std::int64_t received_mono_ns = 0;  // when the receiver handed it on (latency)
   std::uint32_t size = 0;
   bool imu = false;                   // from the Ouster IMU port (imu.source ouster)
-  std::array<std::uint8_t, kMaxDatagram> data{};
+  std::vector<std::uint8_t> data;     // packet_bytes_for(decoder), sized once
 };
+
+// Each pooled packet holds the longest datagram the configured decoder reads
+// and one byte more, so that a longer datagram still reaches it too long (and
+// is counted as it was) rather than cut to a valid size. A VLP-16's pool is
+// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/031-aditd-memory.md).
+// The configured model's decoder (none for a directory of scans). Throws adit::InputError.
+std::unique_ptr<drivers::LidarDecoder> decoder_of(const config::Config& c) {
+  if (c.lidar.source == config::LidarSource::scan_dir) return nullptr;
+  const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
+  if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
+  try {
+    return family->make_decoder(c.lidar.model, c.lidar.calibration);
+  } catch (const InputError& e) {
+    // The family speaks of its own inputs; name the configuration key.
+    throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
+  }
+}
+
+std::size_t packet_bytes_for(const drivers::LidarDecoder* decoder) {
+  constexpr std::size_t kMaxDatagram = 65'536;
+  return decoder != nullptr ? std::min(decoder->max_packet_bytes() + 1, kMaxDatagram) : 0;
+}
 
 }  // namespace
 
@@ -48,7 +69,12 @@ struct LidarSource::Impl {
         stats(s),
         stop(stop_flag),
         end(end_flag),
-        packets(kPacketSlots, overflow, [] { return Packet{}; }),
+        decoder(decoder_of(c)),
+        packets(kPacketSlots, overflow, [bytes = packet_bytes_for(decoder.get())] {
+          Packet p;
+          p.data.resize(bytes);
+          return p;
+        }),
         receiver("receiver", c.threads.receiver, stop_flag),
         assembly("assembly", c.threads.receiver, stop_flag) {
     record_budget_bytes = static_cast<std::uint64_t>(c.session.record_budget_mb * 1e6);
@@ -59,13 +85,6 @@ struct LidarSource::Impl {
     }
     if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);
     const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
-    if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
-    try {
-      decoder = family->make_decoder(c.lidar.model, c.lidar.calibration);
-    } catch (const InputError& e) {
-      // The family speaks of its own inputs; name the configuration key.
-      throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
-    }
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
     if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
       imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
@@ -144,7 +163,7 @@ struct LidarSource::Impl {
     }
     packet->src_ip = src_ip;
     packet->src_port = src_port;
-    packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
+    packet->size = static_cast<std::uint32_t>(std::min(payload.size(), packet->data.size()));
     std::memcpy(packet->data.data(), payload.data(), packet->size);
     packet->received_mono_ns = monotonic_ns();
     stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);

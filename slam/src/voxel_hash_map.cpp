@@ -17,7 +17,7 @@ VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, floa
       mask_(std::bit_ceil(std::max<std::size_t>(capacity_voxels, 16)) - 1),
       max_voxels_((mask_ + 1) * 3 / 4),
       slots_(mask_ + 1),
-      voxels_(mask_ + 1) {
+      voxels_(std::make_unique_for_overwrite<Voxel[]>(mask_ + 1)) {
   doomed_.reserve(slots_.size());
 }
 

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -123,7 +124,11 @@ class VoxelHashMap {
   std::size_t voxel_count_ = 0;
   std::uint64_t dropped_points_ = 0;
   std::vector<Slot> slots_;
-  std::vector<Voxel> voxels_;
+  // Left uninitialised (make_unique_for_overwrite): a voxel's points are read
+  // only up to its slot's count, so the pages of the 30 MB a 2^17-slot table
+  // reserves become resident only as voxels are used, not all at construction
+  // (docs/decisions/031-aditd-memory.md).
+  std::unique_ptr<Voxel[]> voxels_;
   std::vector<VoxelKey> doomed_;  // remove_far's scratch, reserved to capacity
 };
 
