@@ -396,6 +396,7 @@ void LidarSource::join() {
 std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &impl_->assembly}; }
 std::size_t LidarSource::packets_waiting() const { return impl_->packets.depth(); }
 std::size_t LidarSource::packet_capacity() const { return impl_->packets.capacity(); }
+std::size_t LidarSource::packet_bytes() const { return packet_bytes_for(impl_->decoder.get()); }
 OusterImu* LidarSource::imu() { return impl_->imu ? &*impl_->imu : nullptr; }
 
 }  // namespace adit::daemon
