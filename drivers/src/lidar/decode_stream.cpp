@@ -46,7 +46,7 @@ ScanAssemblerConfig assembler_config_for(const LidarDecoder& decoder, std::int64
   config.packet_period_ns = packet_period_ns;
   config.sequence_modulus = decoder.sequence_modulus();
   // Room for the configured model's busiest mode (a VLP-16 in dual return at
-  // 5 Hz: 304 packets, 116 736 points), not for any sensor's.
+  // 5 Hz: 303 packets, 116 352 points), not for any sensor's.
   const std::int64_t period = packet_period_ns > 0 ? packet_period_ns : decoder.min_packet_period_ns();
   const std::int64_t packets = period > 0 ? max_scan_ns / period + 2 : 4096;
   config.max_points_per_scan = static_cast<std::size_t>(packets) * decoder.max_points_per_packet();
