@@ -5,9 +5,10 @@
 #include "adit/daemon/lidar_source.hpp"
 
 #include <algorithm>
-#include <vector>
 #include <cstring>
+#include <memory>
 #include <span>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -38,10 +39,6 @@ struct Packet {
   std::vector<std::uint8_t> data;     // packet_bytes_for(decoder), sized once
 };
 
-// Each pooled packet holds the longest datagram the configured decoder reads
-// and one byte more, so that a longer datagram still reaches it too long (and
-// is counted as it was) rather than cut to a valid size. A VLP-16's pool is
-// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/031-aditd-memory.md).
 // The configured model's decoder (none for a directory of scans). Throws adit::InputError.
 std::unique_ptr<drivers::LidarDecoder> decoder_of(const config::Config& c) {
   if (c.lidar.source == config::LidarSource::scan_dir) return nullptr;
@@ -55,6 +52,10 @@ std::unique_ptr<drivers::LidarDecoder> decoder_of(const config::Config& c) {
   }
 }
 
+// Each pooled packet holds the longest datagram the configured decoder reads
+// and one byte more, so that a longer datagram still reaches it too long (and
+// is counted as it was) rather than cut to a valid size. A VLP-16's pool is
+// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/031-aditd-memory.md).
 std::size_t packet_bytes_for(const drivers::LidarDecoder* decoder) {
   constexpr std::size_t kMaxDatagram = 65'536;
   return decoder != nullptr ? std::min(decoder->max_packet_bytes() + 1, kMaxDatagram) : 0;
