@@ -70,21 +70,22 @@ struct LidarSource::Impl {
         stats(s),
         stop(stop_flag),
         end(end_flag),
-        decoder(decoder_of(c)),
-        packets(kPacketSlots, overflow, [bytes = packet_bytes_for(decoder.get())] {
-          Packet p;
-          p.data.resize(bytes);
-          return p;
-        }),
         receiver("receiver", c.threads.receiver, stop_flag),
         assembly("assembly", c.threads.receiver, stop_flag) {
     record_budget_bytes = static_cast<std::uint64_t>(c.session.record_budget_mb * 1e6);
     record_part_bytes = static_cast<std::uint64_t>(c.session.record_part_mb * 1e6);
     if (c.lidar.source == config::LidarSource::scan_dir) {
       scan_directory.emplace(c.lidar.scan_dir);
+      packets.emplace(kPacketSlots, overflow, [] { return Packet{}; });  // no packets: scans come whole
       return;
     }
-    if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);
+    if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);  // its name first
+    decoder = decoder_of(c);
+    packets.emplace(kPacketSlots, overflow, [bytes = packet_bytes_for(decoder.get())] {
+      Packet p;
+      p.data.resize(bytes);
+      return p;
+    });
     const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
     if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
@@ -150,7 +151,7 @@ struct LidarSource::Impl {
   // Receiver thread: one datagram into the packet pool (and the recording).
   void push(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip, std::uint16_t src_port,
             bool from_imu = false) {
-    Packet* packet = packets.acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
+    Packet* packet = packets->acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
     if (packet == nullptr) return;
     packet->imu = from_imu;
     packet->host_time_ns = time_ns;
@@ -183,7 +184,7 @@ struct LidarSource::Impl {
       }
       if (recorder->failed()) stop_recording(RecordingStop::write_failed);
     }
-    packets.publish(packet);
+    packets->publish(packet);
   }
 
   // Receiver thread: the recording goes on in its next part (lidar.1.pcap,
@@ -272,7 +273,7 @@ struct LidarSource::Impl {
         log::error("{}: {}", e.where(), e.reason());
       }
     }
-    packets.close();
+    packets->close();
   }
 
   void scan_directory_loop() {
@@ -297,7 +298,7 @@ struct LidarSource::Impl {
     if (scan_directory) return;
     // A stop drops what is queued; an ended source is drained.
     while (!stop.load(std::memory_order_relaxed)) {
-      Packet* packet = packets.take_or_wait([this] { return assembly.idle(); });
+      Packet* packet = packets->take_or_wait([this] { return assembly.idle(); });
       if (packet == nullptr) break;
       assembly.beat.beat();
       const std::span<const std::uint8_t> payload(packet->data.data(), packet->size);
@@ -308,12 +309,12 @@ struct LidarSource::Impl {
         if (!period_learnt) learn_packet_period(payload);
         stream->push(payload, packet->host_time_ns);
       }
-      packets.release(packet);
+      packets->release(packet);
     }
     if (!stop.load()) stream->finish();
     if (imu) imu->close();
     stats.bad_packets.store(stream->bad_packets());
-    stats.dropped_packets.store(packets.dropped());
+    stats.dropped_packets.store(packets->dropped());
     scans->close();
   }
 
@@ -345,7 +346,7 @@ struct LidarSource::Impl {
   std::optional<OusterImu> imu;           // imu.source ouster
   std::uint16_t imu_port = 0;
   std::optional<drivers::UdpReceiver> imu_udp;
-  Handoff<Packet> packets;
+  std::optional<Handoff<Packet>> packets;  // sized by the decoder, so built after it
   Handoff<ScanSlot>* scans = nullptr;      // the source's output, set before the threads start
   std::int64_t current_packet_mono_ns = 0;  // assembly thread only
   StageThread receiver;
@@ -395,8 +396,8 @@ void LidarSource::join() {
 }
 
 std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &impl_->assembly}; }
-std::size_t LidarSource::packets_waiting() const { return impl_->packets.depth(); }
-std::size_t LidarSource::packet_capacity() const { return impl_->packets.capacity(); }
+std::size_t LidarSource::packets_waiting() const { return impl_->packets->depth(); }
+std::size_t LidarSource::packet_capacity() const { return impl_->packets->capacity(); }
 std::size_t LidarSource::packet_bytes() const { return packet_bytes_for(impl_->decoder.get()); }
 OusterImu* LidarSource::imu() { return impl_->imu ? &*impl_->imu : nullptr; }
 
