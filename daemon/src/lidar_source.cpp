@@ -5,9 +5,10 @@
 #include "adit/daemon/lidar_source.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cstring>
+#include <memory>
 #include <span>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -26,7 +27,6 @@
 namespace adit::daemon {
 namespace {
 
-constexpr std::size_t kMaxDatagram = 65'536;
 constexpr std::size_t kPacketSlots = 512;  // ~0.4 s of the busiest sensor (Ouster, 1280 packets/s)
 
 struct Packet {
@@ -36,8 +36,30 @@ struct Packet {
   std::int64_t received_mono_ns = 0;  // when the receiver handed it on (latency)
   std::uint32_t size = 0;
   bool imu = false;                   // from the Ouster IMU port (imu.source ouster)
-  std::array<std::uint8_t, kMaxDatagram> data{};
+  std::vector<std::uint8_t> data;     // packet_bytes_for(decoder), sized once
 };
+
+// The configured model's decoder (none for a directory of scans). Throws adit::InputError.
+std::unique_ptr<drivers::LidarDecoder> decoder_of(const config::Config& c) {
+  if (c.lidar.source == config::LidarSource::scan_dir) return nullptr;
+  const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
+  if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
+  try {
+    return family->make_decoder(c.lidar.model, c.lidar.calibration);
+  } catch (const InputError& e) {
+    // The family speaks of its own inputs; name the configuration key.
+    throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
+  }
+}
+
+// Each pooled packet holds the longest datagram the configured decoder reads
+// and one byte more, so that a longer datagram still reaches it too long (and
+// is counted as it was) rather than cut to a valid size. A VLP-16's pool is
+// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/031-aditd-memory.md).
+std::size_t packet_bytes_for(const drivers::LidarDecoder* decoder) {
+  constexpr std::size_t kMaxDatagram = 65'536;
+  return decoder != nullptr ? std::min(decoder->max_packet_bytes() + 1, kMaxDatagram) : 0;
+}
 
 }  // namespace
 
@@ -48,24 +70,23 @@ struct LidarSource::Impl {
         stats(s),
         stop(stop_flag),
         end(end_flag),
-        packets(kPacketSlots, overflow, [] { return Packet{}; }),
         receiver("receiver", c.threads.receiver, stop_flag),
         assembly("assembly", c.threads.receiver, stop_flag) {
     record_budget_bytes = static_cast<std::uint64_t>(c.session.record_budget_mb * 1e6);
     record_part_bytes = static_cast<std::uint64_t>(c.session.record_part_mb * 1e6);
     if (c.lidar.source == config::LidarSource::scan_dir) {
       scan_directory.emplace(c.lidar.scan_dir);
+      packets.emplace(kPacketSlots, overflow, [] { return Packet{}; });  // no packets: scans come whole
       return;
     }
-    if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);
+    if (c.lidar.source == config::LidarSource::pcap) pcap.emplace(c.lidar.pcap, speed);  // its name first
+    decoder = decoder_of(c);
+    packets.emplace(kPacketSlots, overflow, [bytes = packet_bytes_for(decoder.get())] {
+      Packet p;
+      p.data.resize(bytes);
+      return p;
+    });
     const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
-    if (family == nullptr) throw InputError("", "lidar.model", "no decoder for " + c.lidar.model);
-    try {
-      decoder = family->make_decoder(c.lidar.model, c.lidar.calibration);
-    } catch (const InputError& e) {
-      // The family speaks of its own inputs; name the configuration key.
-      throw InputError(e.where().empty() ? c.lidar.calibration : e.where(), "lidar.calibration", e.reason());
-    }
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
     if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
       imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
@@ -130,7 +151,7 @@ struct LidarSource::Impl {
   // Receiver thread: one datagram into the packet pool (and the recording).
   void push(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint32_t src_ip, std::uint16_t src_port,
             bool from_imu = false) {
-    Packet* packet = packets.acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
+    Packet* packet = packets->acquire_or_wait([this] { return receiver.idle(); });  // replay: wait for assembly
     if (packet == nullptr) return;
     packet->imu = from_imu;
     packet->host_time_ns = time_ns;
@@ -144,7 +165,7 @@ struct LidarSource::Impl {
     }
     packet->src_ip = src_ip;
     packet->src_port = src_port;
-    packet->size = static_cast<std::uint32_t>(std::min(payload.size(), kMaxDatagram));
+    packet->size = static_cast<std::uint32_t>(std::min(payload.size(), packet->data.size()));
     std::memcpy(packet->data.data(), payload.data(), packet->size);
     packet->received_mono_ns = monotonic_ns();
     stats.last_packet_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
@@ -163,7 +184,7 @@ struct LidarSource::Impl {
       }
       if (recorder->failed()) stop_recording(RecordingStop::write_failed);
     }
-    packets.publish(packet);
+    packets->publish(packet);
   }
 
   // Receiver thread: the recording goes on in its next part (lidar.1.pcap,
@@ -252,7 +273,7 @@ struct LidarSource::Impl {
         log::error("{}: {}", e.where(), e.reason());
       }
     }
-    packets.close();
+    packets->close();
   }
 
   void scan_directory_loop() {
@@ -277,7 +298,7 @@ struct LidarSource::Impl {
     if (scan_directory) return;
     // A stop drops what is queued; an ended source is drained.
     while (!stop.load(std::memory_order_relaxed)) {
-      Packet* packet = packets.take_or_wait([this] { return assembly.idle(); });
+      Packet* packet = packets->take_or_wait([this] { return assembly.idle(); });
       if (packet == nullptr) break;
       assembly.beat.beat();
       const std::span<const std::uint8_t> payload(packet->data.data(), packet->size);
@@ -288,12 +309,12 @@ struct LidarSource::Impl {
         if (!period_learnt) learn_packet_period(payload);
         stream->push(payload, packet->host_time_ns);
       }
-      packets.release(packet);
+      packets->release(packet);
     }
     if (!stop.load()) stream->finish();
     if (imu) imu->close();
     stats.bad_packets.store(stream->bad_packets());
-    stats.dropped_packets.store(packets.dropped());
+    stats.dropped_packets.store(packets->dropped());
     scans->close();
   }
 
@@ -325,7 +346,7 @@ struct LidarSource::Impl {
   std::optional<OusterImu> imu;           // imu.source ouster
   std::uint16_t imu_port = 0;
   std::optional<drivers::UdpReceiver> imu_udp;
-  Handoff<Packet> packets;
+  std::optional<Handoff<Packet>> packets;  // sized by the decoder, so built after it
   Handoff<ScanSlot>* scans = nullptr;      // the source's output, set before the threads start
   std::int64_t current_packet_mono_ns = 0;  // assembly thread only
   StageThread receiver;
@@ -375,8 +396,9 @@ void LidarSource::join() {
 }
 
 std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &impl_->assembly}; }
-std::size_t LidarSource::packets_waiting() const { return impl_->packets.depth(); }
-std::size_t LidarSource::packet_capacity() const { return impl_->packets.capacity(); }
+std::size_t LidarSource::packets_waiting() const { return impl_->packets->depth(); }
+std::size_t LidarSource::packet_capacity() const { return impl_->packets->capacity(); }
+std::size_t LidarSource::packet_bytes() const { return packet_bytes_for(impl_->decoder.get()); }
 OusterImu* LidarSource::imu() { return impl_->imu ? &*impl_->imu : nullptr; }
 
 }  // namespace adit::daemon

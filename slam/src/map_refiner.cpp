@@ -4,7 +4,9 @@ namespace adit::slam {
 
 MapRefiner::MapRefiner(const MapRefinerConfig& config)
     : config_(config),
-      map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
+      // The mapping thread may fault pages in; the refiner's map fills about half its table on a mine drive.
+      map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m,
+           VoxelHashMap::Storage::on_first_use),
       downsampler_(config.max_scan_points),
       planes_(config.max_scan_points) {
   source_.reserve(config.max_scan_points);

@@ -10,15 +10,20 @@
 
 namespace adit::slam {
 
-VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m)
+VoxelHashMap::VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m, Storage storage)
     : voxel_size_(voxel_size_m),
       inverse_voxel_size_(1.0F / voxel_size_m),
       min_point_spacing_(std::max(min_point_spacing_m, 0.0F)),
       mask_(std::bit_ceil(std::max<std::size_t>(capacity_voxels, 16)) - 1),
       max_voxels_((mask_ + 1) * 3 / 4),
       slots_(mask_ + 1),
-      voxels_(mask_ + 1) {
+      voxels_(std::make_unique_for_overwrite<Voxel[]>(mask_ + 1)) {
   doomed_.reserve(slots_.size());
+  if (storage == Storage::touched) {
+    Voxel zero;
+    zero.points.fill(Eigen::Vector3f::Zero());
+    std::fill_n(voxels_.get(), slots_.size(), zero);
+  }
 }
 
 std::size_t VoxelHashMap::home_of(const VoxelKey& key) const { return voxel_hash(key) & mask_; }

@@ -47,8 +47,11 @@ TEST(MemoryGrowth, GivesMallocsBytesInUseFromTheFirstHeapSampleOnAndTheMapsSize)
   EXPECT_DOUBLE_EQ(g->heap_end_mb, 9.0);
   EXPECT_DOUBLE_EQ(g->map_from_mb, 2.0);
   EXPECT_DOUBLE_EQ(g->map_end_mb, 6.0);
+  // Resident less the tiles, largest from pose 10 on: 20 - 2, 21 - 3, 22 - 4, 23 - 6.
+  EXPECT_DOUBLE_EQ(g->max_beyond_map_mb, 18.0);
   const std::string text = figures_text(PipelineFigures{.memory = samples}, 0.3);
   EXPECT_NE(text.find("malloc in use 8.0 -> 9.0 MB, map tiles 2.0 -> 6.0 MB"), std::string::npos) << text;
+  EXPECT_NE(text.find("max 18.0 MB beyond the map's tiles"), std::string::npos) << text;
 }
 
 TEST(PipelineConfig, CommandLineOverridesTheFile) {

@@ -148,10 +148,14 @@ int bench_pipeline(const BenchPipelineOptions& o) {
   if (config.lidar.source != config::LidarSource::pcap)
     throw InputError(o.inputs.config_file, "lidar.source", "the bench needs a capture: give --pcap or lidar.source: pcap");
 
-  daemon::PipelineOptions file_options;
-  file_options.replay_speed = o.speed;
-  daemon::Pipeline file_pipeline(config, file_options);
-  const PipelineFigures file = run_pipeline(file_pipeline);
+  // The file's pipeline is gone before the loopback run, whose resident size
+  // would otherwise hold both (the peak, VmHWM, is the process's and does).
+  const PipelineFigures file = [&] {
+    daemon::PipelineOptions file_options;
+    file_options.replay_speed = o.speed;
+    daemon::Pipeline file_pipeline(config, file_options);
+    return run_pipeline(file_pipeline);
+  }();
   const LoopbackRun udp = run_over_loopback(config, o.speed);
   const std::uint64_t lost = udp.sent.sent > udp.figures.datagrams ? udp.sent.sent - udp.figures.datagrams : 0;
 

@@ -120,7 +120,7 @@ int bench_odometry(const BenchOptions& o) {
   config.sweep_velocity_sigma_radps = o.sweep_velocity_sigma_radps;
   config.target_registration_points = o.target_registration_points;
   const auto most_points = static_cast<std::size_t>(quantile(sizes, 1.0));
-  config.max_scan_points = std::max<std::size_t>(config.max_scan_points, most_points);
+  config.max_scan_points = std::max<std::size_t>(most_points, 1);  // room for the largest, as aditd for its sensor
   // The payload as aditd reads it: its extrinsics, ranges and CAN bus; or
   // none (sensor frame, no wheels, no accelerometer).
   config::Config payload;

@@ -119,6 +119,7 @@ std::optional<MemoryGrowth> memory_growth(const std::vector<MemorySample>& sampl
   g.max_mb = std::max_element(first, samples.end(), [](const MemorySample& a, const MemorySample& b) {
                return a.resident_mb < b.resident_mb;
              })->resident_mb;
+  for (auto m = first; m != samples.end(); ++m) g.max_beyond_map_mb = std::max(g.max_beyond_map_mb, m->resident_mb - m->map_mb);
   return g;
 }
 
@@ -146,7 +147,8 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
     j["resident_growth"] = {{"from_pose", g->from_pose}, {"from_mb", g->from_mb}, {"end_mb", g->end_mb},
                             {"max_mb", g->max_mb},       {"percent", g->percent()}, {"samples", f.memory.size()},
                             {"heap_in_use_from_mb", g->heap_from_mb}, {"heap_in_use_end_mb", g->heap_end_mb},
-                            {"map_from_mb", g->map_from_mb}, {"map_end_mb", g->map_end_mb}};
+                            {"map_from_mb", g->map_from_mb}, {"map_end_mb", g->map_end_mb},
+                            {"max_beyond_map_mb", g->max_beyond_map_mb}};
   if (f.mapping)
     j["map"] = {{"points", f.map_points},           {"tiles", f.map_tiles},
                 {"resident_tiles", f.resident_tiles}, {"evicted_tiles", f.evicted_tiles},
@@ -170,8 +172,9 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
       f.bad_packets, f.odometry_median_ms, f.odometry_p99_ms, f.latency_median_ms, f.latency_p99_ms, f.latency_max_ms,
       f.beyond_odometry_median_ms, f.beyond_odometry_p99_ms, f.sensor_span_s, f.duration_s, f.speed(), f.peak_resident_mb);
   if (const auto g = memory_growth(f.memory, from_fraction))
-    text += fmt::format("; resident {:.1f} MB at pose {} -> {:.1f} MB at the end ({:+.2f} %, max {:.1f} MB)",
-                        g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb);
+    text += fmt::format("; resident {:.1f} MB at pose {} -> {:.1f} MB at the end ({:+.2f} %, max {:.1f} MB; "
+                        "max {:.1f} MB beyond the map's tiles)",
+                        g->from_mb, g->from_pose, g->end_mb, g->percent(), g->max_mb, g->max_beyond_map_mb);
   if (const auto g = memory_growth(f.memory, from_fraction); g && g->heap_from_mb >= 0.0 && g->heap_end_mb >= 0.0)
     text += fmt::format("; malloc in use {:.1f} -> {:.1f} MB, map tiles {:.1f} -> {:.1f} MB", g->heap_from_mb,
                         g->heap_end_mb, g->map_from_mb, g->map_end_mb);

@@ -102,6 +102,9 @@ struct MemoryGrowth {
   double heap_end_mb = -1.0;
   double map_from_mb = 0.0;  // the tiled map's own figure, at from_pose and at the end
   double map_end_mb = 0.0;
+  // The largest sample of resident size less the map's tiles (issue #26's
+  // figure: what aditd holds beyond the map it has built), from from_pose on.
+  double max_beyond_map_mb = 0.0;
   double percent() const { return from_mb > 0.0 ? 100.0 * (end_mb - from_mb) / from_mb : 0.0; }
 };
 std::optional<MemoryGrowth> memory_growth(const std::vector<MemorySample>& samples, double from_fraction);

@@ -45,7 +45,10 @@ ScanAssemblerConfig assembler_config_for(const LidarDecoder& decoder, std::int64
   config.cut_azimuth_deg = cut_azimuth_deg;
   config.packet_period_ns = packet_period_ns;
   config.sequence_modulus = decoder.sequence_modulus();
-  const std::int64_t packets = packet_period_ns > 0 ? max_scan_ns / packet_period_ns + 2 : 4096;
+  // Room for the configured model's busiest mode (a VLP-16 in dual return at
+  // 5 Hz: 303 packets, 116 352 points), not for any sensor's.
+  const std::int64_t period = packet_period_ns > 0 ? packet_period_ns : decoder.min_packet_period_ns();
+  const std::int64_t packets = period > 0 ? max_scan_ns / period + 2 : 4096;
   config.max_points_per_scan = static_cast<std::size_t>(packets) * decoder.max_points_per_packet();
   return config;
 }

@@ -115,6 +115,8 @@ OusterDecoder::OusterDecoder(const OusterMetadata& m)
   points_.resize(capacity);
 }
 
+std::size_t OusterDecoder::max_packet_bytes() const { return std::max(layout_.packet_bytes, kOusterImuPacketBytes); }
+
 DecodedPacket OusterDecoder::decode(std::span<const std::uint8_t> payload, std::int64_t /*host_time_ns*/) {
   DecodedPacket out;
   std::size_t count = 0;

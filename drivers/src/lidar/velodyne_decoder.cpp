@@ -207,6 +207,14 @@ VelodyneDecoder::VelodyneDecoder(VelodyneModel model, VelodyneCalibration calibr
   points_.resize(kMaxPoints);
 }
 
+std::int64_t VelodyneDecoder::min_packet_period_ns() const {
+  return velodyne_packet_period_ns(model_, VelodyneReturnMode::dual);
+}
+
+std::size_t VelodyneDecoder::max_packet_bytes() const {
+  return std::max(kVelodyneDataPacketSize, kVelodynePositionPacketSize);
+}
+
 DecodedPacket VelodyneDecoder::decode(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) {
   if (payload.size() == kVelodyneDataPacketSize) return decode_data(payload, host_time_ns);
   if (payload.size() == kVelodynePositionPacketSize) return decode_position(payload);

@@ -65,6 +65,8 @@ class LidarSource {
   std::vector<StageThread*> threads();
   std::size_t packets_waiting() const;
   std::size_t packet_capacity() const;
+  // Bytes each pooled packet holds: the decoder's longest datagram and one more.
+  std::size_t packet_bytes() const;
 
  private:
   struct Impl;

@@ -31,7 +31,7 @@ namespace adit::daemon {
 
 // The odometry aditd runs for `config`: `base` (slam defaults, or a
 // benchmark's settings) with the range limits of the lidar section and room
-// for `max_points` per scan.
+// for `max_points` per scan (exactly; 0 keeps base's).
 slam::OdometryConfig odometry_config_of(const config::Config& config, slam::OdometryConfig base, std::size_t max_points);
 
 // How often the motion sensors helped (only counted when configured).

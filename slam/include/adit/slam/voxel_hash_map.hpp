@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -48,7 +49,16 @@ class VoxelHashMap {
   // voxel is refused (KISS-ICP ≥ 1.0 uses voxel_size / sqrt(max points)).
   // Without it a voxel keeps its first kMaxPointsPerVoxel points: the rings of
   // the few scans that first saw it, repeated, and nothing of later scans.
-  VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m = 0.0F);
+  //
+  // The points' storage (capacity × kMaxPointsPerVoxel points: 31.5 MB at
+  // 2^17) is written at construction (`touched`), so a caller on a hot path
+  // (the odometry) takes no page fault later; `on_first_use` leaves it to
+  // become resident a page at a time as voxels are first used, for a thread
+  // that may allocate (the mapping thread's refiner): a mine drive uses about
+  // half of it (docs/decisions/031-aditd-memory.md).
+  enum class Storage : std::uint8_t { touched, on_first_use };
+  VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m = 0.0F,
+               Storage storage = Storage::touched);
 
   // Adds points (map frame). A point lands in its voxel unless the voxel is
   // full, or the table is, or (with a minimum spacing) a point of the voxel
@@ -123,7 +133,9 @@ class VoxelHashMap {
   std::size_t voxel_count_ = 0;
   std::uint64_t dropped_points_ = 0;
   std::vector<Slot> slots_;
-  std::vector<Voxel> voxels_;
+  // A voxel's points are read only up to its slot's count, so the storage
+  // may be left unwritten (Storage::on_first_use).
+  std::unique_ptr<Voxel[]> voxels_;
   std::vector<VoxelKey> doomed_;  // remove_far's scratch, reserved to capacity
 };
 

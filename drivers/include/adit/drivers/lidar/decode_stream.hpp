@@ -52,7 +52,9 @@ class DecodeStream {
 };
 
 // An assembler configuration for a decoder: room for `max_scan_ns` of packets
-// (default: one revolution at 5 Hz, the slowest rate these sensors run at).
+// (default: one revolution at 5 Hz, the slowest rate these sensors run at) at
+// `packet_period_ns`, or when that is 0 at the decoder's min_packet_period_ns
+// (4096 packets when it has none).
 ScanAssemblerConfig assembler_config_for(const LidarDecoder& decoder, std::int64_t packet_period_ns,
                                          float cut_azimuth_deg, std::int64_t max_scan_ns = 200'000'000);
 

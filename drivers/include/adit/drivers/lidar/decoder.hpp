@@ -55,6 +55,13 @@ class LidarDecoder {
   // The UDP destination port of data packets, by default.
   virtual std::uint16_t default_port() const = 0;
   virtual std::size_t max_points_per_packet() const = 0;
+  // The shortest time between this model's data packets in any return mode,
+  // 0 when the decoder cannot tell before it sees packets: a scan's buffers
+  // are sized from it (assembler_config_for), else for 4096 packets.
+  virtual std::int64_t min_packet_period_ns() const { return 0; }
+  // The longest datagram this decoder reads (data and auxiliary packets); the
+  // packet pool before it (aditd's LiDAR source) keeps this many bytes a packet.
+  virtual std::size_t max_packet_bytes() const { return 65'536; }
   // Where DecodedPacket::sequence wraps (for the ScanAssembler's loss counting).
   virtual std::uint64_t sequence_modulus() const { return std::uint64_t{1} << 32; }
   // host_time_ns (CLOCK_REALTIME) resolves sensor clocks that are ambiguous

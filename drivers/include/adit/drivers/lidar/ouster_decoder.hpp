@@ -47,6 +47,8 @@ class OusterDecoder final : public LidarDecoder {
   std::string_view model() const override { return model_; }
   std::uint16_t default_port() const override { return port_; }
   std::size_t max_points_per_packet() const override { return points_.size(); }
+  std::int64_t min_packet_period_ns() const override { return packet_period_ns_; }
+  std::size_t max_packet_bytes() const override;  // the lidar packet's or the IMU packet's
   DecodedPacket decode(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) override;
 
   // The last IMU packet decoded (decode() returns `auxiliary` for them).

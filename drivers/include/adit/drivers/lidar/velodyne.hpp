@@ -124,6 +124,8 @@ class VelodyneDecoder final : public LidarDecoder {
   std::string_view model() const override { return to_string(model_); }
   std::uint16_t default_port() const override { return kVelodyneDataPort; }
   std::size_t max_points_per_packet() const override { return kMaxPoints; }
+  std::int64_t min_packet_period_ns() const override;  // dual return: twice the packets
+  std::size_t max_packet_bytes() const override;
   // Data packets come back `ok`; position packets `auxiliary` (see last_position()).
   DecodedPacket decode(std::span<const std::uint8_t> payload, std::int64_t host_time_ns) override;
 
