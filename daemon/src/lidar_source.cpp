@@ -55,7 +55,7 @@ std::unique_ptr<drivers::LidarDecoder> decoder_of(const config::Config& c) {
 // Each pooled packet holds the longest datagram the configured decoder reads
 // and one byte more, so that a longer datagram still reaches it too long (and
 // is counted as it was) rather than cut to a valid size. A VLP-16's pool is
-// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/031-aditd-memory.md).
+// then 0.6 MB, not the 33.5 MB of 64 kB a packet (docs/decisions/032-aditd-memory.md).
 std::size_t packet_bytes_for(const drivers::LidarDecoder* decoder) {
   constexpr std::size_t kMaxDatagram = 65'536;
   return decoder != nullptr ? std::min(decoder->max_packet_bytes() + 1, kMaxDatagram) : 0;

@@ -17,7 +17,7 @@ slam::OdometryConfig odometry_config_of(const config::Config& config, slam::Odom
   base.max_range_m = static_cast<float>(config.lidar.max_range_m);
   // Sized to the configured sensor, not to slam's 400 000 default: the
   // downsampler's table and the registration's buffers follow it (a VLP-16:
-  // 116 352, docs/decisions/031-aditd-memory.md).
+  // 116 352, docs/decisions/032-aditd-memory.md).
   if (max_points > 0) base.max_scan_points = max_points;
   if (config.imu.enabled) {
     base.inertial.noise = {config.imu.gyro_noise_density, config.imu.accel_noise_density, config.imu.gyro_bias_walk,

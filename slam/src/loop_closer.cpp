@@ -81,8 +81,10 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
 bool LoopCloser::try_candidate(const LoopCandidate& c) {
   LoopEvent event{c.query, c.candidate, c.descriptor_distance, "", 0.0, 0.0, 0.0};
   // The candidate's surroundings in its own frame, by the graph.
+  // Its storage becomes resident only as the submap's voxels are used (11
+  // keyframes fill a small part of it): not 16.8 MB written per candidate.
   VoxelHashMap submap(config_.verification.submap_voxel_m, config_.verification.submap_capacity_voxels,
-                      config_.verification.submap_point_spacing_m);
+                      config_.verification.submap_point_spacing_m, VoxelHashMap::Storage::on_first_use);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.submap_keyframes));
   const std::size_t first = c.candidate >= w ? c.candidate - w : 0;
   const std::size_t last = std::min(c.candidate + w, c.query - 1);

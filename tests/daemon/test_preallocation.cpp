@@ -1,5 +1,5 @@
 // aditd's preallocations follow the configured sensor, not the busiest one
-// (docs/decisions/031-aditd-memory.md): a VLP-16's scan, packet and odometry
+// (docs/decisions/032-aditd-memory.md): a VLP-16's scan, packet and odometry
 // buffers are sized from its own packet rate and datagram, so a change that
 // sizes them for any sensor again (4096 packets a scan, 64 kB a packet,
 // slam's 400 000 points) fails here rather than in a resident-size figure.

@@ -55,7 +55,7 @@ class VoxelHashMap {
   // (the odometry) takes no page fault later; `on_first_use` leaves it to
   // become resident a page at a time as voxels are first used, for a thread
   // that may allocate (the mapping thread's refiner): a mine drive uses about
-  // half of it (docs/decisions/031-aditd-memory.md).
+  // half of it (docs/decisions/032-aditd-memory.md).
   enum class Storage : std::uint8_t { touched, on_first_use };
   VoxelHashMap(float voxel_size_m, std::size_t capacity_voxels, float min_point_spacing_m = 0.0F,
                Storage storage = Storage::touched);
