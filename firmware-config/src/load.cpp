@@ -107,8 +107,11 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
   }
 }
 
+// Made absolute, so that the configuration aditd saves into a session folder
+// (config.yaml, read again there by the products) names the same files.
 void resolve(std::string& path, const std::filesystem::path& base_dir) {
-  if (!path.empty() && std::filesystem::path(path).is_relative()) path = (base_dir / path).lexically_normal().string();
+  if (!path.empty() && std::filesystem::path(path).is_relative())
+    path = std::filesystem::absolute(base_dir / path).lexically_normal().string();
 }
 
 }  // namespace

@@ -214,6 +214,14 @@ TEST(ConfigLoader, RelativePathsAreResolvedAgainstTheConfigFolder) {
   EXPECT_EQ(c.lidar.pcap, "/sessions/a.pcap");
 }
 
+// A configuration read from a relative folder (`aditd --config firmware-config/default.yaml`) names its
+// files absolutely: aditd saves it into the session folder, where it is read again (the products).
+TEST(ConfigLoader, PathsFromARelativeConfigFolderBecomeAbsolute) {
+  const Config c = parse_config(std::string(kMinimal) + "  source: pcap\n  pcap: ../sessions/a.pcap\n", "relative.yaml",
+                                "firmware-config");
+  EXPECT_EQ(c.lidar.pcap, (std::filesystem::current_path() / "sessions/a.pcap").string());
+}
+
 TEST(ConfigLoader, KeyFileIsResolvedAgainstTheConfigFolderUnlessACredential) {
   Config c = parse(std::string(kMinimal) + "lcm:\n  key_file: ../keys/command.key\n");
   EXPECT_EQ(c.lcm.key_file, "/keys/command.key");
