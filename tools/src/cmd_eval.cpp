@@ -178,16 +178,16 @@ void add_loops(CLI::App& eval, int& status) {
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--truth", o->truth, "The simulator's truth_body.tum")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--revisit", o->revisit_m, "True revisit: keyframes' true positions within this (m, default 3)")
+  cmd->add_option("--revisit", o->judge.revisit_m, "True revisit: keyframes' true positions within this (m, default 3)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--min-path", o->min_path_m, "... and at least this far apart along the true path (m, default 30)")
+  cmd->add_option("--min-path", o->judge.min_path_m, "... and at least this far apart along the true path (m, default 30)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--false-beyond", o->false_beyond_m, "An accepted loop whose keyframes lie farther apart is false (m, default 10)")
+  cmd->add_option("--false-beyond", o->judge.false_beyond_m, "An accepted loop whose keyframes lie farther apart is false (m, default 10)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--max-error", o->max_error_m, "... or whose measurement is off the truth by more (m, default 0.3)")
+  cmd->add_option("--max-error", o->judge.max_error_m, "... or whose measurement is off the truth by more (m, default 0.3)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--max-error-deg", o->max_error_deg, "... or by more (degrees, default 1)")->check(CLI::PositiveNumber);
-  cmd->add_option("--window", o->window, "Recall: a true loop within this many keyframes of a revisit (default 5)");
+  cmd->add_option("--max-error-deg", o->judge.max_error_deg, "... or by more (degrees, default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--window", o->judge.window, "Recall: a true loop within this many keyframes of a revisit (default 5)");
   cmd->add_flag("--json", o->json, "Print JSON instead of a table");
   cmd->callback([o, &status] {
     run_eval_loops(*o);

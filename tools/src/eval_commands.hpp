@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/eval/loop_truth.hpp"
 #include "adit/eval/mesh_distance.hpp"
 #include "adit/eval/stats.hpp"
 #include "adit/slam/trajectory.hpp"
@@ -94,12 +95,7 @@ void run_eval_moving(const MovingEvalOptions& options);
 struct LoopsEvalOptions {
   std::string session;  // aditd's session folder: summary.json ("loops"."edges") and keyframes.tum
   std::string truth;    // adit sim's truth_body.tum
-  double revisit_m = 3.0;
-  double min_path_m = 30.0;
-  double false_beyond_m = 10.0;
-  double max_error_m = 0.3;
-  double max_error_deg = 1.0;
-  std::size_t window = 5;
+  eval::LoopTruthConfig judge;  // what counts as a revisit, a false loop, a recalled one
   bool json = false;
 };
 

@@ -31,13 +31,7 @@ void run_eval_loops(const LoopsEvalOptions& o) {
   const slam::Trajectory keyframes = eval::read_tum(keyframes_file);
   const slam::Trajectory truth = eval::read_tum(o.truth);
   const eval::KeyframeTruth at_keyframes = eval::keyframe_truth(truth, keyframes.stamps, o.truth);
-  eval::LoopTruthConfig c;
-  c.revisit_m = o.revisit_m;
-  c.min_path_m = o.min_path_m;
-  c.false_beyond_m = o.false_beyond_m;
-  c.max_error_m = o.max_error_m;
-  c.max_error_deg = o.max_error_deg;
-  c.window = o.window;
+  const eval::LoopTruthConfig& c = o.judge;
   const eval::LoopTruthReport r = eval::evaluate_loops(at_keyframes, loops, c, summary.string());
   const std::size_t partial = static_cast<std::size_t>(
       std::count_if(r.loops.begin(), r.loops.end(), [](const eval::LoopCheck& l) { return l.partial; }));
