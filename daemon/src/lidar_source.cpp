@@ -86,7 +86,6 @@ struct LidarSource::Impl {
       p.data.resize(bytes);
       return p;
     });
-    const drivers::LidarFamily* family = drivers::lidar_family_of_model(c.lidar.model);
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
     if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
       imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
@@ -117,7 +116,7 @@ struct LidarSource::Impl {
     // (learn_packet_period); until then, and for families without one, loss
     // is counted by sequence only.
     model = c.lidar.model;
-    lidar_family = family;
+    lidar_family = drivers::lidar_family_of_model(c.lidar.model);  // decoder_of found it
     assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
     stream.emplace(*decoder, *assembler, [this](drivers::LidarScan& scan) { hand_on(scan); });
   }

@@ -42,8 +42,7 @@ LoopClosureStage::LoopClosureStage(const config::Config& config, PipelineStats& 
                                    const slam::LoopClosureConfig& loops)
     : stats_(stats),
       thread_("loops", config::ThreadSettings{}, stop),  // SCHED_OTHER whatever the other stages use, never FIFO
-      closer_(loop_closure_config(config, loops)),
-      gravity_(loop_closure_config(config, loops).gravity_sigma_rad > 0.0) {}
+      closer_(loop_closure_config(config, loops)) {}
 
 void LoopClosureStage::start() {
   thread_.start([this] { loop(); });
@@ -67,10 +66,7 @@ void LoopClosureStage::loop() {
     }
     const std::size_t accepted_before = closer_.stats().accepted;
     const std::size_t file_errors_before = closer_.scans().read_errors() + closer_.scans().write_errors();
-    // The up the map pose holds, in the body frame: R⁻¹·e_z.
-    const std::optional<Eigen::Vector3d> up =
-        gravity_ ? std::optional<Eigen::Vector3d>(k->pose.linear().transpose() * Eigen::Vector3d::UnitZ()) : std::nullopt;
-    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points, up)) {
+    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points)) {
       const Eigen::Isometry3d c = closer_.correction();
       log::info("loops: keyframe {}: {} loop(s) accepted, graph optimised in {:.3f} s; correction {:.3f} m",
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <fstream>
 #include <numeric>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/products/grid_io.hpp"
 #include "adit/products/grid_projection.hpp"
@@ -19,11 +19,7 @@
 namespace adit::products {
 namespace {
 
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+double thread_cpu_s() { return 1e-9 * static_cast<double>(thread_cpu_ns()); }
 
 nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
   nlohmann::json files = nlohmann::json::array();

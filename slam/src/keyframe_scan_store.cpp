@@ -2,7 +2,6 @@
 #include "adit/slam/keyframe_scan_store.hpp"
 
 #include <array>
-#include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -11,6 +10,8 @@ namespace adit::slam {
 namespace {
 
 constexpr std::array<char, 8> kTag{'A', 'D', 'I', 'T', 'K', 'F', 'S', '1'};
+// The points go to the file as they lie in memory: three floats each, no padding.
+static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
 constexpr std::uint64_t kMaxPoints = std::uint64_t{1} << 26;  // far above any keyframe: a count beyond is damage
 
 // FNV-1a, 64 bit (Fowler, Noll, Vo): enough to tell a damaged file, not a
@@ -48,13 +49,11 @@ void KeyframeScanStore::spill(std::size_t k) {
   const std::filesystem::path file = file_of(k);
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   const std::uint64_t n = slot.points.size();
-  const std::size_t payload = n * 3 * sizeof(float);
-  std::vector<float> xyz(n * 3);
-  for (std::size_t i = 0; i < n; ++i) std::memcpy(&xyz[3 * i], slot.points[i].data(), 3 * sizeof(float));
-  const std::uint64_t hash = fnv1a(xyz.data(), payload);
+  const std::size_t payload = n * sizeof(Eigen::Vector3f);
+  const std::uint64_t hash = fnv1a(slot.points.data(), payload);
   out.write(kTag.data(), kTag.size());
   out.write(reinterpret_cast<const char*>(&n), sizeof n);
-  out.write(reinterpret_cast<const char*>(xyz.data()), static_cast<std::streamsize>(payload));
+  out.write(reinterpret_cast<const char*>(slot.points.data()), static_cast<std::streamsize>(payload));
   out.write(reinterpret_cast<const char*>(&hash), sizeof hash);
   out.close();
   if (!out) {
@@ -93,15 +92,14 @@ bool KeyframeScanStore::read(std::size_t k, std::vector<Eigen::Vector3f>& out) {
   std::uint64_t n = 0;
   if (!in.read(tag.data(), tag.size()) || tag != kTag) return fail("not a keyframe scan (tag)");
   if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > kMaxPoints) return fail("damaged (point count)");
-  std::vector<float> xyz(n * 3);
+  out.resize(n);
+  const std::size_t payload = n * sizeof(Eigen::Vector3f);
   std::uint64_t hash = 0;
-  if (!in.read(reinterpret_cast<char*>(xyz.data()), static_cast<std::streamsize>(xyz.size() * sizeof(float))) ||
+  if (!in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(payload)) ||
       !in.read(reinterpret_cast<char*>(&hash), sizeof hash))
     return fail("damaged (short)");
   if (in.peek() != std::ifstream::traits_type::eof()) return fail("damaged (longer than its count)");
-  if (hash != fnv1a(xyz.data(), xyz.size() * sizeof(float))) return fail("damaged (hash)");
-  out.resize(n);
-  for (std::size_t i = 0; i < n; ++i) out[i] = Eigen::Vector3f(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  if (hash != fnv1a(out.data(), payload)) return fail("damaged (hash)");
   return true;
 }
 

@@ -26,7 +26,7 @@ LoopCloser::LoopCloser(const LoopClosureConfig& config)
 }
 
 bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                              std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body) {
+                              std::span<const Eigen::Vector3f> points) {
   const std::size_t k = graph_.nodes.size();
   const std::int64_t search_start_ns = monotonic_ns();
   std::vector<Eigen::Vector3f> kept, query;
@@ -48,9 +48,11 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
     path_m_.push_back(path_m_.back() + motion.translation().norm());
     variance_.push_back(variance_.back() + 1.0 / information(0, 0));
   }
-  if (up_body && config_.gravity_sigma_rad > 0.0)
+  if (config_.gravity_sigma_rad > 0.0) {
+    const Eigen::Vector3d up_body = odometry_pose.linear().transpose() * Eigen::Vector3d::UnitZ();
     graph_.gravity.push_back(
-        {k, *up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad), 1e-9 * static_cast<double>(stamp_ns)});
+        {k, up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad), 1e-9 * static_cast<double>(stamp_ns)});
+  }
   odometry_.push_back(odometry_pose);
   stamps_.push_back(stamp_ns);
   scans_.add(std::move(kept));
@@ -109,9 +111,7 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
   const ScanContextMatch m = compare(descriptors_[c.query], descriptors_[c.candidate]);
   if (m.alternative_distance <= config_.search.max_descriptor_distance)
     guesses.push_back(yawed(graph_guess, c.alternative_yaw_rad));
-  LoopVerificationConfig verification = config_.verification;
-  verification.heading_gate_rad = config_.heading_gate_rad;
-  const LoopVerification v = verify_loop(query_points_, submap, guesses, verification);
+  const LoopVerification v = verify_loop(query_points_, submap, guesses, config_.verification);
   stats_.set_aside_readings += static_cast<std::size_t>(v.set_aside);
   event.inlier_ratio = v.registration.inlier_ratio;
   event.rmse_m = v.registration.rmse_m;

@@ -28,27 +28,21 @@
 namespace adit::slam {
 namespace {
 
-struct RealKeyframe {
-  std::int64_t stamp_ns = 0;
-  Eigen::Isometry3d pose;
-  std::vector<Eigen::Vector3f> points;
-};
-
-std::vector<RealKeyframe> hdl64_keyframes(const std::filesystem::path& dir) {
+std::vector<Keyframe> hdl64_keyframes(const std::filesystem::path& dir) {
   drivers::ScanDirectorySource source(dir);
   Odometry odometry{OdometryConfig{}};
   KeyframeSelector selector({1.0, 10.0});
   VoxelDownsampler downsampler(200'000);
   drivers::LidarScan scan;
   std::vector<Eigen::Vector3f> points;
-  std::vector<RealKeyframe> keyframes;
+  std::vector<Keyframe> keyframes;
   while (source.next(scan)) {
     points.clear();
     for (const drivers::LidarPoint& p : scan.points) points.emplace_back(p.x, p.y, p.z);
     const OdometryResult r = odometry.process({scan.start_time_ns, points, {}});
     EXPECT_TRUE(r.valid) << to_string(r.status);
     if (!r.valid || !selector.take(r.pose)) continue;
-    RealKeyframe k{scan.start_time_ns, r.pose, {}};
+    Keyframe k{scan.start_time_ns, r.pose, {}};
     k.points.reserve(points.size());
     downsampler.downsample(points, 0.2F, k.points);
     keyframes.push_back(std::move(k));
@@ -58,10 +52,10 @@ std::vector<RealKeyframe> hdl64_keyframes(const std::filesystem::path& dir) {
 
 TEST(LoopClosureRealdata, NoLoopOnTheHdl64SequenceWhichNeverRevisits) {
   ADIT_REQUIRE_SHARED_DATA(dir, "sequences/hdl64-urban-22");
-  const std::vector<RealKeyframe> keyframes = hdl64_keyframes(dir);
+  const std::vector<Keyframe> keyframes = hdl64_keyframes(dir);
   ASSERT_GE(keyframes.size(), 10U);  // one a metre or more (two scans) over 17 m
   LoopCloser closer;
-  for (const RealKeyframe& k : keyframes) closer.add_keyframe(k.stamp_ns, k.pose, k.points);
+  for (const Keyframe& k : keyframes) closer.add_keyframe(k.stamp_ns, k.pose, k.points);
   EXPECT_EQ(closer.stats().keyframes, keyframes.size());
   EXPECT_EQ(closer.stats().accepted, 0U);
   EXPECT_EQ(closer.graph().loop_count(), 0U);
@@ -71,10 +65,10 @@ TEST(LoopClosureRealdata, NoLoopOnTheHdl64SequenceWhichNeverRevisits) {
 
 // With the settings given, the closer's loops on this sequence, checked against
 // the odometry's relative poses; returns the count accepted.
-std::size_t loops_agreeing_with_odometry(const std::vector<RealKeyframe>& keyframes, const LoopClosureConfig& config,
+std::size_t loops_agreeing_with_odometry(const std::vector<Keyframe>& keyframes, const LoopClosureConfig& config,
                                          const char* name) {
   LoopCloser closer(config);
-  for (const RealKeyframe& k : keyframes) closer.add_keyframe(k.stamp_ns, k.pose, k.points);
+  for (const Keyframe& k : keyframes) closer.add_keyframe(k.stamp_ns, k.pose, k.points);
   const LoopClosureStats& s = closer.stats();
   std::printf("hdl64-urban-22, %s: %zu keyframes, %zu candidates, %zu verified (%zu partial), %zu accepted\n", name,
               s.keyframes, s.candidates, s.verified, s.partial, s.accepted);
@@ -99,7 +93,7 @@ std::size_t loops_agreeing_with_odometry(const std::vector<RealKeyframe>& keyfra
 
 TEST(LoopClosureRealdata, LoopsAcceptedAlongTheSameStreetAgreeWithTheOdometry) {
   ADIT_REQUIRE_SHARED_DATA(dir, "sequences/hdl64-urban-22");
-  const std::vector<RealKeyframe> keyframes = hdl64_keyframes(dir);
+  const std::vector<Keyframe> keyframes = hdl64_keyframes(dir);
   LoopClosureConfig config;
   config.search.min_path_separation_m = 3.0;
   config.search.base_radius_m = 8.0;  // the gate would otherwise keep only keyframes about 3 m away

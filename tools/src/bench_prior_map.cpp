@@ -14,8 +14,6 @@
 #include <numbers>
 #include <random>
 
-#include <time.h>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -56,13 +54,6 @@ struct Start {
   double seconds = 0.0;
   std::string failure;
 };
-
-// CPU time of this thread: the localisation on one core, whatever else the machine runs.
-std::int64_t thread_cpu_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 Eigen::Isometry3d yaw_only(const Eigen::Isometry3d& pose) {
   const Eigen::Vector3d x = pose.linear().col(0);

@@ -56,7 +56,6 @@ class LoopClosureStage {
   StageThread thread_;
   KeyframeQueue keyframes_;
   slam::LoopCloser closer_;
-  const bool gravity_;  // roll/pitch priors from the map poses (imu.enabled)
   double refine_time_s_ = 0.0;
 };
 

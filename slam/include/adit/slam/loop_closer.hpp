@@ -15,7 +15,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,10 +32,20 @@
 
 namespace adit::slam {
 
+// Verification with the heading gate (LoopVerificationConfig::heading_gate_rad):
+// Scan Context's other reading lies ≥ 90° away, the graph's heading within a
+// few degrees over a session (σ_r ≈ 1.5 mrad a keyframe: 3.6° over the 1,729
+// keyframes of a 30-minute drive); 45° lies between them.
+inline LoopVerificationConfig gated_verification() {
+  LoopVerificationConfig config;
+  config.heading_gate_rad = M_PI / 4;
+  return config;
+}
+
 struct LoopClosureConfig {
   ScanContextConfig descriptor;
   PlaceRecognitionConfig search;
-  LoopVerificationConfig verification;
+  LoopVerificationConfig verification = gated_verification();
   ConsistencyConfig consistency;
   PoseGraphSolverConfig solver;
   OdometryNoise odometry;
@@ -46,13 +55,11 @@ struct LoopClosureConfig {
   std::size_t scans_in_ram = 200;
   float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
-  double gravity_sigma_rad = 0.0;    // > 0: a roll/pitch prior per keyframe with an `up`
+  // > 0: a roll/pitch prior per keyframe holding the up its pose holds
+  // (R⁻¹·e_z in the body frame: with an accelerometer the map's poses hold
+  // gravity, decision 008).
+  double gravity_sigma_rad = 0.0;
   double tilt_walk_rad_per_sqrt_s = 0.0;  // the ups' tilt walk (PoseGraph::tilt_walk_rad_per_sqrt_s)
-  // Verification's heading gate (LoopVerificationConfig::heading_gate_rad):
-  // Scan Context's other reading lies ≥ 90° away, the graph's heading within
-  // a few degrees over a session (σ_r ≈ 1.5 mrad a keyframe: 3.6° over the
-  // 1,729 keyframes of a 30-minute drive); 45° lies between them.
-  double heading_gate_rad = M_PI / 4;
 };
 
 // One candidate's fate, for the log and summary.json.
@@ -95,7 +102,7 @@ class LoopCloser {
   // Adds a keyframe (`points` in its body frame) and closes what loops it
   // can. Returns true when the graph was optimised (the poses moved).
   bool add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                    std::span<const Eigen::Vector3f> points, const std::optional<Eigen::Vector3d>& up_body = {});
+                    std::span<const Eigen::Vector3f> points);
 
   // The graph's estimate of every keyframe, in order.
   const std::vector<Eigen::Isometry3d>& poses() const { return graph_.nodes; }
