@@ -92,13 +92,19 @@ bool KeyframeScanStore::read(std::size_t k, std::vector<Eigen::Vector3f>& out) {
   std::uint64_t n = 0;
   if (!in.read(tag.data(), tag.size()) || tag != kTag) return fail("not a keyframe scan (tag)");
   if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > kMaxPoints) return fail("damaged (point count)");
-  out.resize(n);
+  // The file's size must be what its count says before anything is
+  // allocated for it: a damaged count must not cost the payload its RAM.
   const std::size_t payload = n * sizeof(Eigen::Vector3f);
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error) return fail("cannot size the keyframe's scan");
+  if (size < kTag.size() + 2 * sizeof(std::uint64_t) + payload) return fail("damaged (short)");
+  if (size > kTag.size() + 2 * sizeof(std::uint64_t) + payload) return fail("damaged (longer than its count)");
+  out.resize(n);
   std::uint64_t hash = 0;
   if (!in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(payload)) ||
       !in.read(reinterpret_cast<char*>(&hash), sizeof hash))
     return fail("damaged (short)");
-  if (in.peek() != std::ifstream::traits_type::eof()) return fail("damaged (longer than its count)");
   if (hash != fnv1a(out.data(), payload)) return fail("damaged (hash)");
   return true;
 }

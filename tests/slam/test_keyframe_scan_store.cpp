@@ -80,6 +80,27 @@ TEST(KeyframeScanStore, ADamagedOrMissingFileIsRefusedNamingIt) {
   EXPECT_EQ(out, scan(4));
 }
 
+// A count damaged to claim 2^25 points (400 MB) in a 24-byte file is refused
+// by the file's size, before anything is allocated for it.
+TEST(KeyframeScanStore, ACountTheFileCannotHoldIsRefusedBeforeItsRamIsTaken) {
+  const Folder folder("adit_test_kfs_count");
+  KeyframeScanStore store(0);
+  store.spill_to(folder.path);
+  store.add(scan(0));
+  ASSERT_EQ(store.spilled(), 1U);
+  {
+    std::ofstream f(store.file_of(0), std::ios::binary | std::ios::trunc);
+    const std::uint64_t n = std::uint64_t{1} << 25, hash = 0;
+    f.write("ADITKFS1", 8);
+    f.write(reinterpret_cast<const char*>(&n), sizeof n);
+    f.write(reinterpret_cast<const char*>(&hash), sizeof hash);
+  }
+  std::vector<Eigen::Vector3f> out;
+  EXPECT_FALSE(store.read(0, out));
+  EXPECT_NE(store.last_error().find("short"), std::string::npos) << store.last_error();
+  EXPECT_LT(out.capacity(), 1000U);
+}
+
 TEST(KeyframeScanStore, AFolderThatCannotBeWrittenKeepsTheScansInRam) {
   const Folder folder("adit_test_kfs_unwritable");
   std::filesystem::create_directories(folder.path);
