@@ -1,7 +1,8 @@
 # Sourced by the benchmark scripts from the project's root: the build tree,
 # the set of simulated drives they judge a change on, and the session of
 # each, simulated once and reused.
-#   DRIVE = scene:platform:seconds:seed, e.g. mine:robot:60:3 (adit sim's options)
+#   DRIVE = scene:platform:seconds:seed[:sensor], e.g. mine:robot:60:3 or
+#   mine:drone:30:1:Mid-360 (adit sim's options; the sensor defaults to the VLP-16)
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds the sessions (default: build).
 build=$(realpath "${ADIT_BUILD_DIR:-build}")
 
@@ -22,17 +23,19 @@ use_drives() {
 # sim_session DRIVE LOG_DIR: prints the session folder, simulating it first
 # when it is not there yet (the log goes to LOG_DIR/NAME-sim.log).
 sim_session() {
-  local scene platform seconds seed name session
-  IFS=: read -r scene platform seconds seed <<< "$1"
+  local scene platform seconds seed sensor name session
+  IFS=: read -r scene platform seconds seed sensor <<< "$1"
   if [ -z "$seed" ]; then
-    echo "$1: expected scene:platform:seconds:seed" >&2
+    echo "$1: expected scene:platform:seconds:seed[:sensor]" >&2
     return 2
   fi
   name="$scene-$platform-$seconds-s$seed"
+  [ -z "$sensor" ] || name="$name-$sensor"
+  sensor=${sensor:-VLP-16}
   session="$build/sessions/bench-map/$name"
   if [ ! -f "$session/lidar.pcap" ]; then
     mkdir -p "$2"
-    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor VLP-16 --duration "$seconds" --seed "$seed" \
+    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor "$sensor" --duration "$seconds" --seed "$seed" \
       --out "$session" > "$2/$name-sim.log" 2>&1 || { echo "$1: adit sim failed ($2/$name-sim.log)" >&2; return 1; }
   fi
   echo "$session"
