@@ -1,8 +1,9 @@
 # Sourced by the benchmark scripts from the project's root: the build tree,
 # the set of simulated drives they judge a change on, and the session of
 # each, simulated once and reused.
-#   DRIVE = scene:platform:seconds:seed[:sensor], e.g. mine:robot:60:3 or
-#   mine:drone:30:1:Mid-360 (adit sim's options; the sensor defaults to the VLP-16)
+#   DRIVE = scene:platform:seconds:seed[:OPTIONS], e.g. mine:robot:60:3 (adit sim's options), or
+#   mine:drone:30:1:--sensor=Mid-360,--imu-on-can (OPTIONS: more of adit sim's options, comma-separated;
+#   they name the session too; the sensor is the VLP-16 unless they give one)
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds the sessions (default: build).
 build=$(realpath "${ADIT_BUILD_DIR:-build}")
 
@@ -23,20 +24,25 @@ use_drives() {
 # sim_session DRIVE LOG_DIR: prints the session folder, simulating it first
 # when it is not there yet (the log goes to LOG_DIR/NAME-sim.log).
 sim_session() {
-  local scene platform seconds seed sensor name session
-  IFS=: read -r scene platform seconds seed sensor <<< "$1"
+  local scene platform seconds seed options name session
+  IFS=: read -r scene platform seconds seed options <<< "$1"
   if [ -z "$seed" ]; then
-    echo "$1: expected scene:platform:seconds:seed[:sensor]" >&2
+    echo "$1: expected scene:platform:seconds:seed[:OPTIONS]" >&2
     return 2
   fi
   name="$scene-$platform-$seconds-s$seed"
-  [ -z "$sensor" ] || name="$name-$sensor"
-  sensor=${sensor:-VLP-16}
+  local -a more=()
+  if [ -n "$options" ]; then
+    IFS=, read -r -a more <<< "$options"
+    name="$name-$(printf '%s' "$options" | tr -c 'A-Za-z0-9.' '-' | sed -e 's/--*/-/g' -e 's/^-//')"
+  fi
+  local -a sensor=(--sensor VLP-16)
+  [[ ",$options" != *,--sensor* ]] || sensor=()
   session="$build/sessions/bench-map/$name"
   if [ ! -f "$session/lidar.pcap" ]; then
     mkdir -p "$2"
-    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor "$sensor" --duration "$seconds" --seed "$seed" \
-      --out "$session" > "$2/$name-sim.log" 2>&1 || { echo "$1: adit sim failed ($2/$name-sim.log)" >&2; return 1; }
+    "$build/bin/adit" sim --scene "$scene" --platform "$platform" "${sensor[@]}" --duration "$seconds" --seed "$seed" \
+      "${more[@]}" --out "$session" > "$2/$name-sim.log" 2>&1 || { echo "$1: adit sim failed ($2/$name-sim.log)" >&2; return 1; }
   fi
   echo "$session"
 }
