@@ -10,6 +10,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -104,6 +105,9 @@ TEST(LivoxImuSource, PcapReadingsReachTheOdometrysHistoryOnTheLidarClock) {
   source.join();
 
   const ImuStats& s = imu->imu_stats();
+  std::printf("%zu scans; %llu IMU packets, %llu readings (%llu unclocked) at %.1f Hz; the odometry copied %zu\n", scans,
+              static_cast<unsigned long long>(s.packets.load()), static_cast<unsigned long long>(s.samples.load()),
+              static_cast<unsigned long long>(s.count(ImuProblem::unclocked)), s.rate_hz.load(), readings.size());
   EXPECT_GE(scans, 85U);
   EXPECT_EQ(stats.foreign_datagrams.load(), 0U) << "port 56401 is the IMU's, not foreign";
   EXPECT_EQ(s.packets.load(), packets);
