@@ -119,23 +119,26 @@ struct LidarSource::Impl {
   }
 
   // The LiDAR's own IMU (imu.source ouster or livox) and where its packets
-  // come: their own port (imu_port; the Ouster's metadata says which, the
-  // Mid-360's is 56401) or, for a Livox, among the points as packets the
+  // come: their own port (lidar.imu_port, else the Ouster's metadata says
+  // which, the Mid-360's is 56401) or, for a Livox, among the points as packets the
   // decoder reports `auxiliary` (the Avia's SDK1 IMU packets). Throws
   // adit::InputError naming the file or key.
   void make_imu(const config::Config& c) {
     const bool replay = c.lidar.source == config::LidarSource::pcap;
     if (c.imu.source == config::ImuSource::ouster) {
       auto ouster = std::make_unique<OusterImu>(c, drivers::load_ouster_metadata(c.lidar.calibration), replay);
-      imu_port = ouster->port();
+      imu_port = c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : ouster->port();
       if (imu_port == data_port)
-        throw InputError(c.lidar.calibration, "udp_port_imu", fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
+        throw InputError(c.lidar.imu_port != 0 ? std::string() : c.lidar.calibration,
+                         c.lidar.imu_port != 0 ? "lidar.imu_port" : "udp_port_imu",
+                         fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
       imu = std::move(ouster);
     } else if (c.imu.source == config::ImuSource::livox) {
       const std::optional<drivers::LivoxModel> livox = drivers::livox_model_from_name(c.lidar.model);
       if (!livox) throw InputError("", "imu.source", "livox needs a Livox LiDAR, not " + c.lidar.model);
       imu = std::make_unique<LivoxImu>(c, livox_imu_mounting(*livox, c.lidar.extrinsics), replay);
-      const std::uint16_t port = drivers::livox_imu_port(*livox);
+      const std::uint16_t port =
+          c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : drivers::livox_imu_port(*livox);
       imu_port = port != data_port ? port : 0;  // 0: on the data port
       imu_among_points = true;
     }

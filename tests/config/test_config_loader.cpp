@@ -188,6 +188,8 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(parse_error("payload:\n  id: test\nlidar:\n  model: OS1-64\n" + livox_imu).key(), "imu.source");
   const std::string mid360 = "payload:\n  id: test\nlidar:\n  model: Mid-360\n";
   EXPECT_EQ(parse(mid360 + livox_imu).imu.source, ImuSource::livox);
+  EXPECT_EQ(parse(mid360 + "  imu_port: 40001\n" + livox_imu).lidar.imu_port, 40001);
+  EXPECT_EQ(parse_error(mid360 + "  imu_port: 70000\n" + livox_imu).key(), "lidar.imu_port");
   EXPECT_EQ(parse("payload:\n  id: test\nlidar:\n  model: Avia\n" + livox_imu).imu.source, ImuSource::livox);
   EXPECT_EQ(parse_error(mid360 + livox_imu + "  accel_x_signal: ax\n").reason(),
             "livox reads the LiDAR's IMU packets: give no CAN signals");

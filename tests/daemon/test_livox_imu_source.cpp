@@ -4,16 +4,23 @@
 // the odometry reads it (copy_covering per scan): every packet counted, the
 // stamps on the LiDAR's clock and increasing at 200 Hz, the readings the
 // simulated ones (float32 in g on the wire); the pipeline hands the same
-// source to the odometry and records the IMU packets on their own port. The
-// Avia's IMU packets, among its points on the data port, reach it too.
+// source to the odometry and records the IMU packets on their own port, and
+// reads them live from a socket of their own. The Avia's IMU packets, among
+// its points on the data port, reach it too.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <thread>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
 
 #include "adit/config/load.hpp"
 #include "adit/daemon/lidar_source.hpp"
@@ -22,6 +29,8 @@
 #include "adit/drivers/lidar/livox.hpp"
 #include "adit/drivers/lidar/livox_encoder.hpp"
 #include "adit/drivers/pcap_reader.hpp"
+#include "adit/drivers/pcap_replay.hpp"
+#include "adit/drivers/udp.hpp"
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/sim/session.hpp"
 #include "shared_data.hpp"
@@ -233,6 +242,54 @@ TEST(LivoxImuSource, PipelineFeedsTheOdometryAndRecordsTheImuPort) {
   EXPECT_GE(s.imu.samples.load() + 2, packets);
   EXPECT_GE(s.poses.load(), 85U);
   EXPECT_EQ(imu_datagrams(options.record_file), packets);
+}
+
+// Live: the session's first 2 s sent over real UDP on loopback at their own
+// pace, the points to lidar.port and the IMU's packets to lidar.imu_port (both
+// off 56301/56401, so that tests running side by side do not meet): the second
+// socket reads every IMU packet, stamped on the LiDAR clock mapped to the host's.
+TEST(LivoxImuSource, ArrivesLiveOnItsOwnPortBesideThePoints) {
+  const sim::SimOptions& o = session();
+  const auto lidar_port = static_cast<std::uint16_t>(40000 + 2 * (::getpid() % 10000));
+  const auto imu_port = static_cast<std::uint16_t>(lidar_port + 1);
+  const std::string yaml = fmt::format(
+      "payload:\n  id: test\n  state_dir: {}\nlidar:\n  model: Mid-360\n  source: udp\n  address: 127.0.0.1\n"
+      "  port: {}\n  imu_port: {}\nimu:\n  enabled: true\n  source: livox\nthreads:\n  lock_memory: false\n",
+      (test::binary_dir() / "livox-imu-live").string(), lidar_port, imu_port);
+  PipelineOptions options;
+  options.mapping = false;
+  Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
+  pipeline.start();
+  drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
+  drivers::UdpSender to_imu("127.0.0.1", imu_port);
+  drivers::PacedPcapReader reader(o.out / "lidar.pcap", 1.0);
+  drivers::UdpDatagram d;
+  std::size_t imu_sent = 0, lidar_sent = 0;
+  while (reader.next(d) && d.capture_time_ns < o.start_time_ns + 2'000'000'000) {
+    if (d.dst_port == drivers::kLivoxMid360ImuPort) imu_sent += to_imu.send(d.payload) ? 1 : 0;
+    else lidar_sent += to_lidar.send(d.payload) ? 1 : 0;
+  }
+  const double sent_s = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                       std::chrono::system_clock::now().time_since_epoch())
+                                                       .count());
+  for (int i = 0; i < 200 && pipeline.stats().datagrams.load() < imu_sent + lidar_sent; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  pipeline.end_source();
+  pipeline.join();
+  const ImuStats& imu = pipeline.stats().imu;
+  std::printf("live: %zu point and %zu IMU datagrams sent; %llu IMU packets read, %llu readings (%llu unclocked)\n",
+              lidar_sent, imu_sent, static_cast<unsigned long long>(imu.packets.load()),
+              static_cast<unsigned long long>(imu.samples.load()),
+              static_cast<unsigned long long>(imu.count(ImuProblem::unclocked)));
+  EXPECT_NEAR(static_cast<double>(imu_sent), 400.0, 1.0);
+  EXPECT_EQ(imu.packets.load(), imu_sent) << "loopback does not lose 400 datagrams";
+  EXPECT_EQ(imu.samples.load() + imu.count(ImuProblem::unclocked), imu.packets.load());
+  EXPECT_GE(imu.samples.load() + 2, imu_sent);
+  EXPECT_EQ(imu.count(ImuProblem::time_back), 0U);
+  EXPECT_GE(pipeline.stats().poses.load(), 15U);
+  // Stamped on the LiDAR clock mapped to the host's: the last reading within the sending's last 0.1 s.
+  EXPECT_NEAR(imu.last_t.load(), sent_s, 0.1);
 }
 
 }  // namespace

@@ -42,6 +42,10 @@ struct LidarSection {
   std::string calibration;               // Velodyne YAML, Hesai/RoboSense CSV, Ouster metadata JSON
   std::string address = "0.0.0.0";       // udp: local address to bind
   int port = 0;                          // udp: 0 = the model's default data port
+  // udp and pcap: the port of the LiDAR's own IMU packets (imu.source ouster
+  // or livox); 0 = the sensor's (Ouster: the metadata's udp_port_imu; Mid-360:
+  // 56401; Avia: among the points, on the data port).
+  int imu_port = 0;
   std::string interface;                 // udp: bind to this interface (empty = any)
   std::string multicast_group;           // udp: join this group (empty = unicast)
   int receive_buffer_bytes = 16 << 20;   // udp: SO_RCVBUF

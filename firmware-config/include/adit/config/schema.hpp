@@ -94,6 +94,7 @@ void describe(V& v, LidarSection& s) {
   v.optional("calibration", s.calibration);
   v.optional("address", s.address);
   v.optional("port", s.port, Range<int>{0, 65535});
+  v.optional("imu_port", s.imu_port, Range<int>{0, 65535});
   v.optional("interface", s.interface);
   v.optional("multicast_group", s.multicast_group);
   v.optional("receive_buffer_bytes", s.receive_buffer_bytes, Range<int>{65536, 1 << 30});
