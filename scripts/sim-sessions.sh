@@ -2,8 +2,8 @@
 # the set of simulated drives they judge a change on, and the session of
 # each, simulated once and reused.
 #   DRIVE = scene:platform:seconds:seed[:OPTIONS], e.g. mine:robot:60:3 (adit sim's options), or
-#   mine:drone:30:1:--sensor=Mid-360,--imu-on-can (OPTIONS: more of adit sim's options, comma-separated;
-#   they name the session too; the sensor is the VLP-16 unless they give one)
+#   mine:drone:60:1:--ground-s=2 or mine:drone:30:1:--sensor=Mid-360,--imu-on-can (OPTIONS: more of adit sim's
+#   options, comma-separated; they name the session too; the sensor is the VLP-16 unless they give one)
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds the sessions (default: build).
 build=$(realpath "${ADIT_BUILD_DIR:-build}")
 

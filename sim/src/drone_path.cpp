@@ -21,14 +21,16 @@ ScheduleOptions schedule_options(const DronePathOptions& o) {
   s.speed_mps = o.speed_mps;
   s.turn_rate_rps = DronePathOptions::kTurnRate;
   s.ramp_s = 1.5;
-  s.hold_start_s = DronePathOptions::kClimb + DronePathOptions::kHover;
+  s.hold_start_s = o.ground_s + DronePathOptions::kClimb + DronePathOptions::kHover;
   s.hold_end_s = DronePathOptions::kHover;
   return s;
 }
 
 }  // namespace
 
-double drone_min_duration_s() { return min_schedule_duration_s(schedule_options(DronePathOptions{})); }
+double drone_min_duration_s(const DronePathOptions& options) {
+  return min_schedule_duration_s(schedule_options(options));
+}
 
 BodyTrack drone_path(const Scene& scene, const DronePathOptions& o) {
   const Route& route = scene.route;
@@ -43,11 +45,12 @@ BodyTrack drone_path(const Scene& scene, const DronePathOptions& o) {
     const RoutePoint r = route_at(route, schedule.arc[i]);
     const Eigen::Vector2d left(-std::sin(r.heading), std::cos(r.heading));
     const Eigen::Vector2d xy = r.position + left * o.lateral_offset_m;
-    // Climb from 0.3 m, then rise and sink ±0.5 m with the distance flown.
-    const double climb = smoothstep(t / DronePathOptions::kClimb);
+    // On the floor at 0.3 m (its legs), climb, then rise and sink ±0.5 m with
+    // the distance flown.
+    const double climb = smoothstep((t - o.ground_s) / DronePathOptions::kClimb);
     const double cruise = o.altitude_m + 0.5 * std::sin(2.0 * std::numbers::pi * schedule.arc[i] / 30.0);
     position[i] = Eigen::Vector3d(xy.x(), xy.y(), 0.3 + climb * (cruise - 0.3));
-    const double moving = smoothstep((t - DronePathOptions::kClimb - DronePathOptions::kHover) / 2.0) *
+    const double moving = smoothstep((t - o.ground_s - DronePathOptions::kClimb - DronePathOptions::kHover) / 2.0) *
                           smoothstep((o.duration_s - DronePathOptions::kHover - t) / 2.0);
     const double wanted = r.heading + std::numbers::pi * schedule.turn_fraction[i] +
                           moving * kYawSweep * std::sin(2.0 * std::numbers::pi * t / kYawPeriod);
@@ -72,7 +75,10 @@ BodyTrack drone_path(const Scene& scene, const DronePathOptions& o) {
     const double forward = c * acceleration.x() + s * acceleration.y();
     const double lateral = -s * acceleration.x() + c * acceleration.y();
     const double t = static_cast<double>(i) * dt;
-    const double gust = 0.5 * std::numbers::pi / 180.0;
+    // Turbulence once off the floor (on its legs the airframe stands still),
+    // faded in over the climb's first second.
+    const double airborne = o.ground_s > 0.0 ? smoothstep(t - o.ground_s) : 1.0;
+    const double gust = airborne * 0.5 * std::numbers::pi / 180.0;
     const double pitch = std::atan2(forward, kGravity) + gust * value_noise3(o.seed ^ 0x4775ULL, t / 0.7, 0.5, 0.5);
     const double roll = -std::atan2(lateral, kGravity) + gust * value_noise3(o.seed ^ 0x4776ULL, t / 0.7, 0.5, 0.5);
     samples[i].position = position[i];

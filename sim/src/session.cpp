@@ -48,8 +48,18 @@ bool is_ouster(const SimOptions& o) { return o.sensor.starts_with("OS"); }
 bool is_livox(const SimOptions& o) { return o.sensor == "Mid-360"; }
 
 
+DronePathOptions drone_options(const SimOptions& o) {
+  DronePathOptions d;
+  d.duration_s = o.duration_s;
+  d.speed_mps = platform_speed_mps(o);
+  d.lateral_offset_m = o.lateral_offset_m;
+  d.ground_s = o.ground_s;
+  d.seed = o.seed;
+  return d;
+}
+
 double min_duration_s(const SimOptions& o) {
-  return is_drone(o) ? drone_min_duration_s() : is_handheld(o) ? handheld_min_duration_s() : robot_min_duration_s();
+  return is_drone(o) ? drone_min_duration_s(drone_options(o)) : is_handheld(o) ? handheld_min_duration_s() : robot_min_duration_s();
 }
 double max_speed_mps(const SimOptions& o) {
   return is_drone(o)      ? DronePathOptions::kMaxSpeed
@@ -124,14 +134,7 @@ BodyTrack simulated_path(const Scene& scene, const SimOptions& o) {
     h.seed = o.seed;
     return handheld_path(scene, h);
   }
-  if (is_drone(o)) {
-    DronePathOptions d;
-    d.duration_s = o.duration_s;
-    d.speed_mps = platform_speed_mps(o);
-    d.lateral_offset_m = o.lateral_offset_m;
-    d.seed = o.seed;
-    return drone_path(scene, d);
-  }
+  if (is_drone(o)) return drone_path(scene, drone_options(o));
   RobotPathOptions r;
   r.duration_s = o.duration_s;
   r.speed_mps = platform_speed_mps(o);
@@ -164,6 +167,8 @@ void validate(const SimOptions& o) {
   require(std::isfinite(o.speed_mps) && o.speed_mps >= 0.0 && o.speed_mps <= fastest, "--speed",
           "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s (0: its own pace)");
   require(std::isfinite(o.lateral_offset_m), "--lateral-offset-m", "must be a number");
+  require(std::isfinite(o.ground_s) && o.ground_s >= 0.0 && o.ground_s <= 60.0, "--ground-s",
+          "must be 0-60 s");
   require(std::isfinite(o.wheel_radius_error) && std::abs(o.wheel_radius_error) <= 0.1, "--wheel-radius-error",
           "must be within ±0.1 (±10 %)");
   require(std::isfinite(o.slips_per_minute) && o.slips_per_minute >= 0.0 && o.slips_per_minute <= 60.0,

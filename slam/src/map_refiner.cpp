@@ -41,7 +41,10 @@ Eigen::Isometry3d MapRefiner::refine(const Eigen::Isometry3d& odometry_pose, std
   }
   last_odometry_ = odometry_pose;
   last_refined_ = refined;
+  const bool first = !started_;
   started_ = true;
+  if (!first && !moved_since(added_at_, refined, config_.map_insertion)) return refined;
+  added_at_ = refined;
 
   downsampler_.downsample(scan, config_.map_points_m, placed_);
   const Eigen::Isometry3f pose = refined.cast<float>();

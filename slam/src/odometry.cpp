@@ -137,6 +137,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     }
     transform_into(deskewed_, pose_, registered_);
     map_.add(registered_);
+    added_at_ = pose_;
     started_ = true;
     last_stamp_ns_ = scan.stamp_ns;
     result.pose = pose_;
@@ -284,6 +285,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
 }
 
 void Odometry::add_deskewed_to_map() {
+  if (!moved_since(added_at_, pose_, config_.map_insertion)) return;
+  added_at_ = pose_;
   transform_into(deskewed_, pose_, registered_);
   map_.add(registered_);
   if ((pose_.translation() - removed_far_at_).norm() >= config_.map_removal_step_m) {

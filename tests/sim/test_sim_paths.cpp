@@ -119,6 +119,15 @@ TEST(SimPaths, DroneHoversClimbsAndTurnsWithinItsLimits) {
   const Scene scene = simulated_scene(o);
   const BodyTrack path = simulated_path(scene, o);
   EXPECT_LT((path.pose(5.9).translation() - path.pose(4.1).translation()).norm(), 1e-3);
+  // --ground-s: on its legs (0.3 m, level, no turbulence) for that long, then the same climb.
+  o.ground_s = 2.0;
+  const BodyTrack grounded = simulated_path(scene, o);
+  for (const double t : {0.0, 1.0, 1.99}) {
+    EXPECT_NEAR(grounded.pose(t).translation().z(), 0.3, 1e-9) << t;
+    EXPECT_TRUE(grounded.pose(t).linear().isApprox(grounded.pose(0.0).linear(), 1e-12)) << t;
+  }
+  EXPECT_GT(grounded.pose(2.0 + 4.0).translation().z(), 1.4);
+  EXPECT_LT((grounded.pose(7.9).translation() - grounded.pose(6.1).translation()).norm(), 1e-3);
 }
 
 // The walker, in the mine and the building, out and back and in laps: a

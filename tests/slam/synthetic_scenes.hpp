@@ -2,10 +2,12 @@
 // Synthetic surfaces for registration tests: a closed room and a long, plain
 // tunnel (a box corridor), sampled as points in the world frame.
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace adit::slam::test {
 
@@ -53,6 +55,36 @@ inline std::vector<Eigen::Vector3f> tunnel(std::size_t n, unsigned seed, float l
       case 1: points.emplace_back(x, -2.0F, a * 2.25F); break;
       case 2: points.emplace_back(x, a * 2.0F, 2.25F); break;
       default: points.emplace_back(x, a * 2.0F, -2.25F); break;
+    }
+  }
+  return points;
+}
+
+// What a 16-beam spinning LiDAR (±15° in 2° steps, 0.2° azimuth steps, as a
+// VLP-16) at `pose` sees from inside the box [-hx,hx]×[-hy,hy]×[-hz,hz], in
+// its own frame, with Gaussian range noise: rings, not a random sample, so
+// planes fitted through map points meet what they meet on real scans.
+inline std::vector<Eigen::Vector3f> ring_scan_in_box(const Eigen::Isometry3d& pose, float hx, float hy, float hz,
+                                                     float range_sigma_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0F, range_sigma_m);
+  const Eigen::Vector3d h(hx, hy, hz);
+  std::vector<Eigen::Vector3f> points;
+  points.reserve(16 * 1800);
+  for (int beam = 0; beam < 16; ++beam) {
+    const double elevation = (-15.0 + 2.0 * beam) * M_PI / 180.0;
+    for (int step = 0; step < 1800; ++step) {
+      const double azimuth = 0.2 * step * M_PI / 180.0;
+      const Eigen::Vector3d d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                              std::sin(elevation));
+      const Eigen::Vector3d o = pose.translation();
+      const Eigen::Vector3d w = pose.linear() * d;
+      double range = 1e9;
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(w[a]) < 1e-12) continue;
+        range = std::min(range, ((w[a] > 0.0 ? h[a] : -h[a]) - o[a]) / w[a]);
+      }
+      points.push_back((d * (range + noise(rng))).cast<float>());
     }
   }
   return points;

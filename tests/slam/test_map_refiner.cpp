@@ -27,6 +27,20 @@ TEST(MapRefiner, TheFirstScanKeepsItsOdometryPose) {
   EXPECT_FALSE(refiner.map().empty());
 }
 
+// Standing still, the same view is not added again (map_insertion.hpp);
+// once the body has moved a few centimetres, the next scan is.
+TEST(MapRefiner, AScanFromWhereTheMapLastTookOneIsNotAddedAgain) {
+  MapRefiner refiner;
+  const Eigen::Isometry3d still = along_x(0.0);
+  refiner.refine(still, scan_from(still, 1));
+  const std::size_t first = refiner.map().point_count();
+  for (unsigned k = 2; k < 6; ++k) refiner.refine(still, scan_from(still, k));
+  EXPECT_EQ(refiner.map().point_count(), first);
+  const Eigen::Isometry3d moved = along_x(0.1);
+  refiner.refine(moved, scan_from(moved, 7));
+  EXPECT_GT(refiner.map().point_count(), first);
+}
+
 // Wheels with a radius 5 % short (exaggerated from the simulator's 0.4 %) and
 // a slow false turn: the odometry falls behind by 5 cm per metre. In a room
 // whose walls pin every direction, the map's poses follow the scans instead.

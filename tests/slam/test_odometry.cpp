@@ -300,6 +300,36 @@ TEST(Odometry, AFeaturelessTunnelIsReportedDegenerateWithALooseAxis) {
   EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));
 }
 
+// A drone on the floor before take-off: the sensor 0.42 m above the floor of
+// a 20 × 5 × 4.5 m room for 2 s, then climbing 0.5 m/s. Scans taken from one
+// spot do not enter the map again (OdometryConfig::map_insert_step_m), so the
+// floor and roof planes are still there to see the climb; before, the map
+// filled with points along the same rings, its floor planes were refused as
+// lines, and the odometry stayed on the floor while the sensor rose
+// (docs/decisions/033-map-insertion-after-motion.md).
+TEST(Odometry, ASensorThatStoodStillSeesItsClimb) {
+  constexpr float hx = 10.0F, hy = 2.5F, hz = 2.25F;
+  Odometry odometry{OdometryConfig{}};
+  const Eigen::Vector3d start(1.0, 0.3, -hz + 0.42);
+  OdometryResult r;
+  double climbed = 0.0;
+  std::size_t points_after_first = 0;
+  for (int k = 0; k < 50; ++k) {
+    climbed = k < 20 ? 0.0 : 0.05 * (k - 20);
+    Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+    truth.translation() = start + Eigen::Vector3d(0.0, 0.0, climbed);
+    const auto scan = test::ring_scan_in_box(truth, hx, hy, hz, 0.02F, 500 + static_cast<unsigned>(k));
+    r = odometry.process({static_cast<std::int64_t>(0.1e9 * k), scan, {}});
+    ASSERT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
+    if (k == 0) points_after_first = odometry.local_map().point_count();
+    if (k == 19) {
+      EXPECT_EQ(odometry.local_map().point_count(), points_after_first) << "the map grew standing still";
+    }
+  }
+  EXPECT_NEAR(r.pose.translation().z(), climbed, 0.05);
+  EXPECT_LT(r.pose.translation().head<2>().norm(), 0.05) << r.pose.translation().transpose();
+}
+
 TEST(Deskew, UndoesTheMotionDuringTheScan) {
   // A sensor moving at 2 m/s along x and turning at 90°/s measures a wall at
   // x = 5 (world) over 0.1 s; deskewed, the points lie on the wall in the

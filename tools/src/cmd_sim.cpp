@@ -35,6 +35,9 @@ void register_sim_commands(CLI::App& app, int& status) {
       ->capture_default_str();
   cmd->add_option("--lateral-offset-m", o->lateral_offset_m, "Drive this far left (+) of the drift's centre line")
       ->capture_default_str();
+  cmd->add_option("--ground-s", o->ground_s,
+                  "Drone: seconds on the floor with the rotors running before the take-off")
+      ->capture_default_str();
   cmd->add_option("--wheel-radius-error", o->wheel_radius_error,
                   "True wheel radius relative error against the configured one")
       ->capture_default_str();

@@ -1,5 +1,6 @@
 #pragma once
-// A multirotor flying a scene's route: climbs from the floor and hovers, then
+// A multirotor flying a scene's route: sits on the floor with its rotors
+// running (`ground_s`, as every real take-off starts), climbs and hovers, then
 // flies the route (laps, or out, a yaw turn in hover and back) at up to
 // 2 m/s, rising and sinking along the way, sweeping its yaw ±25° about the
 // direction of travel (≤ 90°/s), and hovers again at the end. Roll and pitch
@@ -18,6 +19,7 @@ struct DronePathOptions {
   double speed_mps = 1.0;        // cruise speed, at most kMaxSpeed
   double lateral_offset_m = 0.0;
   double altitude_m = 2.0;       // mean flight height above the floor
+  double ground_s = 0.0;         // s on the floor, rotors running, before the climb
   std::uint64_t seed = 0;
 
   static constexpr double kMaxSpeed = 2.0;
@@ -28,6 +30,6 @@ struct DronePathOptions {
 };
 
 BodyTrack drone_path(const Scene& scene, const DronePathOptions& options);
-double drone_min_duration_s();
+double drone_min_duration_s(const DronePathOptions& options);
 
 }  // namespace adit::sim

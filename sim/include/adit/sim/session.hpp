@@ -40,6 +40,7 @@ struct SimOptions {
   // Platform and path
   double speed_mps = 0.0;  // 0: the platform's own pace (robot, drone 1.0 m/s; handheld 1.3 m/s)
   double lateral_offset_m = 0.0;
+  double ground_s = 0.0;  // drone: s on the floor, rotors running, before the take-off
   // Wheels
   bool wheels = true;
   double wheel_radius_error = 0.004;

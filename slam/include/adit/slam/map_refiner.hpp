@@ -29,6 +29,7 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/slam/map_insertion.hpp"
 #include "adit/slam/registration.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -49,6 +50,7 @@ struct MapRefinerConfig {
   double kernel_scale_m = 0.1;        // the robust kernel's starting scale
   std::size_t max_scan_points = 400'000;
   RegistrationConfig registration;
+  MapInsertionStep map_insertion;      // a refined scan enters the map once the body has moved
 };
 
 class MapRefiner {
@@ -58,7 +60,8 @@ class MapRefiner {
   // `odometry_pose`: the scan's pose from odometry; `points`: the scan in the
   // body frame at that pose, deskewed. Returns the refined pose (the first
   // scan keeps its odometry pose: it defines the map frame) and adds the
-  // scan, placed there, to the refinement map.
+  // scan, placed there, to the refinement map once the body has moved since
+  // the last scan it took (map_insertion).
   Eigen::Isometry3d refine(const Eigen::Isometry3d& odometry_pose, std::span<const Eigen::Vector3f> points);
 
   // The last registration (zero iterations for the first scan).
@@ -74,6 +77,7 @@ class MapRefiner {
   std::vector<MapPlane> planes_;
   Eigen::Isometry3d last_odometry_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d last_refined_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d added_at_ = Eigen::Isometry3d::Identity();  // where the map last took a scan
   RegistrationResult last_;
   bool started_ = false;
 };

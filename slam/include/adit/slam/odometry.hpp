@@ -21,6 +21,7 @@
 #include "adit/slam/gravity.hpp"
 #include "adit/slam/imu_sample.hpp"
 #include "adit/slam/inertial_filter.hpp"
+#include "adit/slam/map_insertion.hpp"
 #include "adit/slam/registration.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -60,6 +61,9 @@ struct OdometryConfig {
   // edge of the range, where few scan points are. So the map reaches at most
   // max_range_m + map_removal_step_m.
   float map_removal_step_m = 1.0F;
+  // A scan enters the local map only once the body has moved since the last
+  // scan that did (map_insertion.hpp).
+  MapInsertionStep map_insertion;
   std::size_t max_scan_points = 400'000; // beyond this a scan is cut (counted)
   std::size_t min_registration_points = 100;
   double initial_threshold_m = 2.0;
@@ -207,6 +211,7 @@ class Odometry {
   double last_correspondences_ = 0.0;
   float registration_voxel_m_;  // this scan's, adapted from the last (see OdometryConfig)
   Eigen::Vector3d removed_far_at_ = Eigen::Vector3d::Zero();  // sensor position at the last remove_far
+  Eigen::Isometry3d added_at_ = Eigen::Isometry3d::Identity();  // pose of the last scan the map took
   // LiDAR-inertial odometry (odometry_inertial.cpp).
   // Whether the scan's IMU readings can carry the filter over it: then the
   // filter is propagated to the scan and its sweep's motion predicted.
@@ -221,7 +226,8 @@ class Odometry {
   bool inertial_started_ = false;
   std::vector<TimedPose> sweep_motion_;  // the body over this sweep, from the scan start
   RegistrationConfig inertial_registration_;
-  // Places deskewed_ at pose_ in the map, dropping what is out of range.
+  // Places deskewed_ at pose_ in the map once the body has moved since the
+  // last scan it took (map_insertion), dropping what is out of range.
   void add_deskewed_to_map();
   // Up in the odometry frame (see OdometryConfig::gravity_settle_s): the
   // weighted sum of the measured ups placed by their poses, until settled.
