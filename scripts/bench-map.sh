@@ -8,7 +8,8 @@
 # another as much (docs/decisions/014-judge-map-on-twelve-drives.md). Judge on the set.
 #
 # Usage: scripts/bench-map.sh [DRIVE ...]
-#   DRIVE = scene:platform:seconds:seed, e.g. mine:robot:60:3 (adit sim's options);
+#   DRIVE = scene:platform:seconds:seed[:OPTIONS], e.g. mine:robot:60:3 or mine:drone:30:1:--sensor=Mid-360
+#   (adit sim's options; OPTIONS comma-separated, scripts/sim-sessions.sh);
 #   without arguments, the twelve drives of docs/decisions/014-judge-map-on-twelve-drives.md (about 3 minutes on 2 cores).
 # Sessions are made once under build/sessions/bench-map/; each run's files go to build/bench-map/.
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds those folders (default: build).

@@ -2,7 +2,8 @@
 # the set of simulated drives they judge a change on, and the session of
 # each, simulated once and reused.
 #   DRIVE = scene:platform:seconds:seed[:OPTIONS], e.g. mine:robot:60:3 (adit sim's options), or
-#   mine:drone:60:1:--ground-s=2 (OPTIONS: more of adit sim's options, comma-separated; they name the session too)
+#   mine:drone:60:1:--ground-s=2 or mine:drone:30:1:--sensor=Mid-360,--imu-on-can (OPTIONS: more of adit sim's
+#   options, comma-separated; they name the session too; the sensor is the VLP-16 unless they give one)
 # ADIT_BUILD_DIR: the build tree whose bin/ runs and which holds the sessions (default: build).
 build=$(realpath "${ADIT_BUILD_DIR:-build}")
 
@@ -35,10 +36,12 @@ sim_session() {
     IFS=, read -r -a more <<< "$options"
     name="$name-$(printf '%s' "$options" | tr -c 'A-Za-z0-9.' '-' | sed -e 's/--*/-/g' -e 's/^-//')"
   fi
+  local -a sensor=(--sensor VLP-16)
+  [[ ",$options" != *,--sensor* ]] || sensor=()
   session="$build/sessions/bench-map/$name"
   if [ ! -f "$session/lidar.pcap" ]; then
     mkdir -p "$2"
-    "$build/bin/adit" sim --scene "$scene" --platform "$platform" --sensor VLP-16 --duration "$seconds" --seed "$seed" \
+    "$build/bin/adit" sim --scene "$scene" --platform "$platform" "${sensor[@]}" --duration "$seconds" --seed "$seed" \
       "${more[@]}" --out "$session" > "$2/$name-sim.log" 2>&1 || { echo "$1: adit sim failed ($2/$name-sim.log)" >&2; return 1; }
   fi
   echo "$session"

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include "adit/config/config.hpp"
+
 namespace adit::daemon {
 
 std::string_view to_string(ImuProblem problem) {
@@ -16,6 +18,15 @@ std::string_view to_string(ImuProblem problem) {
     case ImuProblem::unclocked: return "off the LiDAR clock";
   }
   return "?";
+}
+
+std::string_view imu_source_name(config::ImuSource source) {
+  switch (source) {
+    case config::ImuSource::ouster: return "ouster";
+    case config::ImuSource::livox: return "livox";
+    case config::ImuSource::can: break;
+  }
+  return "can";
 }
 
 std::string describe_problems(const ImuStats& s, std::string_view source) {

@@ -15,8 +15,10 @@
 #include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/livox_imu.hpp"
 #include "adit/daemon/ouster_imu.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
+#include "adit/drivers/lidar/livox.hpp"
 #include "adit/drivers/lidar/ouster_metadata.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/lidar/scan_directory.hpp"
@@ -35,7 +37,7 @@ struct Packet {
   std::uint16_t src_port = 0;
   std::int64_t received_mono_ns = 0;  // when the receiver handed it on (latency)
   std::uint32_t size = 0;
-  bool imu = false;                   // from the Ouster IMU port (imu.source ouster)
+  bool imu = false;                   // from the LiDAR's IMU port (imu.source ouster, livox)
   std::vector<std::uint8_t> data;     // packet_bytes_for(decoder), sized once
 };
 
@@ -87,12 +89,7 @@ struct LidarSource::Impl {
       return p;
     });
     data_port = c.lidar.port != 0 ? static_cast<std::uint16_t>(c.lidar.port) : decoder->default_port();
-    if (c.imu.enabled && c.imu.source == config::ImuSource::ouster) {
-      imu.emplace(c, drivers::load_ouster_metadata(c.lidar.calibration), c.lidar.source == config::LidarSource::pcap);
-      imu_port = imu->port();
-      if (imu_port == data_port)
-        throw InputError(c.lidar.calibration, "udp_port_imu", fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
-    }
+    if (c.imu.enabled) make_imu(c);
     if (c.lidar.source == config::LidarSource::udp) {
       drivers::UdpReceiverConfig udp_config;
       udp_config.bind_address = c.lidar.address;
@@ -101,8 +98,8 @@ struct LidarSource::Impl {
       udp_config.multicast_group = c.lidar.multicast_group;
       udp_config.receive_buffer_bytes = c.lidar.receive_buffer_bytes;
       udp.emplace(udp_config);
-      if (imu) {
-        // The IMU's packets (100 Hz, 48 bytes) on their own port, read by the
+      if (imu_port != 0) {
+        // The IMU's packets (Ouster 100 Hz, 48 bytes; Mid-360 200 Hz, 60 bytes) on their own port, read by the
         // same receiver thread into the same packet pool: the assembly thread
         // then sees both in arrival order and stamps the IMU with the LiDAR
         // stream's clock estimate without sharing it across threads (the
@@ -119,6 +116,32 @@ struct LidarSource::Impl {
     lidar_family = drivers::lidar_family_of_model(c.lidar.model);  // decoder_of found it
     assembler.emplace(drivers::assembler_config_for(*decoder, 0, static_cast<float>(c.lidar.scan_cut_azimuth_deg)));
     stream.emplace(*decoder, *assembler, [this](drivers::LidarScan& scan) { hand_on(scan); });
+  }
+
+  // The LiDAR's own IMU (imu.source ouster or livox) and where its packets
+  // come: their own port (lidar.imu_port, else the Ouster's metadata says
+  // which, the Mid-360's is 56401) or, for a Livox, among the points as packets the
+  // decoder reports `auxiliary` (the Avia's SDK1 IMU packets). Throws
+  // adit::InputError naming the file or key.
+  void make_imu(const config::Config& c) {
+    const bool replay = c.lidar.source == config::LidarSource::pcap;
+    if (c.imu.source == config::ImuSource::ouster) {
+      auto ouster = std::make_unique<OusterImu>(c, drivers::load_ouster_metadata(c.lidar.calibration), replay);
+      imu_port = c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : ouster->port();
+      if (imu_port == data_port)
+        throw InputError(c.lidar.imu_port != 0 ? std::string() : c.lidar.calibration,
+                         c.lidar.imu_port != 0 ? "lidar.imu_port" : "udp_port_imu",
+                         fmt::format("{} is the LiDAR's port too (lidar.port)", imu_port));
+      imu = std::move(ouster);
+    } else if (c.imu.source == config::ImuSource::livox) {
+      const std::optional<drivers::LivoxModel> livox = drivers::livox_model_from_name(c.lidar.model);
+      if (!livox) throw InputError("", "imu.source", "livox needs a Livox LiDAR, not " + c.lidar.model);
+      imu = std::make_unique<LivoxImu>(c, livox_imu_mounting(*livox, c.lidar.extrinsics), replay);
+      const std::uint16_t port =
+          c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : drivers::livox_imu_port(*livox);
+      imu_port = port != data_port ? port : 0;  // 0: on the data port
+      imu_among_points = true;
+    }
   }
 
   bool reading() const { return !stop.load(std::memory_order_relaxed) && !end.load(std::memory_order_relaxed); }
@@ -224,7 +247,7 @@ struct LidarSource::Impl {
         receiver.beat.beat();
         watch_the_clock();
         stats.datagrams.fetch_add(1, std::memory_order_relaxed);
-        if (imu && d.dst_port == imu_port) {
+        if (imu_port != 0 && d.dst_port == imu_port) {
           push(d.payload, d.capture_time_ns, d.src_ip, d.src_port, true);
           continue;
         }
@@ -306,7 +329,9 @@ struct LidarSource::Impl {
       } else {
         current_packet_mono_ns = packet->received_mono_ns;
         if (!period_learnt) learn_packet_period(payload);
-        stream->push(payload, packet->host_time_ns);
+        const drivers::PacketStatus status = stream->push(payload, packet->host_time_ns);
+        if (imu_among_points && status == drivers::PacketStatus::auxiliary)
+          imu->push(payload, packet->host_time_ns, stream->clock());
       }
       packets->release(packet);
     }
@@ -342,8 +367,9 @@ struct LidarSource::Impl {
   int record_part = 0;
   std::uint64_t earlier_parts_bytes = 0;
   static constexpr std::size_t kRecordOverhead = 128;  // pcap, Ethernet, IP and UDP headers of one datagram
-  std::optional<OusterImu> imu;           // imu.source ouster
-  std::uint16_t imu_port = 0;
+  std::unique_ptr<PacketImu> imu;         // imu.source ouster or livox (make_imu)
+  std::uint16_t imu_port = 0;             // 0: no port of its own
+  bool imu_among_points = false;          // a Livox: the data port's auxiliary packets are IMU packets
   std::optional<drivers::UdpReceiver> imu_udp;
   std::optional<Handoff<Packet>> packets;  // sized by the decoder, so built after it
   Handoff<ScanSlot>* scans = nullptr;      // the source's output, set before the threads start
@@ -398,6 +424,6 @@ std::vector<StageThread*> LidarSource::threads() { return {&impl_->receiver, &im
 std::size_t LidarSource::packets_waiting() const { return impl_->packets->depth(); }
 std::size_t LidarSource::packet_capacity() const { return impl_->packets->capacity(); }
 std::size_t LidarSource::packet_bytes() const { return packet_bytes_for(impl_->decoder.get()); }
-OusterImu* LidarSource::imu() { return impl_->imu ? &*impl_->imu : nullptr; }
+PacketImu* LidarSource::imu() { return impl_->imu.get(); }
 
 }  // namespace adit::daemon

@@ -2,16 +2,19 @@
 // (livox_imu.hpp). push() runs per packet on the assembly thread.
 #include "adit/daemon/livox_imu.hpp"
 
+#include <array>
+
 #include "adit/daemon/extrinsics.hpp"
 #include "adit/drivers/lidar/livox_packet.hpp"
 
 namespace adit::daemon {
 
-ImuMounting livox_mid360_imu_mounting(const config::Transform& lidar_extrinsics) {
+ImuMounting livox_imu_mounting(drivers::LivoxModel model, const config::Transform& lidar_extrinsics) {
   const Eigen::Isometry3d body_from_sensor = isometry_of(lidar_extrinsics);
+  const std::array<double, 3> in_sensor = drivers::livox_imu_position_m(model);
   ImuMounting out;
   out.rotation = body_from_sensor.linear();
-  out.position_m = body_from_sensor * Eigen::Vector3d(0.011, 0.02329, -0.04412);
+  out.position_m = body_from_sensor * Eigen::Vector3d(in_sensor[0], in_sensor[1], in_sensor[2]);
   return out;
 }
 

@@ -11,7 +11,7 @@
 #include "adit/daemon/lidar_source.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/mapping_stage.hpp"
-#include "adit/daemon/ouster_imu.hpp"
+#include "adit/daemon/packet_imu.hpp"
 #include "adit/daemon/odometry_stage.hpp"
 #include "adit/daemon/output_stage.hpp"
 #include "adit/daemon/scan_odometry.hpp"
@@ -27,10 +27,11 @@ std::unique_ptr<CanFeed> can_feed_of(const config::Config& c, HostClock clock) {
   return std::make_unique<CanFeed>(c, clock);
 }
 
-// The IMU the odometry reads: the CAN feed's or the Ouster's (LidarSource), or none.
+// The IMU the odometry reads: the CAN feed's or the LiDAR's own (an Ouster's
+// or a Livox's, LidarSource), or none.
 ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& source) {
   if (!c.imu.enabled) return nullptr;
-  if (c.imu.source == config::ImuSource::ouster) return source.imu();
+  if (c.imu.source != config::ImuSource::can) return source.imu();
   return can;
 }
 

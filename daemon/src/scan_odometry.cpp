@@ -36,7 +36,7 @@ slam::OdometryConfig with_imu_position(slam::OdometryConfig odometry, const ImuS
 }
 
 bool has_gyro(const config::ImuSection& imu) {
-  return imu.source == config::ImuSource::ouster || !imu.gyro_x_signal.empty();
+  return imu.source != config::ImuSource::can || !imu.gyro_x_signal.empty();  // a LiDAR's own IMU has one
 }
 
 }  // namespace

@@ -457,7 +457,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
               map.tile_count(), dir.string());
     if (config_.imu.enabled) {
       const std::string problems =
-          describe_problems(s.imu, config_.imu.source == config::ImuSource::ouster ? "ouster" : "can");
+          describe_problems(s.imu, imu_source_name(config_.imu.source));
       if (!problems.empty()) log::warn("session {}: {}", id, problems);
     }
   } catch (const std::exception& e) {
@@ -607,7 +607,7 @@ StatusSample Sessions::status_sample() {
   // (time going back, undecodable, unclocked), its configured clock offset;
   // its other problems (gaps, saturation, stuck axes) name themselves in the fault.
   const ImuStats& imu = s.imu;
-  const std::string imu_source = config_.imu.source == config::ImuSource::ouster ? "ouster" : "can";
+  const std::string imu_source(imu_source_name(config_.imu.source));
   if (config_.imu.enabled) {
     SensorHealth h;
     h.name = "imu " + imu_source;

@@ -57,11 +57,21 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
 
   if (c.imu.enabled) {
     const bool gyro = !c.imu.gyro_x_signal.empty() || !c.imu.gyro_y_signal.empty() || !c.imu.gyro_z_signal.empty();
-    if (c.imu.source == ImuSource::ouster) {
-      if (!c.lidar.model.starts_with("OS"))
-        fail("imu.source", "lidar.model", "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's)");
+    if (c.imu.source == ImuSource::ouster || c.imu.source == ImuSource::livox) {
+      // The LiDAR's own IMU: its packets come with the LiDAR's.
+      const bool ouster = c.imu.source == ImuSource::ouster;
+      const bool lidar_has_it = ouster ? c.lidar.model.starts_with("OS") : c.lidar.model == "Mid-360" || c.lidar.model == "Avia";
+      if (!lidar_has_it)
+        fail("imu.source", "lidar.model",
+             ouster ? "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's), not " + c.lidar.model
+                    : "livox needs a Livox LiDAR (lidar.model Mid-360 or Avia: its IMU packets come with the LiDAR's), not " +
+                          c.lidar.model);
+      if (c.lidar.source == LidarSource::scan_dir)
+        fail("imu.source", "lidar.source", std::string(ouster ? "ouster" : "livox") +
+                                               " reads the LiDAR's IMU packets: a scan directory has none");
       if (gyro || !c.imu.accel_x_signal.empty() || !c.imu.accel_y_signal.empty() || !c.imu.accel_z_signal.empty())
-        fail("imu.source", "imu.source", "ouster reads the LiDAR's IMU packets: give no CAN signals");
+        fail("imu.source", "imu.source",
+             std::string(ouster ? "ouster" : "livox") + " reads the LiDAR's IMU packets: give no CAN signals");
     } else {
       // The IMU is read by the CAN thread that integrates the wheels.
       if (!c.can.enabled) fail("imu.enabled", "imu.enabled", "needs can.enabled: true (the IMU is read from CAN)");

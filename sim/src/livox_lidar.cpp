@@ -5,6 +5,7 @@
 #include <numbers>
 #include <vector>
 
+#include "adit/drivers/lidar/livox.hpp"
 #include "adit/drivers/lidar/livox_encoder.hpp"
 
 namespace adit::sim {
@@ -26,7 +27,8 @@ Eigen::Vector3d livox_direction(const LivoxPattern& p, std::uint64_t index) {
 
 Eigen::Isometry3d livox_mid360_imu_in_sensor() {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.translation() = Eigen::Vector3d(0.011, 0.02329, -0.04412);
+  const std::array<double, 3> p = drivers::livox_imu_position_m(drivers::LivoxModel::mid360);
+  e.translation() = Eigen::Vector3d(p[0], p[1], p[2]);  // the one figure aditd's LivoxImu mounts it by
   return e;
 }
 

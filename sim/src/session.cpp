@@ -47,18 +47,6 @@ bool is_handheld(const SimOptions& o) { return o.platform == "handheld"; }
 bool is_ouster(const SimOptions& o) { return o.sensor.starts_with("OS"); }
 bool is_livox(const SimOptions& o) { return o.sensor == "Mid-360"; }
 
-// The Mid-360's own IMU, inside the sensor (livox_lidar.hpp), at its 200 Hz.
-ImuOptions livox_imu_options(const SimOptions& o, const Eigen::Isometry3d& extrinsics) {
-  ImuOptions imu;
-  imu.noise = o.imu_noise;
-  imu.motion = o.platform == "robot" ? ImuMotion::wheeled : ImuMotion::smooth;
-  imu.vibration.enabled = o.vibration == "on" || (o.vibration == "auto" && o.platform == "drone");
-  imu.mount = extrinsics * livox_mid360_imu_in_sensor();
-  imu.rate_hz = 200.0;
-  imu.time_offset_s = o.imu_time_offset_s;  // stamped by the sensor's clock, as its points
-  imu.seed = o.seed ^ 0x4C69766F78ULL;      // another unit than a CAN IMU's
-  return imu;
-}
 
 DronePathOptions drone_options(const SimOptions& o) {
   DronePathOptions d;
@@ -99,8 +87,10 @@ double platform_speed_mps(const SimOptions& o) {
 SimImuSource simulated_imu_source(const SimOptions& o) {
   if (!o.imu) return SimImuSource::none;
   // A robot's IMU is on its CAN bus beside the wheels, whatever the LiDAR;
-  // without wheels an Ouster's own IMU is the one to read.
-  return o.platform == "robot" || !is_ouster(o) ? SimImuSource::can : SimImuSource::ouster;
+  // without wheels the LiDAR's own IMU (Ouster, Mid-360) is the one to read,
+  // unless --imu-on-can asks for the CAN IMU (a comparison).
+  if (o.platform == "robot" || o.imu_on_can) return SimImuSource::can;
+  return is_ouster(o) ? SimImuSource::ouster : is_livox(o) ? SimImuSource::livox : SimImuSource::can;
 }
 
 ImuOptions simulated_imu(const SimOptions& o, SimImuSource source) {
@@ -120,6 +110,12 @@ ImuOptions simulated_imu(const SimOptions& o, SimImuSource source) {
     imu.rate_hz = o.imu_rate_hz > 0.0 ? o.imu_rate_hz : 100.0;
     imu.time_offset_s = o.imu_time_offset_s;  // the LiDAR's and the IMU's stamps come from one clock
     imu.seed = o.seed ^ 0x4F5374496D75ULL;    // another unit than a CAN IMU's in the same session
+  } else if (source == SimImuSource::livox) {
+    // Inside the sensor (livox_lidar.hpp), at its 200 Hz.
+    imu.mount = sensor_extrinsics(o.platform) * livox_mid360_imu_in_sensor();
+    imu.rate_hz = 200.0;
+    imu.time_offset_s = o.imu_time_offset_s;  // stamped by the sensor's clock, as its points
+    imu.seed = o.seed ^ 0x4C69766F78ULL;      // another unit than a CAN IMU's
   } else {
     imu.mount.translation() = o.imu_position_m;
     imu.rate_hz = o.imu_rate_hz > 0.0 ? o.imu_rate_hz : 200.0;
@@ -192,6 +188,10 @@ void validate(const SimOptions& o) {
   require(!(simulated_imu_source(o) == SimImuSource::ouster && !o.imu_position_m.isZero()), "--imu-position-m",
           "the " + o.sensor + "'s IMU sits where its metadata's imu_to_sensor_transform puts it; "
           "--imu-position-m places a CAN IMU");
+  require(!(simulated_imu_source(o) == SimImuSource::livox && !o.imu_position_m.isZero()), "--imu-position-m",
+          "the " + o.sensor + "'s IMU sits inside it where its manual puts it; --imu-position-m places a CAN IMU");
+  require(!(simulated_imu_source(o) == SimImuSource::livox && o.imu_rate_hz != 0.0 && o.imu_rate_hz != 200.0),
+          "--imu-rate-hz", "the " + o.sensor + "'s IMU sends 200 Hz");
   require(std::isfinite(o.imu_time_offset_s) && std::abs(o.imu_time_offset_s) <= 1.0, "--imu-time-offset-s",
           "must be within ±1 s");
   require(o.vibration == "auto" || o.vibration == "on" || o.vibration == "off", "--vibration",
@@ -260,7 +260,7 @@ SimSummary run_simulation(const SimOptions& o) {
   const People people = simulated_people(scene, o);
   LidarSimStats stats;
   // A Mid-360 sends its IMU's SDK2 packets (200 Hz, to port 56401) beside its points, always.
-  const ImuOptions livox_imu = livox_imu_options(o, lidar.extrinsics);
+  const ImuOptions livox_imu = simulated_imu(o, SimImuSource::livox);
   const std::vector<ImuSample> livox_samples = is_livox(o) ? simulate_imu(body, livox_imu) : std::vector<ImuSample>{};
   std::size_t livox_imu_written = 0;
   const auto write_livox_imu_packets = [&](std::int64_t until_ns) {
@@ -300,7 +300,9 @@ SimSummary run_simulation(const SimOptions& o) {
   }
   write_imu_packets(std::numeric_limits<std::int64_t>::max());
   pcap.flush();
-  if (is_livox(o)) write_imu_truth(o.out / "truth_livox_imu.csv", livox_samples, o.start_time_ns, livox_imu.time_offset_s);
+  if (is_livox(o))
+    write_imu_truth(o.out / (imu_source == SimImuSource::livox ? "truth_imu.csv" : "truth_livox_imu.csv"), livox_samples,
+                    o.start_time_ns, livox_imu.time_offset_s);
 
   WheelOptions wheels;
   wheels.radius_error = o.wheel_radius_error;

@@ -73,7 +73,8 @@ void write_session_config(const std::filesystem::path& file, const SimOptions& o
   if (imu_source != SimImuSource::none) {
     const Eigen::Vector3d p = imu.mount.translation();
     const Eigen::Vector3d r = rpy_deg(imu.mount.linear());
-    text += fmt::format("imu:\n  enabled: true\n  source: {}\n", can_imu ? "can" : "ouster");
+    text += fmt::format("imu:\n  enabled: true\n  source: {}\n",
+                        can_imu ? "can" : imu_source == SimImuSource::ouster ? "ouster" : "livox");
     if (can_imu)
       text += "  accel_x_signal: imu_accel_x\n  accel_y_signal: imu_accel_y\n  accel_z_signal: imu_accel_z\n"
               "  gyro_x_signal: imu_gyro_x\n  gyro_y_signal: imu_gyro_y\n  gyro_z_signal: imu_gyro_z\n";

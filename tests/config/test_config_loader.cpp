@@ -177,7 +177,26 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(inertial.imu.gyro_z_signal, "gz");
   const InputError ouster = parse_error(std::string(kMinimal) + "imu:\n  enabled: true\n  source: ouster\n");
   EXPECT_EQ(ouster.key(), "imu.source");
-  EXPECT_EQ(ouster.reason(), "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's)");
+  EXPECT_EQ(ouster.reason(), "ouster needs an Ouster LiDAR (its IMU packets come with the LiDAR's), not VLP-16");
+  // A Livox's own IMU: only with a Livox LiDAR, the error on imu.source's line.
+  const std::string livox_imu = "imu:\n  enabled: true\n  source: livox\n";
+  const InputError livox = parse_error(std::string(kMinimal) + livox_imu);
+  EXPECT_EQ(livox.key(), "imu.source");
+  EXPECT_EQ(livox.where(), "test.yaml:7");
+  EXPECT_EQ(livox.reason(),
+            "livox needs a Livox LiDAR (lidar.model Mid-360 or Avia: its IMU packets come with the LiDAR's), not VLP-16");
+  EXPECT_EQ(parse_error("payload:\n  id: test\nlidar:\n  model: OS1-64\n" + livox_imu).key(), "imu.source");
+  const std::string mid360 = "payload:\n  id: test\nlidar:\n  model: Mid-360\n";
+  EXPECT_EQ(parse(mid360 + livox_imu).imu.source, ImuSource::livox);
+  EXPECT_EQ(parse(mid360 + "  imu_port: 40001\n" + livox_imu).lidar.imu_port, 40001);
+  EXPECT_EQ(parse_error(mid360 + "  imu_port: 70000\n" + livox_imu).key(), "lidar.imu_port");
+  EXPECT_EQ(parse("payload:\n  id: test\nlidar:\n  model: Avia\n" + livox_imu).imu.source, ImuSource::livox);
+  EXPECT_EQ(parse_error(mid360 + livox_imu + "  accel_x_signal: ax\n").reason(),
+            "livox reads the LiDAR's IMU packets: give no CAN signals");
+  EXPECT_EQ(parse_error("payload:\n  id: test\nlidar:\n  model: Mid-360\n  source: scan_dir\n  scan_dir: scans\n" +
+                        livox_imu)
+                .reason(),
+            "livox reads the LiDAR's IMU packets: a scan directory has none");
 
   const InputError fifo = parse_error(std::string(kMinimal) + "threads:\n  odometry:\n    policy: fifo\n");
   EXPECT_EQ(fifo.key(), "threads.odometry.priority");

@@ -30,7 +30,7 @@ TEST(LivoxImu, PacketsBecomeBodyFrameReadingsOnTheHostClock) {
   config::Config config;
   config.imu.enabled = true;
   config.lidar.extrinsics.rpy_deg = {0.0, 0.0, 90.0};  // the LiDAR turned left in the body
-  const ImuMounting mounting = livox_mid360_imu_mounting(config.lidar.extrinsics);
+  const ImuMounting mounting = livox_imu_mounting(drivers::LivoxModel::mid360, config.lidar.extrinsics);
   EXPECT_NEAR(mounting.position_m.x(), -0.02329, 1e-9);  // (11.0, 23.29) mm turned by 90°
   EXPECT_NEAR(mounting.position_m.y(), 0.011, 1e-9);
   LivoxImu imu(config, mounting, false);

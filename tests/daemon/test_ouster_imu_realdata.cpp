@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "adit/common/clock.hpp"
 #include "adit/config/load.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/lidar/ouster_packet.hpp"
@@ -196,7 +197,17 @@ TEST(OusterImuRealData, ArrivesLiveOnItsOwnPortBesideTheLidar) {
   PipelineOptions options;
   options.mapping = false;
   Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
+  const std::int64_t started_ns = monotonic_ns();
   pipeline.start();
+  // The receiver first drains what its sockets held before the session (as
+  // stale): send once it is reading, its heartbeat beating after the start.
+  const auto receiving = [&] {
+    for (const Heartbeat* h : pipeline.heartbeats())
+      if (h->name == "receiver") return h->last_ns.load() > started_ns;
+    return false;
+  };
+  for (int i = 0; i < 1000 && !receiving(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_TRUE(receiving());
   drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
   drivers::UdpSender to_imu("127.0.0.1", imu_port);
   // At the capture's own pace, as the sensor sends them: the LiDAR clock's

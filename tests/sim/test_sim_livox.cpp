@@ -6,6 +6,7 @@
 // simulated readings (truth_livox_imu.csv) converted to g and back.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -82,6 +83,28 @@ TEST(SimLivox, Mid360PacketsDecodeOntoTheSceneAtEachPointsTime) {
   EXPECT_NEAR(static_cast<double>(imu_packets), o.duration_s * 200, 2);
   EXPECT_GT(points, packets * 60);  // most rays return in a mine
   EXPECT_LT(off_surface, points / 7 / 200) << off_surface << " of " << points / 7;
+}
+
+// Without wheels the Mid-360's own IMU is the one session.yaml reads, inside
+// the sensor where drivers::livox_imu_position_m (aditd's mounting) puts it;
+// a robot's IMU is on CAN beside its wheels; --imu-on-can asks for the CAN one.
+TEST(SimLivox, DronesAndHandheldsReadTheMid360sOwnImu) {
+  SimOptions o = test::short_session("livox-imu-source");
+  o.sensor = "Mid-360";
+  EXPECT_EQ(simulated_imu_source(o), SimImuSource::can);  // the robot
+  for (const char* platform : {"drone", "handheld"}) {
+    o.platform = platform;
+    EXPECT_EQ(simulated_imu_source(o), SimImuSource::livox) << platform;
+    const ImuOptions imu = simulated_imu(o, SimImuSource::livox);
+    const std::array<double, 3> in_sensor = drivers::livox_imu_position_m(drivers::LivoxModel::mid360);
+    const Eigen::Vector3d expected = simulated_extrinsics(o) * Eigen::Vector3d(in_sensor[0], in_sensor[1], in_sensor[2]);
+    EXPECT_TRUE((imu.mount.translation() - expected).isZero(1e-12)) << platform;
+    EXPECT_EQ(imu.rate_hz, 200.0);
+  }
+  o.imu_on_can = true;
+  EXPECT_EQ(simulated_imu_source(o), SimImuSource::can);
+  o.imu = false;
+  EXPECT_EQ(simulated_imu_source(o), SimImuSource::none);
 }
 
 TEST(SimLivox, PatternCoversTheFieldOfViewWithoutRepeating) {

@@ -430,6 +430,11 @@ TEST(SimSession, ImpossibleOptionsAreRejectedBeforeAnyWork) {
   bad.sensor = "OS1-64";
   bad.imu_position_m = Eigen::Vector3d(0.1, 0.0, 0.0);  // the Ouster's IMU is inside the sensor
   expect_rejected(bad, "--imu-position-m");
+  bad.sensor = "Mid-360";  // so is the Mid-360's
+  expect_rejected(bad, "--imu-position-m");
+  bad.imu_position_m.setZero();
+  bad.imu_rate_hz = 100.0;  // it sends 200 Hz
+  expect_rejected(bad, "--imu-rate-hz");
 }
 
 }  // namespace

@@ -97,7 +97,7 @@ int replay(const ReplayOptions& o) {
     if (!o.out.empty()) fmt::print("trajectory: {} ({} poses)\n", o.out, figures.poses - figures.invalid_poses);
     if (config.imu.enabled) {
       const daemon::ImuStats& imu = pipeline.stats().imu;
-      const char* source = config.imu.source == config::ImuSource::ouster ? "ouster" : "can";
+      const std::string_view source = daemon::imu_source_name(config.imu.source);
       fmt::print("imu {}: {} packets or frames, {} readings ({} with gyro) at {:.1f} Hz{}\n", source,
                  imu.packets.load(), imu.samples.load(), imu.gyro_samples.load(), imu.rate_hz.load(),
                  std::isfinite(imu.clock_spread_s.load())

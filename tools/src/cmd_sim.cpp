@@ -44,9 +44,11 @@ void register_sim_commands(CLI::App& app, int& status) {
   cmd->add_option("--slips-per-minute", o->slips_per_minute, "Wheel slip events per minute")->capture_default_str();
   cmd->add_option("--can-offset-s", o->can_offset_s, "CAN clock minus LiDAR clock, seconds")->capture_default_str();
   cmd->add_option("--imu", o->imu,
-                  "An IMU: on CAN (robot; drone and handheld with a non-Ouster LiDAR: accelerometer 0x190, gyroscope "
-                  "0x191) or the OS1-64's own (IMU packets to port 7503)")
+                  "An IMU: on CAN (robot; drone and handheld with a LiDAR without one: accelerometer 0x190, gyroscope "
+                  "0x191) or the LiDAR's own (OS1-64: IMU packets to port 7503; Mid-360: to 56401)")
       ->capture_default_str();
+  cmd->add_flag("--imu-on-can", o->imu_on_can,
+                "Read a CAN IMU even where the LiDAR has its own (drone, handheld), to compare the two");
   cmd->add_option("--imu-rate-hz", o->imu_rate_hz, "IMU samples per second, 100-400 (0: 200 on CAN, 100 from an Ouster)")
       ->capture_default_str();
   cmd->add_option("--gyro-noise-density", o->imu_noise.gyro_noise_density, "Gyroscope white noise, rad/s/√Hz")

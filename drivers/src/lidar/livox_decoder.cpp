@@ -49,6 +49,11 @@ LivoxProtocol livox_protocol(LivoxModel model) {
 }
 std::uint16_t livox_lines(LivoxModel model) { return model == LivoxModel::mid360 ? 4 : 6; }
 std::uint32_t livox_record_period_ns(LivoxModel model) { return model == LivoxModel::mid360 ? 0 : 4167; }
+std::uint16_t livox_imu_port(LivoxModel model) { return model == LivoxModel::mid360 ? kLivoxMid360ImuPort : 0; }
+std::array<double, 3> livox_imu_position_m(LivoxModel model) {
+  return model == LivoxModel::mid360 ? std::array<double, 3>{0.011, 0.02329, -0.04412}
+                                     : std::array<double, 3>{-0.04165, -0.02326, 0.0284};
+}
 
 std::optional<LivoxModel> livox_model_from_packet(std::span<const std::uint8_t> payload) {
   for (const LivoxModel model : {LivoxModel::mid360, LivoxModel::avia}) {

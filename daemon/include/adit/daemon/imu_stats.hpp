@@ -11,6 +11,10 @@
 #include <string>
 #include <string_view>
 
+namespace adit::config {
+enum class ImuSource;  // config.hpp
+}
+
 namespace adit::daemon {
 
 // Why an IMU reading was flagged. Order = the index in ImuStats::problems.
@@ -56,6 +60,8 @@ struct ImuStats {
 // (longest 0.52 s), 1 stuck axis; last: stuck axis gz at packet 1234"), or
 // "" when there are none. `source` names the stream.
 std::string describe_problems(const ImuStats& stats, std::string_view source);
+// The IMU stream's name in logs, health and tools: its `imu.source` value.
+std::string_view imu_source_name(config::ImuSource source);
 
 // Copies every figure (each atomically, not all at one instant): the
 // pipeline's copy of its IMU source's stats.

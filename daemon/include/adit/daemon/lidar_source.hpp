@@ -4,10 +4,12 @@
 // In:   UDP datagrams (live), a pcap file or a directory of scans (replay).
 // Out:  scans in the sensor frame with per-point times (ScanSlot) through
 //       scans(), each with when its last packet arrived; the raw packets as
-//       pcap when a record file is open. With `imu.source: ouster`, the
-//       sensor's IMU packets (its IMU port, 7503, in the same pcap or on a
-//       socket of their own) go through the same packet pool to imu()
-//       (OusterImu), and are recorded with the LiDAR's on their own port.
+//       pcap when a record file is open. With `imu.source: ouster` or
+//       `livox`, the sensor's IMU packets (its IMU port: the Ouster's 7503,
+//       the Mid-360's 56401; in the same pcap or on a socket of their own)
+//       go through the same packet pool to imu() (OusterImu, LivoxImu), and
+//       are recorded with the LiDAR's on their own port; the Avia's come
+//       among its points and reach imu() as well.
 // Threads: "receiver" reads the source into a pool of packets and records
 // them; "assembly" decodes the packets and cuts scans (drivers::DecodeStream).
 // A scan directory needs no assembly: the receiver hands its scans on. Live,
@@ -31,7 +33,7 @@
 
 namespace adit::daemon {
 
-class OusterImu;
+class PacketImu;
 
 class LidarSource {
  public:
@@ -59,8 +61,8 @@ class LidarSource {
   // The most points one scan can hold: the hand-offs after this stage reserve it.
   std::size_t max_points_per_scan() const { return max_points_; }
 
-  // The Ouster's IMU (imu.source ouster), or null.
-  OusterImu* imu();
+  // The LiDAR's own IMU (imu.source ouster or livox), or null.
+  PacketImu* imu();
 
   std::vector<StageThread*> threads();
   std::size_t packets_waiting() const;

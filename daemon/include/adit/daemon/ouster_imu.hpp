@@ -46,7 +46,7 @@ class OusterImu final : public PacketImu {
   // Assembly thread: one datagram from the IMU port, received at
   // `host_time_ns`; `lidar_clock` is the LiDAR stream's sensor-clock estimate.
   void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
-            const drivers::ClockOffsetEstimator& lidar_clock);
+            const drivers::ClockOffsetEstimator& lidar_clock) override;
 
   const char* imu_name() const override { return "ouster"; }
 

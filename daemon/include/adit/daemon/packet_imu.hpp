@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include <Eigen/Core>
 
@@ -36,6 +37,11 @@ class PacketImu : public ImuSource {
   // IMU packet that arrived before it has been pushed (a replay's catch_up
   // stops waiting once the LiDAR is 0.1 s past what it waits for).
   void lidar_reached(double t) { lidar_t_.store(t, std::memory_order_release); }
+  // Assembly thread: one IMU datagram received at `host_time_ns`;
+  // `lidar_clock` is the LiDAR stream's sensor-clock estimate. A damaged or
+  // unclockable packet is counted (ImuMonitor), never thrown.
+  virtual void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
+                    const drivers::ClockOffsetEstimator& lidar_clock) = 0;
   // Assembly thread: no more packets.
   void close() { readings_.close(); }
 

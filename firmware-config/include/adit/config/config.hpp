@@ -42,6 +42,10 @@ struct LidarSection {
   std::string calibration;               // Velodyne YAML, Hesai/RoboSense CSV, Ouster metadata JSON
   std::string address = "0.0.0.0";       // udp: local address to bind
   int port = 0;                          // udp: 0 = the model's default data port
+  // udp and pcap: the port of the LiDAR's own IMU packets (imu.source ouster
+  // or livox); 0 = the sensor's (Ouster: the metadata's udp_port_imu; Mid-360:
+  // 56401; Avia: among the points, on the data port).
+  int imu_port = 0;
   std::string interface;                 // udp: bind to this interface (empty = any)
   std::string multicast_group;           // udp: join this group (empty = unicast)
   int receive_buffer_bytes = 16 << 20;   // udp: SO_RCVBUF
@@ -106,14 +110,16 @@ struct WheelOdometrySection {
 
 // The IMU: an accelerometer, and a gyroscope where the unit has one. From
 // the CAN bus (three signals each, in m/s² and rad/s after the signals'
-// factors) or from the Ouster's own IMU packets (UDP port 7503 beside the
-// LiDAR's, the axes from the metadata's imu_to_sensor). An accelerometer
+// factors), from the Ouster's own IMU packets (UDP port 7503 beside the
+// LiDAR's, the axes from the metadata's imu_to_sensor) or from a Livox's
+// (Mid-360: UDP port 56401; Avia: among its points; placed where the model's
+// manual puts it, docs/LIDAR-LIVOX.md). An accelerometer
 // alone gives gravity's direction for roll and pitch (slam/gravity.hpp, with
 // the wheels' acceleration removed); with a gyroscope the odometry is
 // LiDAR-inertial. The noise model is the datasheet's (Allan deviation)
 // figures; the defaults are a MEMS unit's (ADIS16448, as in the EuRoC
 // datasets' calibration).
-enum class ImuSource { can, ouster };
+enum class ImuSource { can, ouster, livox };
 
 struct ImuSection {
   bool enabled = false;

@@ -57,8 +57,8 @@ inline constexpr std::array<std::pair<std::string_view, ByteOrder>, 2> kByteOrde
     {"intel", ByteOrder::intel}, {"motorola", ByteOrder::motorola}}};
 inline constexpr std::array<std::pair<std::string_view, ValueType>, 3> kValueTypes{{
     {"unsigned", ValueType::unsigned_int}, {"signed", ValueType::signed_int}, {"ieee_float", ValueType::ieee_float}}};
-inline constexpr std::array<std::pair<std::string_view, ImuSource>, 2> kImuSources{{
-    {"can", ImuSource::can}, {"ouster", ImuSource::ouster}}};
+inline constexpr std::array<std::pair<std::string_view, ImuSource>, 3> kImuSources{{
+    {"can", ImuSource::can}, {"ouster", ImuSource::ouster}, {"livox", ImuSource::livox}}};
 inline constexpr std::array<std::pair<std::string_view, DriveModel>, 2> kDriveModels{{
     {"differential", DriveModel::differential}, {"skid_steer", DriveModel::skid_steer}}};
 inline constexpr std::array<std::pair<std::string_view, WheelQuantity>, 3> kWheelQuantities{{
@@ -94,6 +94,7 @@ void describe(V& v, LidarSection& s) {
   v.optional("calibration", s.calibration);
   v.optional("address", s.address);
   v.optional("port", s.port, Range<int>{0, 65535});
+  v.optional("imu_port", s.imu_port, Range<int>{0, 65535});
   v.optional("interface", s.interface);
   v.optional("multicast_group", s.multicast_group);
   v.optional("receive_buffer_bytes", s.receive_buffer_bytes, Range<int>{65536, 1 << 30});

@@ -41,8 +41,8 @@ struct LivoxPattern {
 // Direction of point `index` (of the whole stream) in the sensor frame (x forward, y left, z up).
 Eigen::Vector3d livox_direction(const LivoxPattern& pattern, std::uint64_t index);
 
-// The Mid-360's IMU in its point-cloud frame (Livox Mid-360 user manual, "IMU
-// position": x 11.0, y 23.29, z −44.12 mm, axes parallel).
+// The Mid-360's IMU in its point-cloud frame (drivers::livox_imu_position_m:
+// the user manual's "IMU position", x 11.0, y 23.29, z −44.12 mm, axes parallel).
 Eigen::Isometry3d livox_mid360_imu_in_sensor();
 
 struct LivoxSimOptions {

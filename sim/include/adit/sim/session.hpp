@@ -1,9 +1,10 @@
 #pragma once
 // One simulated survey session: options in, a folder of files out, laid out
 // like a field recording plus its ground truth:
-//   lidar.pcap        the sensor's UDP packets (and an Ouster's IMU packets, port 7503)
+//   lidar.pcap        the sensor's UDP packets (and an Ouster's IMU packets, port 7503; a Mid-360's, 56401)
 //   can.log           wheel TPDOs and the CAN IMU's frames (candump -L)
-//   truth_imu.csv     the IMU's true biases per sample (truth_ouster_imu.csv: a robot's Ouster, beside its CAN IMU)
+//   truth_imu.csv     the IMU's true biases per sample, the IMU session.yaml reads (truth_ouster_imu.csv,
+//                     truth_livox_imu.csv: the LiDAR's own when the CAN IMU is read beside it)
 //   VLP16.yaml, RS16.csv, PandarXT32.csv or OS1-64.json (metadata): the calibration
 //   session.yaml      an adit config that replays it
 //   truth_body.tum    body trajectory (TUM)          truth_sensor.tum sensor trajectory (TUM)
@@ -46,8 +47,9 @@ struct SimOptions {
   double slips_per_minute = 1.0;
   double can_offset_s = 0.0;  // CAN clock minus LiDAR clock
   // The IMU (sim/imu.hpp): on the CAN bus (robots; drones and handhelds with
-  // a non-Ouster LiDAR), or the Ouster's own, in its packets.
+  // a LiDAR without one), or the LiDAR's own (Ouster, Mid-360), in its packets.
   bool imu = true;
+  bool imu_on_can = false;  // the CAN IMU even when the LiDAR has its own (which still sends its packets)
   double imu_rate_hz = 0.0;  // 0: 200 Hz on CAN, 100 Hz from an Ouster (what the real sensor sends)
   ImuNoise imu_noise;        // densities, walks and turn-on biases (the accelerometer's: --imu-bias-mps2)
   Eigen::Vector3d imu_position_m = Eigen::Vector3d::Zero();  // the CAN IMU in the body frame (lever arm)
@@ -73,9 +75,9 @@ BodyTrack simulated_path(const Scene& scene, const SimOptions& options);
 Eigen::Isometry3d simulated_extrinsics(const SimOptions& options);  // sensor in the body frame
 
 // Which IMU session.yaml reads (none with --imu 0).
-enum class SimImuSource { none, can, ouster };
+enum class SimImuSource { none, can, ouster, livox };
 SimImuSource simulated_imu_source(const SimOptions& options);
-// The IMU simulated for that source (can or ouster): rate, noise, mount, clock, motion model, seed.
+// The IMU simulated for that source (can, ouster or livox): rate, noise, mount, clock, motion model, seed.
 ImuOptions simulated_imu(const SimOptions& options, SimImuSource source);
 double platform_speed_mps(const SimOptions& options);  // --speed, or the platform's own pace
 People simulated_people(const Scene& scene, const SimOptions& options);  // the scene must outlive them

@@ -12,6 +12,7 @@
 // ROS drivers number them (Mid-360 4, Avia 6). IMU packets decode as
 // `auxiliary`; last_imu() holds their reading.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -34,6 +35,16 @@ LivoxProtocol livox_protocol(LivoxModel model);
 std::uint16_t livox_lines(LivoxModel model);
 // SDK1 firing period of one record (Avia 4167 ns); SDK2 packets state theirs.
 std::uint32_t livox_record_period_ns(LivoxModel model);
+// The host port the model's IMU packets go to: the Mid-360's own, 56401
+// (livox_ros_driver2 MID360_config.json); 0 for the Avia, whose IMU packets
+// come on the data port among its points.
+std::uint16_t livox_imu_port(LivoxModel model);
+// The built-in IMU's origin in the point frame, metres; its axes are the
+// points' (both manuals). Mid-360: (11.0, 23.29, −44.12) mm (Mid-360 user
+// manual, "IMU position"). Avia: (−41.65, −23.26, 28.4) mm, the opposite of
+// the LiDAR-in-IMU translation FAST-LIO's config/avia.yaml (extrinsic_T) and
+// FAST-LIVO's use for it (their mid360.yaml holds the same opposite of the Mid-360's figure).
+std::array<double, 3> livox_imu_position_m(LivoxModel model);
 // The model whose point or IMU packet this is (protocol header checked against the size), else nullopt.
 // SDK2 packets are taken for a Mid-360, SDK1 packets for an Avia (their siblings share the formats).
 std::optional<LivoxModel> livox_model_from_packet(std::span<const std::uint8_t> payload);
