@@ -126,7 +126,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   deskewer_.deskew(points_, times_, velocity, deskewed_);
   // The map's pose of the scan: the odometry's, refined against the map of
   // the scans before it (slam::MapRefiner says why).
-  const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_) : slot.pose;
+  const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;
   map_trajectory_.write(slot.stamp_ns, map_pose);
   if (journal_ != nullptr) journal_->map_pose(slot.stamp_ns, map_pose);
   const bool keyframe = keyframe_selector_.take(map_pose);

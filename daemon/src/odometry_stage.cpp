@@ -88,6 +88,7 @@ void OdometryStage::hand_to_mapping(const drivers::LidarScan& scan, const slam::
   m->stamp_ns = result.stamp_ns;
   m->pose = result.pose;
   m->valid = result.valid;
+  m->inertial = result.inertial;
   m->points.assign(odometry_.body_points().begin(), odometry_.body_points().end());
   m->times_s.assign(odometry_.body_times().begin(), odometry_.body_times().end());
   m->intensities.clear();

@@ -13,7 +13,8 @@ MapRefiner::MapRefiner(const MapRefinerConfig& config)
   placed_.reserve(config.max_scan_points);
 }
 
-Eigen::Isometry3d MapRefiner::refine(const Eigen::Isometry3d& odometry_pose, std::span<const Eigen::Vector3f> points) {
+Eigen::Isometry3d MapRefiner::refine(const Eigen::Isometry3d& odometry_pose, std::span<const Eigen::Vector3f> points,
+                                     bool inertial) {
   const std::span<const Eigen::Vector3f> scan = points.first(std::min(points.size(), config_.max_scan_points));
   Eigen::Isometry3d refined = odometry_pose;
   last_ = RegistrationResult{};
@@ -30,7 +31,8 @@ Eigen::Isometry3d MapRefiner::refine(const Eigen::Isometry3d& odometry_pose, std
     information(3) = information(4) = 1.0 / (config_.prior_sigma_tilt_rad * config_.prior_sigma_tilt_rad);
     prior.information = information.asDiagonal();
     downsampler_.downsample(scan, config_.source_voxel_m, source_);
-    if (source_.size() >= static_cast<std::size_t>(config_.registration.min_plane_correspondences)) {
+    const bool held_at_rest = inertial && !moved_since(added_at_, prior.mean, config_.map_insertion);
+    if (!held_at_rest && source_.size() >= static_cast<std::size_t>(config_.registration.min_plane_correspondences)) {
       last_ = register_scan(source_, map_, prior, config_.max_distance_m, config_.kernel_scale_m, config_.registration,
                             planes_);
       refined = last_.pose;

@@ -41,6 +41,24 @@ TEST(MapRefiner, AScanFromWhereTheMapLastTookOneIsNotAddedAgain) {
   EXPECT_GT(refiner.map().point_count(), first);
 }
 
+// From the LiDAR-inertial odometry, a scan from where the map last took one
+// keeps the odometry's motion exactly (no registration at rest); once the
+// body has moved, scans are registered again.
+TEST(MapRefiner, AtRestTheLidarInertialOdometrysMotionIsKept) {
+  MapRefiner refiner;
+  const Eigen::Isometry3d still = along_x(0.0);
+  refiner.refine(still, scan_from(still, 1), true);
+  for (unsigned k = 2; k < 6; ++k) {
+    // The odometry reports a few millimetres of sway, as a hand does.
+    const Eigen::Isometry3d sway = along_x(0.001 * k, 0.0002 * k);
+    EXPECT_TRUE(refiner.refine(sway, scan_from(still, k), true).isApprox(sway, 1e-12)) << k;
+    EXPECT_EQ(refiner.last().iterations, 0) << k;
+  }
+  const Eigen::Isometry3d moved = along_x(0.2);
+  refiner.refine(moved, scan_from(moved, 7), true);
+  EXPECT_GT(refiner.last().iterations, 0);
+}
+
 // Wheels with a radius 5 % short (exaggerated from the simulator's 0.4 %) and
 // a slow false turn: the odometry falls behind by 5 cm per metre. In a room
 // whose walls pin every direction, the map's poses follow the scans instead.

@@ -44,6 +44,7 @@ struct MapSlot {
   std::int64_t stamp_ns = 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   bool valid = false;
+  bool inertial = false;  // the pose is the LiDAR-inertial odometry's
   std::vector<Eigen::Vector3f> points;
   std::vector<float> times_s;
   std::vector<float> intensities;

@@ -61,8 +61,14 @@ class MapRefiner {
   // body frame at that pose, deskewed. Returns the refined pose (the first
   // scan keeps its odometry pose: it defines the map frame) and adds the
   // scan, placed there, to the refinement map once the body has moved since
-  // the last scan it took (map_insertion).
-  Eigen::Isometry3d refine(const Eigen::Isometry3d& odometry_pose, std::span<const Eigen::Vector3f> points);
+  // the last scan it took (map_insertion). `inertial`: the pose comes from
+  // the LiDAR-inertial odometry; then a scan from where the map last took
+  // one is not registered but keeps the odometry's motion: at rest the
+  // registration against a map of that one view creeps (0.18° over a
+  // hand-held's 2 s start), where the gyroscope holds the attitude
+  // (docs/decisions/034-refinement-holds-at-rest.md).
+  Eigen::Isometry3d refine(const Eigen::Isometry3d& odometry_pose, std::span<const Eigen::Vector3f> points,
+                           bool inertial = false);
 
   // The last registration (zero iterations for the first scan).
   const RegistrationResult& last() const { return last_; }
