@@ -35,6 +35,7 @@
 #include "adit/drivers/pcap_writer.hpp"
 #include "adit/sim/session.hpp"
 #include "shared_data.hpp"
+#include "pipeline_run.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -260,17 +261,8 @@ TEST(LivoxImuSource, ArrivesLiveOnItsOwnPortBesideThePoints) {
   PipelineOptions options;
   options.mapping = false;
   Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
-  const std::int64_t started_ns = monotonic_ns();
-  pipeline.start();
-  // The receiver first drains what its sockets held before the session (as
-  // stale): send once it is reading, its heartbeat beating after the start.
-  const auto receiving = [&] {
-    for (const Heartbeat* h : pipeline.heartbeats())
-      if (h->name == "receiver") return h->last_ns.load() > started_ns;
-    return false;
-  };
-  for (int i = 0; i < 1000 && !receiving(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  ASSERT_TRUE(receiving());
+  // Sent once the receiver reads (it drains what came before the session).
+  ASSERT_TRUE(test::start_and_wait_for_receiver(pipeline));
   drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
   drivers::UdpSender to_imu("127.0.0.1", imu_port);
   drivers::PacedPcapReader reader(o.out / "lidar.pcap", 1.0);

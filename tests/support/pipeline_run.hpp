@@ -5,19 +5,37 @@
 
 #include <filesystem>
 #include <fstream>
+#include <chrono>
 #include <functional>
 #include <memory>
+#include <thread>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/common/clock.hpp"
 #include "adit/config/load.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 
 namespace adit::test {
+
+// Starts a live pipeline and returns once its receiver reads: the receiver
+// first drains what its sockets held before the session (as stale), so a
+// test sends only when the receiver's heartbeat beats after the start.
+inline bool start_and_wait_for_receiver(daemon::Pipeline& pipeline) {
+  const std::int64_t started_ns = monotonic_ns();
+  pipeline.start();
+  const auto receiving = [&] {
+    for (const daemon::Heartbeat* h : pipeline.heartbeats())
+      if (h->name == "receiver") return h->last_ns.load() > started_ns;
+    return false;
+  };
+  for (int i = 0; i < 1000 && !receiving(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  return receiving();
+}
 
 struct ScoredRun {
   std::unique_ptr<daemon::Pipeline> pipeline;  // joined: its stats are final
