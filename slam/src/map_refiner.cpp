@@ -30,8 +30,8 @@ Eigen::Isometry3d MapRefiner::refine(const Eigen::Isometry3d& odometry_pose, std
     information.tail<3>().setConstant(1.0 / (config_.prior_sigma_rad * config_.prior_sigma_rad));
     information(3) = information(4) = 1.0 / (config_.prior_sigma_tilt_rad * config_.prior_sigma_tilt_rad);
     prior.information = information.asDiagonal();
-    downsampler_.downsample(scan, config_.source_voxel_m, source_);
     const bool held_at_rest = inertial && !moved_since(added_at_, prior.mean, config_.map_insertion);
+    if (!held_at_rest) downsampler_.downsample(scan, config_.source_voxel_m, source_);
     if (!held_at_rest && source_.size() >= static_cast<std::size_t>(config_.registration.min_plane_correspondences)) {
       last_ = register_scan(source_, map_, prior, config_.max_distance_m, config_.kernel_scale_m, config_.registration,
                             planes_);
