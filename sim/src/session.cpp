@@ -47,7 +47,6 @@ bool is_handheld(const SimOptions& o) { return o.platform == "handheld"; }
 bool is_ouster(const SimOptions& o) { return o.sensor.starts_with("OS"); }
 bool is_livox(const SimOptions& o) { return o.sensor == "Mid-360"; }
 
-
 DronePathOptions drone_options(const SimOptions& o) {
   DronePathOptions d;
   d.duration_s = o.duration_s;

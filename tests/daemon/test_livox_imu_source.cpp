@@ -258,11 +258,9 @@ TEST(LivoxImuSource, ArrivesLiveOnItsOwnPortBesideThePoints) {
       "payload:\n  id: test\n  state_dir: {}\nlidar:\n  model: Mid-360\n  source: udp\n  address: 127.0.0.1\n"
       "  port: {}\n  imu_port: {}\nimu:\n  enabled: true\n  source: livox\nthreads:\n  lock_memory: false\n",
       (test::binary_dir() / "livox-imu-live").string(), lidar_port, imu_port);
-  PipelineOptions options;
-  options.mapping = false;
-  Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
+  const std::unique_ptr<Pipeline> pipeline = test::live_pipeline(yaml);
   // Sent once the receiver reads (it drains what came before the session).
-  ASSERT_TRUE(test::start_and_wait_for_receiver(pipeline));
+  ASSERT_TRUE(test::start_and_wait_for_receiver(*pipeline));
   drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
   drivers::UdpSender to_imu("127.0.0.1", imu_port);
   drivers::PacedPcapReader reader(o.out / "lidar.pcap", 1.0);
@@ -275,12 +273,12 @@ TEST(LivoxImuSource, ArrivesLiveOnItsOwnPortBesideThePoints) {
   const double sent_s = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                        std::chrono::system_clock::now().time_since_epoch())
                                                        .count());
-  for (int i = 0; i < 200 && pipeline.stats().datagrams.load() < imu_sent + lidar_sent; ++i)
+  for (int i = 0; i < 200 && pipeline->stats().datagrams.load() < imu_sent + lidar_sent; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  pipeline.end_source();
-  pipeline.join();
-  const ImuStats& imu = pipeline.stats().imu;
+  pipeline->end_source();
+  pipeline->join();
+  const ImuStats& imu = pipeline->stats().imu;
   std::printf("live: %zu point and %zu IMU datagrams sent; %llu IMU packets read, %llu readings (%llu unclocked)\n",
               lidar_sent, imu_sent, static_cast<unsigned long long>(imu.packets.load()),
               static_cast<unsigned long long>(imu.samples.load()),
@@ -291,7 +289,7 @@ TEST(LivoxImuSource, ArrivesLiveOnItsOwnPortBesideThePoints) {
   EXPECT_GE(imu.samples.load() + 2, imu_sent);
   EXPECT_EQ(imu.count(ImuProblem::time_back), 0U);
   // Live, a busy machine's odometry drops scans (counted): how many it keeps is not this test's matter.
-  EXPECT_GT(pipeline.stats().poses.load(), 0U);
+  EXPECT_GT(pipeline->stats().poses.load(), 0U);
   // Stamped on the LiDAR clock mapped to the host's: the last reading within the sending's last 0.1 s.
   EXPECT_NEAR(imu.last_t.load(), sent_s, 0.1);
 }

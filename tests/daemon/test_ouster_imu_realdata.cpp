@@ -195,11 +195,9 @@ TEST(OusterImuRealData, ArrivesLiveOnItsOwnPortBesideTheLidar) {
       "payload:\n  id: test\n  state_dir: {}\nlidar:\n  model: {}\n  source: udp\n  address: 127.0.0.1\n"
       "  port: {}\n  calibration: {}\nimu:\n  enabled: true\n  source: ouster\nthreads:\n  lock_memory: false\n",
       (test::binary_dir() / "ouster-imu-live").string(), c.model, lidar_port, metadata.string());
-  PipelineOptions options;
-  options.mapping = false;
-  Pipeline pipeline(config::parse_config(yaml, "test.yaml", "/"), options);
+  const std::unique_ptr<Pipeline> pipeline = test::live_pipeline(yaml);
   // Sent once the receiver reads (it drains what came before the session).
-  ASSERT_TRUE(test::start_and_wait_for_receiver(pipeline));
+  ASSERT_TRUE(test::start_and_wait_for_receiver(*pipeline));
   drivers::UdpSender to_lidar("127.0.0.1", lidar_port);
   drivers::UdpSender to_imu("127.0.0.1", imu_port);
   // At the capture's own pace, as the sensor sends them: the LiDAR clock's
@@ -215,12 +213,12 @@ TEST(OusterImuRealData, ArrivesLiveOnItsOwnPortBesideTheLidar) {
   const double sent_s = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                        std::chrono::system_clock::now().time_since_epoch())
                                                        .count());
-  const ImuStats& imu = pipeline.stats().imu;  // copied from the source per scan and at the end
-  for (int i = 0; i < 200 && pipeline.stats().datagrams.load() < imu_sent + lidar_sent; ++i)
+  const ImuStats& imu = pipeline->stats().imu;  // copied from the source per scan and at the end
+  for (int i = 0; i < 200 && pipeline->stats().datagrams.load() < imu_sent + lidar_sent; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  pipeline.end_source();
-  pipeline.join();
+  pipeline->end_source();
+  pipeline->join();
   std::filesystem::remove(metadata);
   fmt::print("live: {} LiDAR and {} IMU datagrams sent; {} IMU packets read, {} readings, {} before the LiDAR's clock\n",
              lidar_sent, imu_sent, imu.packets.load(), imu.samples.load(), imu.count(ImuProblem::unclocked));

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include <fmt/format.h>
@@ -21,6 +22,13 @@
 #include "run_program.hpp"
 
 namespace adit::test {
+
+// A pipeline for a live-input test: odometry without mapping, not started.
+inline std::unique_ptr<daemon::Pipeline> live_pipeline(const std::string& yaml) {
+  daemon::PipelineOptions options;
+  options.mapping = false;
+  return std::make_unique<daemon::Pipeline>(config::parse_config(yaml, "test.yaml", "/"), options);
+}
 
 // Starts a live pipeline and returns once its receiver reads: the receiver
 // first drains what its sockets held before the session (as stale), so a
