@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -153,6 +154,44 @@ TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
   EXPECT_NE(outside.output.find("outside"), std::string::npos) << outside.output;
   // --ref without --est is refused.
   EXPECT_NE(adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref)).status, 0);
+}
+
+// --align se3 places the map by the rigid fit of all the estimate's positions
+// to the reference's, as a surveyor fits a map to control points: here the
+// estimate's first attitude is 3° off (the map itself is right), which
+// tilts the map placed by its first pose but not the fitted one.
+TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
+  Eigen::Isometry3d map_from_world = Eigen::Isometry3d::Identity();
+  map_from_world.translation() = Eigen::Vector3d(-1.0, 2.0, 0.3);
+  map_from_world.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::string ref_text, est_text;
+  const std::vector<Eigen::Vector3d> path{{1, 1, 0.5}, {3, 1, 0.5}, {5, 1, 0.6}, {5, 3, 0.5}, {5, 5, 0.4}, {3, 5, 0.5}};
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const Eigen::Vector3d m = map_from_world * path[i];
+    Eigen::Quaterniond qm(map_from_world.linear());
+    if (i == 0) qm = qm * Eigen::AngleAxisd(3.0 * M_PI / 180, Eigen::Vector3d::UnitX());
+    const double t = 100.0 + 0.1 * static_cast<double>(i);
+    ref_text += fmt::format("{:.1f} {} {} {} 0 0 0 1\n", t, path[i].x(), path[i].y(), path[i].z());
+    est_text += fmt::format("{:.1f} {:.9f} {:.9f} {:.9f} {:.12f} {:.12f} {:.12f} {:.12f}\n", t, m.x(), m.y(), m.z(), qm.x(),
+                            qm.y(), qm.z(), qm.w());
+  }
+  const TempFile ref(ref_text), est(est_text), map("", ".ply");
+  fill(map, map_from_world);
+  const std::string placed_by = "map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) + " --est " + q(est);
+  const auto fitted = json_of(adit_eval(placed_by + " --align se3 --json"));
+  EXPECT_NEAR(fitted["fraction_within"].get<double>(), 6.0 / 11.0, 1e-9);
+  EXPECT_EQ(fitted["placement"], "se3");
+  const auto by_origin = json_of(adit_eval(placed_by + " --json"));
+  EXPECT_EQ(by_origin["placement"], "origin");
+  EXPECT_NEAR(fitted["median_m"].get<double>(), 0.0495, 1e-5);
+  EXPECT_GT(std::abs(by_origin["median_m"].get<double>() - 0.0495), 0.005) << "the first pose's 3° tilt the map";
+
+  // Poses on one line fix no rotation: an input error naming the estimate.
+  const TempFile line("100.0 0 0 0 0 0 0 1\n100.1 1 0 0 0 0 0 1\n100.2 2 0 0 0 0 0 1\n");
+  const EvalRun degenerate = adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) +
+                                       " --est " + q(line) + " --align se3");
+  EXPECT_EQ(degenerate.status, 2) << degenerate.output;
+  EXPECT_NE(degenerate.output.find(line.path().string()), std::string::npos) << degenerate.output;
 }
 
 TEST_F(AditEvalMap, BadFilesAreNamed) {

@@ -14,6 +14,8 @@
 #include "adit/common/error.hpp"
 #include "adit/protocol/map_import.hpp"
 #include "adit/protocol/ply_mesh.hpp"
+#include "adit/eval/align.hpp"
+#include "adit/eval/associate.hpp"
 #include "adit/eval/interpolate.hpp"
 #include "adit/eval/mesh_distance.hpp"
 #include "adit/eval/trajectory_io.hpp"
@@ -61,16 +63,39 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 struct Placement {
   Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
-  double t0 = 0.0;  // s; the estimate's first stamp when placed by trajectories
+  double t0 = 0.0;  // s; the estimate's first stamp when placed by its origin
   bool by_trajectories = false;
+  std::size_t fitted_poses = 0;  // poses of the fit when placed by a rigid fit (se3)
 };
+
+// The rigid transform that best lays the estimate's positions onto the
+// reference's (Umeyama, align.hpp), as a surveyor fits a map to control
+// points: a tilt or heading error the whole map shares does not count.
+Eigen::Isometry3d world_from_map_fitted(const std::string& ref_file, const std::string& est_file, std::size_t& poses) {
+  constexpr double kMaxDifference = 0.01;  // s, as adit eval traj
+  const eval::Associated a = eval::associate(timed_trajectory(ref_file), timed_trajectory(est_file), kMaxDifference);
+  const auto fit = eval::align_trajectory(a.ref, a.est, eval::Alignment::se3);
+  if (!fit)
+    throw InputError(est_file, "",
+                     fmt::format("{} poses matched to {} within {} s: too few, or all on one line, for a rigid fit",
+                                 a.est.size(), ref_file, kMaxDifference));
+  poses = a.est.size();
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = fit->rotation;
+  t.translation() = fit->translation;
+  return t;
+}
 
 Placement placement(const MapEvalOptions& o) {
   Placement p;
   if (o.ref.empty()) return p;
+  p.by_trajectories = true;
+  if (o.align == "se3") {
+    p.world_from_map = world_from_map_fitted(o.ref, o.est, p.fitted_poses);
+    return p;
+  }
   p.t0 = timed_trajectory(o.est).stamps.front();
   p.world_from_map = world_from_map(o.ref, o.est);
-  p.by_trajectories = true;
   return p;
 }
 
@@ -162,13 +187,18 @@ void run_eval_map(const MapEvalOptions& o) {
                            {"p95_m", metres_or_null(a.p95)},
                            {"mean_m", metres_or_null(a.mean)},
                            {"beyond_cap", a.beyond_cap},
-                           {"cap_m", o.cap}};
+                           {"cap_m", o.cap},
+                           {"placement", !place.by_trajectories ? "none" : o.align}};
     fmt::print("{}\n", j.dump(2));
     return;
   }
   fmt::print("map               {} ({} points)\n", o.map, a.points);
   fmt::print("scene             {} ({} triangles)\n", o.scene, scene.size());
-  if (place.by_trajectories) {
+  if (place.fitted_poses > 0) {
+    const Eigen::Vector3d t = place.world_from_map.translation();
+    fmt::print("placement         se3 fit of {} poses of the estimate to the reference: map origin at ({:.3f}, {:.3f}, {:.3f}) m\n",
+               place.fitted_poses, t.x(), t.y(), t.z());
+  } else if (place.by_trajectories) {
     const Eigen::Vector3d t = place.world_from_map.translation();
     fmt::print("placement         ref(t0) est(t0)^-1 at t0 = {:.6f} s: map origin at ({:.3f}, {:.3f}, {:.3f}) m\n",
                place.t0, t.x(), t.y(), t.z());
