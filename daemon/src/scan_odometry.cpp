@@ -19,6 +19,9 @@ slam::OdometryConfig odometry_config_of(const config::Config& config, slam::Odom
   // downsampler's table and the registration's buffers follow it (a VLP-16:
   // 116 352, docs/decisions/032-aditd-memory.md).
   if (max_points > 0) base.max_scan_points = max_points;
+  // A wheeled platform's traction bounds how far it departs from constant
+  // velocity while its wheels are silent (decision 035).
+  if (config.wheel_odometry.enabled) base.max_acceleration_mps2 = config.wheel_odometry.max_acceleration_mps2;
   if (config.imu.enabled) {
     base.inertial.noise = {config.imu.gyro_noise_density, config.imu.accel_noise_density, config.imu.gyro_bias_walk,
                            config.imu.accel_bias_walk};

@@ -155,7 +155,10 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   PosePrior constant_velocity;
   constant_velocity.mean = pose_ * constant_velocity_delta;
   Vector6d information;
-  information.head<3>().setConstant(1.0 / (config_.constant_velocity_sigma_m * config_.constant_velocity_sigma_m));
+  const double translation_sigma = config_.max_acceleration_mps2 > 0.0 && dt > 0.0
+                                       ? 0.5 * config_.max_acceleration_mps2 * dt * dt
+                                       : config_.constant_velocity_sigma_m;
+  information.head<3>().setConstant(1.0 / (translation_sigma * translation_sigma));
   information.tail<3>().setConstant(1.0 / (config_.constant_velocity_sigma_rad * config_.constant_velocity_sigma_rad));
   constant_velocity.information = information.asDiagonal();
   if (scan.gravity && up_frame_ && scan.gravity->sigma_rad > 0.0)

@@ -330,6 +330,52 @@ TEST(Odometry, ASensorThatStoodStillSeesItsClimb) {
   EXPECT_LT(r.pose.translation().head<2>().norm(), 0.05) << r.pose.translation().transpose();
 }
 
+// A wheeled robot at 1 m/s along a drift whose walls say little of the
+// motion along it (a few ribs across it), its wheels silent for 1.5 s (the
+// CAN bus off). With its traction bounded (OdometryConfig::
+// max_acceleration_mps2), the constant-velocity prediction is held as
+// tightly as that bound allows and the odometry keeps to the drift's axis;
+// with the loose default it slid along the drift by 0.15 m in the soak's
+// drive (docs/decisions/035-traction-bounded-prediction.md). The walls carry
+// 3 cm of noise; the ribs are 1 % of the points.
+double worst_error_with_silent_wheels(double max_acceleration_mps2) {
+  auto world = test::tunnel(400000, 25);
+  std::mt19937 rng(26);
+  std::uniform_real_distribution<float> u(-1.0F, 1.0F);
+  for (int i = 0; i < 4000; ++i) {  // ribs: 0.2 m deep, every 4 m, on the walls' lower half
+    const float x = 4.0F * std::round(25.0F * u(rng));
+    const float side = u(rng) > 0.0F ? 1.0F : -1.0F;
+    world.emplace_back(x, side * (1.8F + 0.2F * std::abs(u(rng))), -2.25F + 1.5F * std::abs(u(rng)));
+  }
+  OdometryConfig config;
+  config.max_acceleration_mps2 = max_acceleration_mps2;
+  Odometry odometry(config);
+  MotionPrior step;  // the wheels: 0.1 m per scan
+  step.delta.translation() << 0.1, 0.0, 0.0;
+  step.covariance.diagonal() << 1e-4, 1e-4, 2.5e-3, 4e-4, 4e-4, 2.5e-5;
+  std::normal_distribution<float> noise(0.0F, 0.03F);
+  double worst = 0.0;
+  for (int k = 0; k < 35; ++k) {
+    const Eigen::Isometry3d truth = planar_pose(0.1 * k, 0.0, 0.0);
+    auto scan = observe(world, truth, 15000, 600 + static_cast<unsigned>(k));
+    for (auto& p : scan) p += Eigen::Vector3f(noise(rng), noise(rng), noise(rng));
+    std::optional<MotionPrior> wheel;
+    if (k > 0 && k < 20) wheel = step;  // then silent
+    const OdometryResult r = odometry.process({static_cast<std::int64_t>(k) * 100'000'000, scan, {}}, wheel);
+    EXPECT_TRUE(r.valid) << "scan " << k;
+    worst = std::max(worst, (r.pose.translation() - truth.translation()).norm());
+  }
+  return worst;
+}
+
+TEST(Odometry, ARobotsTractionCarriesItThroughADriftWhileItsWheelsAreSilent) {
+  const double bounded = worst_error_with_silent_wheels(4.0);
+  const double loose = worst_error_with_silent_wheels(0.0);
+  EXPECT_LT(bounded, 0.01);
+  // The scene is one where it matters: the loose prediction slides.
+  EXPECT_GT(loose, 5.0 * bounded) << "bounded " << bounded << " m, loose " << loose << " m";
+}
+
 TEST(Deskew, UndoesTheMotionDuringTheScan) {
   // A sensor moving at 2 m/s along x and turning at 90°/s measures a wall at
   // x = 5 (world) over 0.1 s; deskewed, the points lie on the wall in the

@@ -78,6 +78,12 @@ struct OdometryConfig {
   // weak prior so that degenerate directions stay anchored to the prediction.
   double constant_velocity_sigma_m = 0.5;
   double constant_velocity_sigma_rad = 0.2;
+  // A platform whose acceleration is bounded (a wheeled robot's traction)
+  // departs from a constant-velocity prediction by at most ½·a·dt² in a scan;
+  // when set (> 0), that is the prediction's translation σ instead of
+  // constant_velocity_sigma_m. It carries a featureless drift through a
+  // wheel dropout (docs/decisions/035-traction-bounded-prediction.md).
+  double max_acceleration_mps2 = 0.0;
   // A wheel prior whose registration matches fewer than this share of the
   // previous scan's correspondences is checked against constant velocity.
   double min_correspondence_share = 0.7;
