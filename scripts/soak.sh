@@ -10,8 +10,8 @@
 #   40-43  the IMU (accelerometer, id 0x190) dropping out
 #   45-48  LCM flooded with garbage on aditd's channels (adit faults lcm)
 #   50     the host's wall clock stepped 2 s ahead, at 55 back (libfaketime)
-# It passes when aditd does not crash, its resident memory is flat (the last
-# quarter's mean within 5 % of the second quarter's), every fault shows in the status log (`adit
+# It passes when aditd does not crash, its peak resident memory is within 5 %
+# of the fault-free run's, every fault shows in the status log (`adit
 # status` every 2 s), and the map holds its shape: its points within 5 cm of
 # the true scene, the map laid on the scene by the rigid fit of its poses to
 # the true ones (as to control points), within 1 point of the fault-free
@@ -56,8 +56,18 @@ echo "soak: $minutes min mine drive (seed $seed) in $work"
 # the map is the one a real-time run makes).
 mkdir -p "$work/clean"
 config_for clean "$session/lidar.pcap" "$session/can.log" 0 soak-clean "udpm://239.255.76.67:7701?ttl=0" > "$work/clean/aditd.yaml"
-"$build/bin/aditd" --config "$work/clean/aditd.yaml" --once > "$work/clean/aditd.log" 2>&1 ||
-  { echo "soak: the fault-free run failed ($work/clean/aditd.log)" >&2; exit 1; }
+peak_mb() {  # PID: the process's peak resident size so far (VmHWM), empty once it has gone
+  awk '/^VmHWM/ {print $2 / 1024}' "/proc/$1/status" 2> /dev/null || true
+}
+"$build/bin/aditd" --config "$work/clean/aditd.yaml" --once > "$work/clean/aditd.log" 2>&1 &
+clean_pid=$!
+clean_peak=0
+while kill -0 "$clean_pid" 2> /dev/null; do
+  hwm=$(peak_mb "$clean_pid")
+  [ -z "$hwm" ] || clean_peak=$hwm
+  sleep 0.5
+done
+wait "$clean_pid" || { echo "soak: the fault-free run failed ($work/clean/aditd.log)" >&2; exit 1; }
 
 # The faulty recordings.
 mkdir -p "$work/faulty"
@@ -83,6 +93,7 @@ client=(--payload "$payload" --lcm-url "$url" --timeout 2)
 echo "elapsed_s,rss_mb" > "$work/memory.csv"
 : > "$work/status.log"
 started=$(date +%s)
+faulty_peak=0
 flooding=0
 while kill -0 "$aditd_pid" 2> /dev/null; do
   elapsed=$(($(date +%s) - started))
@@ -97,6 +108,8 @@ while kill -0 "$aditd_pid" 2> /dev/null; do
   [ "$second" -lt 45 ] && flooding=0
   rss=$(awk '/^VmRSS/ {print $2 / 1024}' "/proc/$aditd_pid/status" 2> /dev/null || true)
   [ -z "$rss" ] || echo "$elapsed,$rss" >> "$work/memory.csv"
+  hwm=$(peak_mb "$aditd_pid")
+  [ -z "$hwm" ] || faulty_peak=$hwm
   if [ $((elapsed % 2)) -eq 0 ]; then
     "$adit" status "${client[@]}" 2> /dev/null | sed "s/^/[$elapsed s] /" >> "$work/status.log" || true
   fi
@@ -117,16 +130,20 @@ check() {  # NAME OK(0/1) FIGURE
   [ "$2" -eq 1 ] || failed=1
 }
 check "aditd ran to the end (exit status)" "$([ "$status" -eq 0 ] && echo 1 || echo 0)" "$status"
-# Flat: the mean resident size over the last quarter (less the last 10 s, when
-# the map files are written) against the second quarter's; the peak beside it.
-read -r second last peak growth < <(awk -F, -v n="$seconds" 'NR > 1 {
+# Memory: the faults must not cost memory. The faulty run's peak resident size
+# against the fault-free run's (the same drive, the same map); the growth from
+# the second quarter to the last is printed beside it, not judged: on a drive
+# that keeps reaching new ground the map grows, in both runs alike (decision
+# 037; the 30-minute soak measures the long-run growth).
+read -r second last growth < <(awk -F, -v n="$seconds" 'NR > 1 {
     if ($1 >= n / 4 && $1 < n / 2) { a += $2; na++ }
-    if ($1 >= 3 * n / 4 && $1 < n - 10) { b += $2; nb++ }
-    if ($2 > p) p = $2 }
-  END { a = na ? a / na : 0; b = nb ? b / nb : 0; printf "%.1f %.1f %.1f %.2f\n", a, b, p, a ? 100 * (b - a) / a : 0 }' \
+    if ($1 >= 3 * n / 4 && $1 < n - 10) { b += $2; nb++ } }
+  END { a = na ? a / na : 0; b = nb ? b / nb : 0; printf "%.1f %.1f %.2f\n", a, b, a ? 100 * (b - a) / a : 0 }' \
   "$work/memory.csv")
-check "memory: last quarter against the second, <= 5 %" "$(awk -v g="$growth" 'BEGIN {print (g <= 5) ? 1 : 0}')" \
-  "$second MB -> $last MB (+$growth %), peak $peak MB"
+check "memory: peak within 5 % of fault-free" \
+  "$(awk -v f="$faulty_peak" -v c="$clean_peak" 'BEGIN {print (c > 0 && f <= 1.05 * c) ? 1 : 0}')" \
+  "$(printf '%.1f MB (fault-free %.1f MB); mean %s MB -> %s MB (+%s %%) second to last quarter' \
+    "$faulty_peak" "$clean_peak" "$second" "$last" "$growth")"
 for fault in "LiDAR silent" "LiDAR link" "CAN bus" "gap" "host clock stepped" "LCM: "; do
   if [ "$fault" = "host clock stepped" ] && [ ${#preload[@]} -eq 0 ]; then continue; fi
   seen=$(grep -c -- "$fault" "$work/status.log" || true)
