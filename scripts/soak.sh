@@ -134,7 +134,7 @@ check "aditd ran to the end (exit status)" "$([ "$status" -eq 0 ] && echo 1 || e
 # against the fault-free run's (the same drive, the same map); the growth from
 # the second quarter to the last is printed beside it, not judged: on a drive
 # that keeps reaching new ground the map grows, in both runs alike (decision
-# 037; the 30-minute soak measures the long-run growth).
+# 038; the 30-minute soak measures the long-run growth).
 read -r second last growth < <(awk -F, -v n="$seconds" 'NR > 1 {
     if ($1 >= n / 4 && $1 < n / 2) { a += $2; na++ }
     if ($1 >= 3 * n / 4 && $1 < n - 10) { b += $2; nb++ } }
