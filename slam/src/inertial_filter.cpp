@@ -186,4 +186,22 @@ void InertialFilter::update(const Eigen::Isometry3d& pose, const Matrix6d& body_
   state_.gravity += dx.segment<3>(kG);
 }
 
+void InertialFilter::update_zero_velocity(double sigma_mps) {
+  const Eigen::Matrix3d innovation_covariance =
+      covariance_.block<3, 3>(kV, kV) + sigma_mps * sigma_mps * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix<double, 18, 3> cross = covariance_.middleCols<3>(kV);
+  const Eigen::Matrix<double, 18, 3> gain = innovation_covariance.ldlt().solve(cross.transpose()).transpose();
+  if (!gain.allFinite()) return;
+  const Eigen::Matrix<double, 18, 1> dx = gain * (-state_.velocity);
+  covariance_ -= gain * cross.transpose();
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+
+  state_.pose.translation() += dx.segment<3>(kP);
+  state_.pose.linear() = state_.pose.linear() * exp_so3(dx.segment<3>(kTheta));
+  state_.velocity += dx.segment<3>(kV);
+  state_.gyro_bias += dx.segment<3>(kBg);
+  state_.accel_bias += dx.segment<3>(kBa);
+  state_.gravity += dx.segment<3>(kG);
+}
+
 }  // namespace adit::slam

@@ -56,6 +56,7 @@ void Odometry::start_inertial(const ScanInput& scan, const Matrix6d& body_covari
   Matrix6d M = Matrix6d::Identity();  // registration's ρ to the filter's δp = R·ρ
   M.topLeftCorner<3, 3>() = pose_.linear();
   inertial_.reset(state, M * body_covariance * M.transpose());
+  updated_velocity_ = state.velocity;
   inertial_started_ = true;
 }
 
@@ -111,11 +112,19 @@ void Odometry::register_inertial(const ScanInput& scan, const std::optional<Moti
                    return register_from(start);
                  },
                  result.registration);
-  const Eigen::Isometry3d corrected = result.registration.pose;
-  threshold_.update(predicted.inverse() * corrected, pose_.inverse() * corrected);
+  const Eigen::Isometry3d registered = result.registration.pose;
+  threshold_.update(predicted.inverse() * registered, pose_.inverse() * registered);
 
-  const Matrix6d to_body = adjoint(corrected.inverse());
-  inertial_.update(corrected, to_body * result.registration.covariance * to_body.transpose());
+  const Eigen::Vector3d predicted_velocity = inertial_.state().velocity;
+  const Matrix6d to_body = adjoint(registered.inverse());
+  inertial_.update(registered, to_body * result.registration.covariance * to_body.transpose());
+  // Still wherever the scan can see, and nearly so in the filter's belief:
+  // still along the directions the scan cannot see too (standstill.hpp).
+  result.standstill = appears_still(pose_, result.registration, dt, predicted_velocity,
+                                    predicted_velocity - updated_velocity_, config_.standstill);
+  if (result.standstill) inertial_.update_zero_velocity(config_.standstill.velocity_sigma_mps);
+  const Eigen::Isometry3d corrected = inertial_.state().pose;
+  updated_velocity_ = inertial_.state().velocity;
   // The sweep again with the corrected velocity and biases, for the map.
   const double t = seconds(scan.stamp_ns);
   const double sweep_s = sweep_motion_.empty() ? 0.0 : sweep_motion_.back().t;

@@ -75,6 +75,7 @@ struct Outcome {
   double final_rotation_error_deg = 0.0;
   double worst_rotation_error_deg = 0.0;
   int inertial_scans = 0;
+  int standstill_scans = 0;
 };
 
 // Scans every `period` s along handheld(), with or without the IMU.
@@ -93,6 +94,7 @@ Outcome run(const std::vector<Eigen::Vector3f>& hall, double period, int scans, 
     const OdometryResult r = odometry.process(input);
     EXPECT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
     result.inertial_scans += r.inertial ? 1 : 0;
+    result.standstill_scans += r.standstill ? 1 : 0;
     const Eigen::Isometry3d expected = handheld(0.0).inverse() * handheld(t);
     result.final_position_error_m = (r.pose.translation() - expected.translation()).norm();
     result.final_rotation_error_deg = angle_deg(r.pose.linear(), expected.linear());
@@ -113,6 +115,7 @@ TEST(InertialOdometry, AHandheldScannerTurningFastIsTrackedWithScansHalfASecondA
   const auto hall = test::room(400000, 41, 12.0F, 8.0F, 3.0F);
   const Outcome inertial = run(hall, 0.5, 13, true);
   EXPECT_EQ(inertial.inertial_scans, 13);
+  EXPECT_EQ(inertial.standstill_scans, 0);  // walking: never taken for still
   // Measured: 0.026 m and 0.05°; LiDAR only, 13 m and 131°.
   EXPECT_LT(inertial.final_position_error_m, 0.05);
   EXPECT_LT(inertial.worst_rotation_error_deg, 0.2);
@@ -157,6 +160,55 @@ TEST(InertialOdometry, AnImuDropoutFallsBackToLidarOnlyAndRecovers) {
   const Eigen::Isometry3d expected = walk(0.0).inverse() * walk(3.9);
   EXPECT_LT((r.pose.translation() - expected.translation()).norm(), 0.02);
   EXPECT_LT(angle_deg(r.pose.linear(), expected.linear()), 0.2);
+}
+
+// Standing still in a corridor: the scan cannot see along it, so there the
+// position is the IMU's alone. An accelerometer bias that walks after the
+// start (0.05 m/s² along the corridor from t = 0.5 s, as a MEMS unit warming
+// up) is read as acceleration; the zero-velocity update holds the body
+// still instead, and learns the bias (standstill.hpp).
+TEST(InertialOdometry, ABodyStandingInACorridorStaysPutWithTheZeroVelocityUpdate) {
+  const auto corridor = test::tunnel(300000, 51, 200.0F);
+  const auto rest = [](double) { return Eigen::Isometry3d::Identity(); };
+  std::mt19937 rng(13);
+  std::normal_distribution<double> gyro_noise(0.0, 0.003), accel_noise(0.0, 0.03);
+  std::vector<ImuSample> imu;
+  for (double t = -0.5; t <= 3.5; t += 0.005) {
+    const Eigen::Vector3d accel_bias(t > 0.5 ? 0.05 : 0.0, -0.02, 0.03);
+    ImuSample s = test::imu_sample(rest, t, Eigen::Vector3d(0.004, -0.003, 0.002), accel_bias);
+    for (int i = 0; i < 3; ++i) {
+      s.angular_rate(i) += gyro_noise(rng);
+      s.specific_force(i) += accel_noise(rng);
+    }
+    imu.push_back(s);
+  }
+  const auto stand = [&](bool zero_velocity_update) {
+    OdometryConfig config;
+    config.max_range_m = 30.0F;
+    config.standstill.enabled = zero_velocity_update;
+    config.max_start_speed_mps = 0.0;  // no start search: along the corridor every offset fits alike
+    Odometry odometry(config);
+    std::vector<float> times;
+    OdometryResult r;
+    int still = 0;
+    for (int k = 0; k < 30; ++k) {
+      const double t = 0.1 * k;
+      const auto points = sweep(corridor, rest, t, 20000, 700 + static_cast<unsigned>(k), times);
+      r = odometry.process({static_cast<std::int64_t>(std::llround(t * 1e9)), points, times, std::nullopt, imu});
+      EXPECT_TRUE(r.valid && r.inertial) << "scan " << k;
+      still += r.standstill ? 1 : 0;
+    }
+    EXPECT_TRUE(r.status == OdometryStatus::degenerate) << "the corridor's axis should be unseen";
+    return std::pair{r.pose.translation().norm(), still};
+  };
+  const auto [held, still_scans] = stand(true);
+  const auto [drifted, none] = stand(false);
+  std::printf("after 2.9 s standing: %.4f m off with the zero-velocity update (%d scans still), %.4f m without\n", held,
+              still_scans, drifted);
+  EXPECT_GE(still_scans, 25);
+  EXPECT_EQ(none, 0);
+  EXPECT_LT(held, 0.01);
+  EXPECT_GT(drifted, 0.05);  // what the update prevents
 }
 
 }  // namespace

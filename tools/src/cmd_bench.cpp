@@ -150,6 +150,8 @@ int bench_odometry(const BenchOptions& o) {
   std::vector<double> voxels;
   std::vector<double> weakest;
   std::size_t wheel_rejected = 0;
+  std::size_t inertial = 0;
+  std::size_t standstill = 0;
   for (const BenchScan& scan : scans) {
     to_lidar_scan(scan, lidar_scan);
     const slam::OdometryResult& r = odometry.process(lidar_scan);
@@ -157,6 +159,8 @@ int bench_odometry(const BenchOptions& o) {
     degenerate += r.status == slam::OdometryStatus::degenerate ? 1 : 0;
     invalid += r.valid ? 0 : 1;
     wheel_rejected += r.wheel_rejected ? 1 : 0;
+    inertial += r.inertial ? 1 : 0;
+    standstill += r.standstill ? 1 : 0;
     iterations.push_back(r.registration.iterations);
     used_points.push_back(static_cast<double>(r.registration_points));
     if (r.registration_points > 0) voxels.push_back(r.registration_voxel_m);
@@ -175,9 +179,10 @@ int bench_odometry(const BenchOptions& o) {
                  counts.scans_without_wheels, wheel_rejected);
     if (can->has_imu()) {
       const daemon::ImuStats& imu = can->imu_stats();
-      fmt::print("IMU: {} readings ({} with gyro) at {:.1f} Hz; gravity's up held {} scans, {} without\n",
+      fmt::print("IMU: {} readings ({} with gyro) at {:.1f} Hz; gravity's up held {} scans, {} without; {} scans "
+                 "LiDAR-inertial, {} of them still (a zero-velocity update)\n",
                  imu.samples.load(), imu.gyro_samples.load(), imu.rate_hz.load(), counts.gravity_priors,
-                 counts.scans_without_gravity);
+                 counts.scans_without_gravity, inertial, standstill);
       if (const std::string problems = daemon::describe_problems(imu, "can"); !problems.empty())
         fmt::print("{}\n", problems);
     }

@@ -113,6 +113,12 @@ class InertialFilter {
   // body tangent at that pose ([v; ω], pose·exp(ε)).
   void update(const Eigen::Isometry3d& pose, const Matrix6d& body_covariance);
 
+  // Conditions the state on the body being still: velocity zero with σ
+  // `sigma_mps` per axis (a zero-velocity update, standstill.hpp). The
+  // Kalman update of the measurement v = 0 (H selects δv); through the
+  // covariance it also moves the pose, the biases and gravity.
+  void update_zero_velocity(double sigma_mps);
+
   const InertialState& state() const { return state_; }
   const Matrix18d& covariance() const { return covariance_; }
   const InertialConfig& config() const { return config_; }

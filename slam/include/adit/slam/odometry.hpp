@@ -23,6 +23,7 @@
 #include "adit/slam/inertial_filter.hpp"
 #include "adit/slam/map_insertion.hpp"
 #include "adit/slam/registration.hpp"
+#include "adit/slam/standstill.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
 
@@ -125,6 +126,9 @@ struct OdometryConfig {
   // teach the filter its gyroscope's bias. 0.03–0.3 m track every drive of
   // docs/decisions/020-lio-noise-and-scan-weight.md; 0.1 m in their middle.
   double inertial_point_sigma_m = 0.1;
+  // With the IMU: a zero-velocity update when the scan shows the body still
+  // (standstill.hpp).
+  StandstillConfig standstill;
 };
 
 // Body motion since the previous scan from wheel odometry, with its
@@ -165,6 +169,7 @@ struct OdometryResult {
   bool valid = false;       // the pose comes from registration
   bool wheel_rejected = false;  // the wheel prior disagreed with the scan (or the IMU); it was not used
   bool inertial = false;        // the IMU predicted and deskewed this scan
+  bool standstill = false;      // the body appeared still: the filter took a zero-velocity update
   Vector6d sweep_velocity = Vector6d::Zero();  // body twist per second over the scan, as deskewed
   RegistrationResult registration;
   std::size_t input_points = 0;
@@ -230,6 +235,7 @@ class Odometry {
   void start_inertial(const ScanInput& scan, const Matrix6d& body_covariance);
   InertialFilter inertial_;
   bool inertial_started_ = false;
+  Eigen::Vector3d updated_velocity_ = Eigen::Vector3d::Zero();  // the filter's after its last update (world)
   std::vector<TimedPose> sweep_motion_;  // the body over this sweep, from the scan start
   RegistrationConfig inertial_registration_;
   // Places deskewed_ at pose_ in the map once the body has moved since the
