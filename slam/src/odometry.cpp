@@ -232,6 +232,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // docs/decisions/012-start-search.md).
   if (!wheel && !velocity_known_ && dt > 0.0) {
     search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m, config_.wheel_rejection_margin,
+                 config_.start_search_noise_sigmas,
                  [&](const Eigen::Vector2d& offset) {
                    PosePrior start = constant_velocity;
                    start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);

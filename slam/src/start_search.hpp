@@ -5,6 +5,12 @@
 // offset's result replaces the best one when it explains clearly more of the
 // scan (`margin` more correspondences). Shared by the LiDAR-only step
 // (odometry.cpp) and the LiDAR-inertial one (odometry_inertial.cpp).
+//
+// The winner must also beat the prediction's own registration by more than
+// counting noise: `noise_sigmas`·√n correspondences, n the prediction's
+// count (a count's Poisson spread). Against a map of one scan taken at rest
+// both match a few dozen to a few hundred points, and a 5 % margin is a tie
+// (decision 040).
 
 #include <cmath>
 
@@ -17,7 +23,9 @@ namespace adit::slam {
 // `register_from(offset)` registers from the prediction moved by `offset`
 // (m, body x and y) and returns the result.
 template <typename RegisterFrom>
-void search_start(double reach_m, double step_m, double margin, RegisterFrom&& register_from, RegistrationResult& best) {
+void search_start(double reach_m, double step_m, double margin, double noise_sigmas, RegisterFrom&& register_from,
+                  RegistrationResult& best) {
+  const RegistrationResult predicted = best;
   const auto steps = static_cast<int>(std::floor(reach_m / step_m + 1e-9));
   for (int k = 1; k <= steps; ++k) {
     const double d = k * step_m;
@@ -28,6 +36,8 @@ void search_start(double reach_m, double step_m, double margin, RegisterFrom&& r
         best = alternative;
     }
   }
+  const double n = static_cast<double>(predicted.correspondences);
+  if (static_cast<double>(best.correspondences) - n <= noise_sigmas * std::sqrt(n)) best = predicted;
 }
 
 }  // namespace adit::slam

@@ -74,6 +74,9 @@ struct OdometryConfig {
   // max_start_speed_mps covers between the two scans (decision 012).
   double max_start_speed_mps = 10.0;
   double start_search_step_m = 0.5;
+  // The search's winner must beat the prediction's registration by this many
+  // √n correspondences (n the prediction's): more than counting noise (decision 040).
+  double start_search_noise_sigmas = 3.0;
   double max_scan_gap_s = 1.0;           // a longer gap forgets the velocity
   // The constant-velocity prediction's standard deviation per scan, used as a
   // weak prior so that degenerate directions stay anchored to the prediction.
