@@ -119,8 +119,9 @@ void Odometry::register_inertial(const ScanInput& scan, const std::optional<Moti
   const Eigen::Vector3d predicted_velocity = inertial_.state().velocity;
   const Matrix6d to_body = adjoint(registered.inverse());
   inertial_.update(registered, to_body * result.registration.covariance * to_body.transpose());
-  // Still wherever the scan can see, and nearly so in the filter's belief:
-  // still along the directions the scan cannot see too (standstill.hpp).
+  // Still wherever the scan can see, no acceleration felt, and slow in the
+  // filter's belief: still along the directions the scan cannot see too
+  // (standstill.hpp).
   result.standstill = appears_still(pose_, result.registration, dt, predicted_velocity,
                                     predicted_velocity - updated_velocity_, config_.standstill);
   if (result.standstill) inertial_.update_zero_velocity(config_.standstill.velocity_sigma_mps);

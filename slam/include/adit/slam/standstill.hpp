@@ -7,16 +7,15 @@
 //
 // Why: along a direction the scan cannot see (a drift's axis, a drone on
 // the floor of a tunnel) the filter's velocity is the integral of the
-// accelerometer's error: a 0.2° error of gravity's direction is 0.036 m/s²,
-// 7 cm in 2 s on the floor, and the map taken meanwhile is smeared along
-// the axis (docs/decisions/039-zero-velocity-update.md).
+// accelerometer's error, and the map taken meanwhile is smeared along that
+// axis (docs/decisions/039-zero-velocity-update.md).
 //
 // The test: every direction the scan does see is still between two scans,
-// and the filter itself already believes the body is nearly still. The
-// accelerometer alone cannot tell rest from a steady glide (a rotor's
-// vibration hides the rest of it), and the scan alone cannot see its
-// degenerate axis; together they leave only a body gliding slowly along
-// exactly that axis, without turning, which the speed gate keeps small.
+// the IMU felt no acceleration over the interval, and the filter's speed is
+// low. The scan alone cannot see its degenerate axis, and the accelerometer
+// alone cannot tell rest from a steady glide; together they leave only a
+// body gliding slowly along exactly that axis, without turning or
+// accelerating, which the speed gate keeps small.
 
 #include <Eigen/Geometry>
 
