@@ -20,6 +20,14 @@ Vector6d twist(double x, double y, double z, double rx = 0.0, double ry = 0.0, d
   return v;
 }
 
+// The same, registered in a corridor along x: that axis is the degenerate one.
+RegistrationResult registered_in_corridor(const Vector6d& motion) {
+  RegistrationResult r = registered(motion);
+  r.degenerate = true;
+  r.weakest_direction = twist(1.0, 0.0, 0.0);
+  return r;
+}
+
 const Eigen::Isometry3d kFrom = Eigen::Isometry3d::Identity();
 const Eigen::Vector3d kSlow(0.05, 0.0, 0.0);  // the filter's velocity, m/s
 const Eigen::Vector3d kNoChange(0.002, 0.0, 0.0);  // what the IMU added to it since the last scan
@@ -41,9 +49,7 @@ TEST(Standstill, MotionTheScanSeesIsNotStill) {
 // accelerometer does (0.5 m/s² for 0.1 s).
 TEST(Standstill, ABodySettingOffIsNotStill) {
   const StandstillConfig config;
-  RegistrationResult along_axis = registered(twist(0.0025, 0.0, 0.0));
-  along_axis.degenerate = true;
-  along_axis.weakest_direction = twist(1.0, 0.0, 0.0);
+  const RegistrationResult along_axis = registered_in_corridor(twist(0.0025, 0.0, 0.0));
   EXPECT_TRUE(appears_still(kFrom, along_axis, kDt, kSlow, kNoChange, config));
   EXPECT_FALSE(appears_still(kFrom, along_axis, kDt, kSlow, Eigen::Vector3d(0.05, 0.0, 0.0), config));
 }
@@ -51,24 +57,16 @@ TEST(Standstill, ABodySettingOffIsNotStill) {
 TEST(Standstill, TheDegenerateDirectionIsLeftOut) {
   const StandstillConfig config;
   // 2 cm along a corridor's axis: the prediction's, not the scan's.
-  RegistrationResult along_axis = registered(twist(0.02, 0.0, 0.0));
-  EXPECT_FALSE(appears_still(kFrom, along_axis, kDt, kSlow, kNoChange, config));
-  along_axis.degenerate = true;
-  along_axis.weakest_direction = twist(1.0, 0.0, 0.0);
-  EXPECT_TRUE(appears_still(kFrom, along_axis, kDt, kSlow, kNoChange, config));
+  EXPECT_FALSE(appears_still(kFrom, registered(twist(0.02, 0.0, 0.0)), kDt, kSlow, kNoChange, config));
+  EXPECT_TRUE(appears_still(kFrom, registered_in_corridor(twist(0.02, 0.0, 0.0)), kDt, kSlow, kNoChange, config));
   // Motion across it still counts.
-  RegistrationResult across = registered(twist(0.02, 0.01, 0.0));
-  across.degenerate = true;
-  across.weakest_direction = twist(1.0, 0.0, 0.0);
-  EXPECT_FALSE(appears_still(kFrom, across, kDt, kSlow, kNoChange, config));
+  EXPECT_FALSE(appears_still(kFrom, registered_in_corridor(twist(0.02, 0.01, 0.0)), kDt, kSlow, kNoChange, config));
 }
 
 TEST(Standstill, AFilterThatBelievesInMotionIsNotOverruled) {
   const StandstillConfig config;
-  RegistrationResult along_axis = registered(twist(0.1, 0.0, 0.0));
-  along_axis.degenerate = true;
-  along_axis.weakest_direction = twist(1.0, 0.0, 0.0);
-  EXPECT_FALSE(appears_still(kFrom, along_axis, kDt, Eigen::Vector3d(1.0, 0.0, 0.0), kNoChange, config));
+  EXPECT_FALSE(appears_still(kFrom, registered_in_corridor(twist(0.1, 0.0, 0.0)), kDt, Eigen::Vector3d(1.0, 0.0, 0.0),
+                             kNoChange, config));
   StandstillConfig off = config;
   off.enabled = false;
   EXPECT_FALSE(appears_still(kFrom, registered(Vector6d::Zero()), kDt, kSlow, kNoChange, off));
