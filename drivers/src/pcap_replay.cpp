@@ -14,8 +14,8 @@ std::filesystem::path pcap_part(const std::filesystem::path& first, int index) {
   return part;
 }
 
-PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed)
-    : reader_(file), first_(file), speed_(speed) {}
+PacedPcapReader::PacedPcapReader(const std::filesystem::path& file, double speed, std::int64_t max_catch_up_ns)
+    : reader_(file), first_(file), speed_(speed), max_catch_up_ns_(max_catch_up_ns) {}
 
 PcapStats PacedPcapReader::stats() const {
   PcapStats s = reader_.stats();
@@ -50,6 +50,9 @@ bool PacedPcapReader::next(UdpDatagram& out) {
   // that at once, and sleep_until does the same here.
   std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(due)));
   lateness_ns_ = monotonic_ns() - due;
+  // Too late to catch up: the schedule moves on by the lateness, so the
+  // datagrams after this one keep their recorded spacing from now.
+  if (lateness_ns_ > max_catch_up_ns_) start_monotonic_ns_ += lateness_ns_;
   return true;
 }
 

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 
 #include "adit/drivers/pcap_reader.hpp"
@@ -22,7 +23,14 @@ std::filesystem::path pcap_part(const std::filesystem::path& first, int index);
 class PacedPcapReader {
  public:
   // speed ≤ 0: no pacing. Throws adit::InputError as PcapReader does.
-  PacedPcapReader(const std::filesystem::path& file, double speed);
+  // A reader held up by more than max_catch_up_ns (a descheduled thread)
+  // resumes the recorded pace from where it is instead of releasing the
+  // overdue datagrams at once: a sensor never bursts, and a burst can
+  // overflow a receiver's socket buffer that the steady stream would not.
+  // The default catches up however late it is (a file replay's duration
+  // stays the recording's over the speed).
+  PacedPcapReader(const std::filesystem::path& file, double speed,
+                  std::int64_t max_catch_up_ns = std::numeric_limits<std::int64_t>::max());
 
   // The next datagram, once it is due; false at the end of the capture.
   bool next(UdpDatagram& out);
@@ -38,6 +46,7 @@ class PacedPcapReader {
   int part_ = 0;
   PcapStats earlier_parts_;
   double speed_;
+  std::int64_t max_catch_up_ns_;
   std::optional<std::int64_t> first_capture_ns_;
   std::int64_t start_monotonic_ns_ = 0;
   std::int64_t lateness_ns_ = 0;
