@@ -273,6 +273,11 @@ struct LidarSource::Impl {
       const auto host_time = [this](std::int64_t kernel_ns) {
         return kernel_ns > 0 ? host_clock.from_recent_realtime(kernel_ns) : host_clock.now_ns();
       };
+      // Drops before the session (while the pipeline waited) are not its own.
+      const auto kernel_drops = [this] {
+        return udp->stats().kernel_drops + (imu_udp ? imu_udp->stats().kernel_drops : 0);
+      };
+      const std::uint64_t drops_before = kernel_drops();
       while (reading()) {
         receiver.beat.beat();
         watch_the_clock();
@@ -280,11 +285,12 @@ struct LidarSource::Impl {
           stats.datagrams.fetch_add(1, std::memory_order_relaxed);
           push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port);
         }
-        if (!imu_udp) continue;
-        for (const drivers::ReceivedDatagram& d : imu_udp->receive(0)) {
-          stats.datagrams.fetch_add(1, std::memory_order_relaxed);
-          push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port, true);
-        }
+        if (imu_udp)
+          for (const drivers::ReceivedDatagram& d : imu_udp->receive(0)) {
+            stats.datagrams.fetch_add(1, std::memory_order_relaxed);
+            push(d.payload, host_time(d.kernel_time_ns), d.src_ip, d.src_port, true);
+          }
+        stats.socket_drops.store(kernel_drops() - drops_before, std::memory_order_relaxed);
       }
     }
     if (recorder) {

@@ -413,7 +413,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     const nlohmann::json summary = {
         {"session", id},
         {"lidar", {{"model", config_.lidar.model}, {"datagrams", s.datagrams.load()},
-                   {"dropped_packets", s.dropped_packets.load()}, {"bad_packets", s.bad_packets.load()},
+                   {"dropped_packets", s.dropped_packets.load()}, {"socket_drops", s.socket_drops.load()},
+                   {"bad_packets", s.bad_packets.load()},
                    {"missing_packets", s.missing_packets.load()}, {"duplicate_packets", s.duplicate_packets.load()},
                    {"late_packets", s.late_packets.load()}, {"resyncs", s.resyncs.load()},
                    {"silences", s.silences.load()}, {"longest_silence_s", 1e-9 * static_cast<double>(s.longest_silence_ns.load())},
@@ -562,6 +563,9 @@ std::string Sessions::session_faults(const PipelineStats& s, std::uint64_t datag
   if (s.dropped_packets.load() + s.dropped_scans.load() > 0)
     add(fmt::format("dropped {} packets, {} scans: a stage is too slow", s.dropped_packets.load(),
                     s.dropped_scans.load()));
+  if (s.socket_drops.load() > 0)
+    add(fmt::format("{} datagrams overflowed the socket's receive buffer: the receiver was held up (lidar.receive_buffer_bytes, CPU load)",
+                    s.socket_drops.load()));
   if (s.missing_packets.load() + s.duplicate_packets.load() + s.late_packets.load() > 0)
     add(fmt::format("LiDAR link: {} packets missing ({:.1f} %), {} repeated, {} late (skipped)",
                     s.missing_packets.load(),

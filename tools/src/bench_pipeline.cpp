@@ -174,8 +174,9 @@ int bench_pipeline(const BenchPipelineOptions& o) {
   }
   fmt::print("capture {} ({}) at {}x the recorded rate\n\n", config.lidar.pcap, config.lidar.model, o.speed);
   fmt::print("from the file (no network):\n{}\n", figures_text(file, 0.1));
-  fmt::print("over UDP loopback: sent {} datagrams ({} refused), received {}, lost {}\n{}\n", udp.sent.sent,
-             udp.sent.refused, udp.figures.datagrams, lost, figures_text(udp.figures, 0.1));
+  fmt::print("over UDP loopback: sent {} datagrams ({} refused), received {}, lost {} ({} overflowed the socket's buffer)\n{}\n",
+             udp.sent.sent, udp.sent.refused, udp.figures.datagrams, lost, udp.figures.socket_drops,
+             figures_text(udp.figures, 0.1));
   // The latency starts when the receiver hands the last packet of a scan on,
   // so the kernel's loopback hop itself is outside it; what the network source
   // changes is the receiver's batching and scheduling, seen beyond odometry.

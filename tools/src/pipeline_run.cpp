@@ -71,6 +71,7 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.degenerate_poses = s.degenerate_poses.load();
   f.bad_packets = s.bad_packets.load();
   f.dropped_packets = s.dropped_packets.load();
+  f.socket_drops = s.socket_drops.load();
   f.dropped_scans = s.dropped_scans.load();
   const daemon::PipelineTimings& t = pipeline.timings();
   f.odometry_median_ms = quantile(t.odometry_ms, 0.5);
@@ -134,6 +135,7 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
       {"degenerate_poses", f.degenerate_poses},
       {"bad_packets", f.bad_packets},
       {"dropped_packets", f.dropped_packets},
+      {"socket_drops", f.socket_drops},
       {"dropped_scans", f.dropped_scans},
       {"odometry_ms", {{"median", f.odometry_median_ms}, {"p99", f.odometry_p99_ms}}},
       {"latency_ms", {{"median", f.latency_median_ms}, {"p99", f.latency_p99_ms}, {"max", f.latency_max_ms}}},

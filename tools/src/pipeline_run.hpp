@@ -48,6 +48,7 @@ struct PipelineFigures {
   std::uint64_t degenerate_poses = 0;
   std::uint64_t bad_packets = 0;
   std::uint64_t dropped_packets = 0;
+  std::uint64_t socket_drops = 0;  // udp: the kernel's, the receive buffer full
   std::uint64_t dropped_scans = 0;
   double odometry_median_ms = 0.0;
   double odometry_p99_ms = 0.0;

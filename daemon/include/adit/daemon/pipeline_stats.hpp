@@ -35,6 +35,10 @@ struct PipelineStats {
   std::atomic<std::uint64_t> foreign_datagrams{0}; // not on the data port
   std::atomic<std::uint64_t> stale_datagrams{0};   // udp: in the socket before start(), discarded
   std::atomic<std::uint64_t> dropped_packets{0};   // live: dropped because assembly fell behind
+  // udp: dropped by the kernel because the socket's receive buffer was full
+  // (SO_RXQ_OVFL; the receiver was held up). The assembler also counts them
+  // among missing_packets, where they look like link loss: this says whose.
+  std::atomic<std::uint64_t> socket_drops{0};
   std::atomic<std::uint64_t> scans{0};
   std::atomic<std::uint64_t> dropped_scans{0};     // live: dropped because odometry fell behind
   std::atomic<std::uint64_t> incomplete_scans{0};
