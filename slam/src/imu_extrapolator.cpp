@@ -25,7 +25,9 @@ void ImuExtrapolator::step(const ImuSample& from, const ImuSample& to) {
 void ImuExtrapolator::anchor(const InertialState& state) {
   anchor_ = state;
   current_ = state;
-  current_valid_ = true;
+  // Readings already past the horizon (a replayed log read far ahead): none
+  // of them, nor any later one, gives a pose from this anchor.
+  current_valid_ = count_ == 0 || kept(count_ - 1).t - state.t <= config_.max_horizon_s;
   // Again through the readings since the anchor, each from the one before
   // it (the first kept one from itself, held back to the anchor).
   for (std::size_t i = 0; i < count_ && current_valid_; ++i) {
