@@ -291,6 +291,7 @@ void CanFeed::run() {
     } else {
       frame.time_us = i.host_clock.from_recent_realtime(frame.time_us * 1000) / 1000;
     }
+    const std::int64_t received_mono_ns = monotonic_ns();  // the IMU-rate pose's latency counts from here
     stats_.frames.fetch_add(1, std::memory_order_relaxed);
     stats_.last_frame_us.store(frame.time_us, std::memory_order_relaxed);
     if (i.recorder) {
@@ -360,6 +361,7 @@ void CanFeed::run() {
         imu_stats_.samples.fetch_add(1, std::memory_order_relaxed);
         if (body.has_gyro) imu_stats_.gyro_samples.fetch_add(1, std::memory_order_relaxed);
         imu_stats_.last_seen_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+        if (pose_feed_ != nullptr && body.has_gyro) pose_feed_->reading(body, received_mono_ns);
       }
       if (stopped) break;
     }

@@ -127,7 +127,7 @@ struct LidarSource::Impl {
     const bool replay = c.lidar.source == config::LidarSource::pcap;
     if (c.imu.source == config::ImuSource::ouster) {
       auto ouster = std::make_unique<OusterImu>(c, drivers::load_ouster_metadata(c.lidar.calibration), replay);
-      imu_port = c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : ouster->port();
+      imu_port = lidar_imu_port(c);
       if (imu_port == data_port)
         throw InputError(c.lidar.imu_port != 0 ? std::string() : c.lidar.calibration,
                          c.lidar.imu_port != 0 ? "lidar.imu_port" : "udp_port_imu",
@@ -137,8 +137,7 @@ struct LidarSource::Impl {
       const std::optional<drivers::LivoxModel> livox = drivers::livox_model_from_name(c.lidar.model);
       if (!livox) throw InputError("", "imu.source", "livox needs a Livox LiDAR, not " + c.lidar.model);
       imu = std::make_unique<LivoxImu>(c, livox_imu_mounting(*livox, c.lidar.extrinsics), replay);
-      const std::uint16_t port =
-          c.lidar.imu_port != 0 ? static_cast<std::uint16_t>(c.lidar.imu_port) : drivers::livox_imu_port(*livox);
+      const std::uint16_t port = lidar_imu_port(c);
       imu_port = port != data_port ? port : 0;  // 0: on the data port
       imu_among_points = true;
     }
@@ -331,13 +330,13 @@ struct LidarSource::Impl {
       assembly.beat.beat();
       const std::span<const std::uint8_t> payload(packet->data.data(), packet->size);
       if (packet->imu) {
-        imu->push(payload, packet->host_time_ns, stream->clock());
+        imu->push(payload, packet->host_time_ns, packet->received_mono_ns, stream->clock());
       } else {
         current_packet_mono_ns = packet->received_mono_ns;
         if (!period_learnt) learn_packet_period(payload);
         const drivers::PacketStatus status = stream->push(payload, packet->host_time_ns);
         if (imu_among_points && status == drivers::PacketStatus::auxiliary)
-          imu->push(payload, packet->host_time_ns, stream->clock());
+          imu->push(payload, packet->host_time_ns, packet->received_mono_ns, stream->clock());
       }
       packets->release(packet);
     }
@@ -431,5 +430,15 @@ std::size_t LidarSource::packets_waiting() const { return impl_->packets->depth(
 std::size_t LidarSource::packet_capacity() const { return impl_->packets->capacity(); }
 std::size_t LidarSource::packet_bytes() const { return packet_bytes_for(impl_->decoder.get()); }
 PacketImu* LidarSource::imu() { return impl_->imu.get(); }
+
+std::uint16_t lidar_imu_port(const config::Config& c) {
+  if (c.lidar.imu_port != 0) return static_cast<std::uint16_t>(c.lidar.imu_port);
+  if (!c.imu.enabled) return 0;
+  if (c.imu.source == config::ImuSource::ouster) return drivers::load_ouster_metadata(c.lidar.calibration).udp_port_imu;
+  if (c.imu.source == config::ImuSource::livox)
+    if (const std::optional<drivers::LivoxModel> livox = drivers::livox_model_from_name(c.lidar.model))
+      return drivers::livox_imu_port(*livox);
+  return 0;
+}
 
 }  // namespace adit::daemon

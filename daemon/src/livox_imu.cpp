@@ -22,7 +22,7 @@ LivoxImu::LivoxImu(const config::Config& config, const ImuMounting& mounting, bo
     : PacketImu(config, mounting, replay) {}
 
 void LivoxImu::push(std::span<const std::uint8_t> payload, std::int64_t /*host_time_ns*/,
-                    const drivers::ClockOffsetEstimator& lidar_clock) {
+                    std::int64_t received_mono_ns, const drivers::ClockOffsetEstimator& lidar_clock) {
   const std::uint64_t n = count_packet();
   const std::optional<drivers::LivoxImuReading> raw = drivers::decode_livox_imu(payload);
   if (!raw) {
@@ -36,7 +36,7 @@ void LivoxImu::push(std::span<const std::uint8_t> payload, std::int64_t /*host_t
   }
   hand_on(Eigen::Vector3d(raw->accel_m_s2[0], raw->accel_m_s2[1], raw->accel_m_s2[2]),
           Eigen::Vector3d(raw->gyro_rad_s[0], raw->gyro_rad_s[1], raw->gyro_rad_s[2]), raw->sensor_time_ns,
-          lidar_clock, n);
+          lidar_clock, n, received_mono_ns);
 }
 
 }  // namespace adit::daemon

@@ -35,7 +35,7 @@ OusterImu::OusterImu(const config::Config& config, const drivers::OusterMetadata
                      "imu.source ouster reads the LEGACY IMU profile (48-byte packets), not " + metadata.imu_profile);
 }
 
-void OusterImu::push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
+void OusterImu::push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns, std::int64_t received_mono_ns,
                      const drivers::ClockOffsetEstimator& lidar_clock) {
   const std::uint64_t n = count_packet();
   drivers::OusterImuSample raw;
@@ -57,7 +57,8 @@ void OusterImu::push(std::span<const std::uint8_t> payload, std::int64_t host_ti
                                   std::memory_order_relaxed);
   }
   hand_on(Eigen::Vector3d(raw.accel_mps2[0], raw.accel_mps2[1], raw.accel_mps2[2]),
-          Eigen::Vector3d(raw.gyro_radps[0], raw.gyro_radps[1], raw.gyro_radps[2]), accel_time_ns, lidar_clock, n);
+          Eigen::Vector3d(raw.gyro_radps[0], raw.gyro_radps[1], raw.gyro_radps[2]), accel_time_ns, lidar_clock, n,
+          received_mono_ns);
 }
 
 }  // namespace adit::daemon

@@ -29,7 +29,8 @@ bool PacketImu::near_lidar(const drivers::ClockEstimate& lidar, std::int64_t sen
 }
 
 void PacketImu::hand_on(const Eigen::Vector3d& specific_force, const Eigen::Vector3d& angular_rate,
-                        std::int64_t sensor_ns, const drivers::ClockOffsetEstimator& lidar_clock, std::uint64_t n) {
+                        std::int64_t sensor_ns, const drivers::ClockOffsetEstimator& lidar_clock, std::uint64_t n,
+                        std::int64_t received_mono_ns) {
   slam::ImuSample r;
   r.t = 1e-9 * static_cast<double>(lidar_clock.to_host(sensor_ns)) - time_offset_s_;
   r.specific_force = specific_force;
@@ -46,6 +47,7 @@ void PacketImu::hand_on(const Eigen::Vector3d& specific_force, const Eigen::Vect
   stats_.gyro_samples.fetch_add(1, std::memory_order_relaxed);
   stats_.dropped.store(readings_.dropped(), std::memory_order_relaxed);
   stats_.last_seen_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
+  if (pose_feed_ != nullptr) pose_feed_->reading(r, received_mono_ns);
 }
 
 void PacketImu::catch_up(double until_t, const std::function<bool()>& idle) {

@@ -54,6 +54,15 @@ struct Pipeline::Impl {
       mapping->feed_loops(&loops->input());
     }
     open_files(o.trajectory_file, o.map_trajectory_file, o.record_file);
+    if (ImuSource* imu = imu_source_of(c, can.get(), source); imu != nullptr && c.imu.pose_horizon_s > 0.0) {
+      slam::ImuExtrapolatorConfig x;
+      x.max_sample_gap_s = odometry_config.inertial.max_sample_gap_s;
+      x.imu_position = imu->mounting().position_m;  // as the odometry's filter has it
+      x.max_horizon_s = c.imu.pose_horizon_s;
+      imu_poses.emplace(x, o.sinks.imu_pose);
+      imu->feed_poses_to(&*imu_poses);
+      odometry.anchor_imu_poses_in(&*imu_poses);
+    }
   }
 
   void open_files(const std::filesystem::path& trajectory_file, const std::filesystem::path& map_trajectory_file,
@@ -84,6 +93,7 @@ struct Pipeline::Impl {
   std::optional<MappingStage> mapping;
   std::optional<LoopClosureStage> loops;
   std::optional<JournalWriter> journal;
+  std::optional<ImuPoseFeed> imu_poses;  // the sources' threads read it: joined before it goes
   slam::TiledVoxelMap empty_map;  // map() without mapping
   std::vector<slam::Keyframe> no_keyframes;
   mutable std::mutex warnings_mutex;  // start() writes, the status reads: never per item
@@ -187,6 +197,7 @@ const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_
 const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &*impl_->loops : nullptr; }
 const JournalWriter* Pipeline::journal() const { return impl_->journal ? &*impl_->journal : nullptr; }
 const CanFeedStats* Pipeline::can_stats() const { return impl_->can ? &impl_->can->stats() : nullptr; }
+const ImuPoseFeed* Pipeline::imu_poses() const { return impl_->imu_poses ? &*impl_->imu_poses : nullptr; }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

@@ -14,6 +14,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/daemon/allocator.hpp"
+#include "adit/daemon/imu_pose_publisher.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
 #include "adit/daemon/payload_panel.hpp"
 #include "adit/daemon/sessions.hpp"
@@ -148,6 +149,12 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
               bytes / 1e6, seconds);
     e->session_stopped();
   };
+  // The IMU-rate pose goes out on the IMU's thread by an LCM instance of its own (imu_pose_publisher.hpp).
+  std::optional<ImuPosePublisher> imu_poses;
+  if (config.imu.enabled && config.imu.pose_horizon_s > 0.0) {
+    imu_poses.emplace(config.lcm.url, config.payload.id);
+    outputs.imu_pose = [&imu_poses](const slam::InertialState& s) { imu_poses->publish(s); };
+  }
   Sessions sessions(config, std::move(outputs));
 
   SessionHooks hooks;

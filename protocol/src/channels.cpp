@@ -25,6 +25,7 @@ std::string_view channel_kind(Channel channel) {
     case Channel::tile_request: return "TILE_REQUEST";
     case Channel::file_request: return "FILE_REQUEST";
     case Channel::file: return "FILE";
+    case Channel::imu_pose: return "POSE_IMU";
   }
   return "UNKNOWN";
 }

@@ -40,7 +40,7 @@ TEST(ImuNoAllocation, OusterImuPacketsToTheOdometryAllocateNothing) {
     const auto packet = imu_packet(t, 1e-4F * static_cast<float>(i % 7));
     const std::int64_t host = 1'700'000'000'000'000'000 + static_cast<std::int64_t>(t);
     clock.add(static_cast<std::int64_t>(t), host);  // the LiDAR's packets, going on beside the IMU's
-    imu.push(packet, host, clock);
+    imu.push(packet, host, 0, clock);
     if (i % 10 == 0) imu.catch_up(1e30, {});
   }
   EXPECT_EQ(test::allocations() - before, 0U);

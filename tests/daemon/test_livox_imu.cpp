@@ -36,7 +36,7 @@ TEST(LivoxImu, PacketsBecomeBodyFrameReadingsOnTheHostClock) {
   LivoxImu imu(config, mounting, false);
   drivers::ClockOffsetEstimator clock;
   const std::int64_t t0 = 5'000'000'000;
-  imu.push(packet(t0, 0), t0 + kHostMinusSensor, clock);  // no clock yet: unclocked
+  imu.push(packet(t0, 0), t0 + kHostMinusSensor, 0, clock);  // no clock yet: unclocked
   EXPECT_EQ(imu.imu_stats().count(ImuProblem::unclocked), 1U);
   clock.add(t0, t0 + kHostMinusSensor);
   ADIT_REQUIRE_ALLOCATION_COUNTING();
@@ -44,7 +44,7 @@ TEST(LivoxImu, PacketsBecomeBodyFrameReadingsOnTheHostClock) {
   for (int i = 0; i < 400; ++i) {
     const std::int64_t t = t0 + 5'000'000LL * i;  // 200 Hz
     clock.add(t, t + kHostMinusSensor);
-    imu.push(packet(t, 1e-4F * static_cast<float>(i % 3)), t + kHostMinusSensor, clock);
+    imu.push(packet(t, 1e-4F * static_cast<float>(i % 3)), t + kHostMinusSensor, 0, clock);
     if (i % 10 == 0) imu.catch_up(1e30, {});
   }
   EXPECT_EQ(test::allocations() - before, 0U);
@@ -57,7 +57,7 @@ TEST(LivoxImu, PacketsBecomeBodyFrameReadingsOnTheHostClock) {
   EXPECT_NEAR(mean->x(), -0.1 * 9.80665, 0.01);
   EXPECT_NEAR(mean->z(), 9.80665, 0.01);
   const Packet damaged = packet(t0, 0);
-  imu.push(std::span(damaged.data(), damaged.size() - 1), 0, clock);
+  imu.push(std::span(damaged.data(), damaged.size() - 1), 0, 0, clock);
   EXPECT_EQ(imu.imu_stats().count(ImuProblem::undecodable), 1U);
 }
 

@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   while (offset < size) {
     const std::size_t n = std::min(size - offset, drivers::kOusterImuPacketBytes);
     host_ns += 10'000'000;
-    imu.push(std::span<const std::uint8_t>(data + offset, n), host_ns, clock);
+    imu.push(std::span<const std::uint8_t>(data + offset, n), host_ns, 0, clock);
     offset += n;
   }
   imu.close();

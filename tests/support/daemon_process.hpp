@@ -99,9 +99,18 @@ inline std::string aditd_yaml_for(const std::filesystem::path& session, const st
   };
   if (!edits.payload.empty()) replace_line("\n  id: ", "\n  id: " + edits.payload);
   replace_line("\n  state_dir: ", "\n  state_dir: " + state_dir.string());
-  replace_line("\n  pcap: ", "\n  pcap: " + (session / "lidar.pcap").string());
-  replace_line("\n  calibration: ", "\n  calibration: " + (session / "VLP16.yaml").string());
-  replace_line("\n  log: ", "\n  log: " + (session / "can.log").string());
+  // The session's files (the capture, the LiDAR's calibration or metadata, the CAN log) by absolute path.
+  const auto in_session = [&](const std::string& start) {
+    const std::size_t at = yaml.find(start);
+    if (at == std::string::npos) return;
+    const std::size_t from = at + start.size();
+    const std::size_t end = yaml.find('\n', from);
+    const std::string name = yaml.substr(from, (end == std::string::npos ? yaml.size() : end) - from);
+    replace_line(start, start + (session / name).string());
+  };
+  in_session("\n  pcap: ");
+  in_session("\n  calibration: ");
+  in_session("\n  log: ");
   if (!edits.lcm_url.empty()) replace_line("\n  url: ", "\n  url: " + edits.lcm_url);
   if (edits.as_fast_as_possible) replace_line("\n  replay_speed: ", "\n  replay_speed: 0");
   return yaml + edits.extra_yaml;

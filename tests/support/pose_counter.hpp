@@ -1,6 +1,7 @@
 #pragma once
 // Counts the pose_t messages of one payload on its own LCM socket, as a
-// tablet receives them, and keeps the stamp of the newest.
+// tablet (or, on POSE_IMU, a flight controller) receives them, and keeps the
+// stamp of the newest.
 
 #include <atomic>
 #include <cstdint>
@@ -17,8 +18,9 @@ namespace adit::test {
 
 class PoseCounter {
  public:
-  PoseCounter(const std::string& url, const std::string& payload) : lcm_(url) {
-    lcm_.subscribe(protocol::channel_name(payload, protocol::Channel::pose), &PoseCounter::on_pose, this);
+  PoseCounter(const std::string& url, const std::string& payload, protocol::Channel channel = protocol::Channel::pose)
+      : lcm_(url) {
+    lcm_.subscribe(protocol::channel_name(payload, channel), &PoseCounter::on_pose, this);
     thread_ = std::thread([this] {
       while (running_) lcm_.handleTimeout(20);
     });

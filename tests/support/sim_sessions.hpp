@@ -22,4 +22,15 @@ inline std::filesystem::path mine_drive_12s() {
   return dir;
 }
 
+// A 9 s walk through the mine with a hand-held OS1-64, its IMU packets in the capture (seed 1).
+inline std::filesystem::path handheld_os1_9s() {
+  const std::filesystem::path dir = binary_dir() / "session-handheld-os1";
+  if (!std::filesystem::exists(dir / "lidar.pcap")) {
+    const CommandRun sim = run_adit(fmt::format(
+        "sim --scene mine --platform handheld --sensor OS1-64 --duration 9 --seed 1 --out {}", dir.string()));
+    EXPECT_EQ(sim.status, 0) << sim.output;
+  }
+  return dir;
+}
+
 }  // namespace adit::test

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include "adit/daemon/imu_pose_feed.hpp"
 #include "adit/daemon/imu_stats.hpp"
 #include "adit/slam/motion_history.hpp"
 
@@ -42,6 +43,13 @@ class ImuSource {
   virtual const ImuStats& imu_stats() const = 0;
   // "can" or "ouster", for the status and the reports.
   virtual const char* imu_name() const = 0;
+
+  // Before the source's thread starts: every reading handed to the odometry
+  // also goes to `feed`, on the source's thread (the IMU-rate pose).
+  void feed_poses_to(ImuPoseFeed* feed) { pose_feed_ = feed; }
+
+ protected:
+  ImuPoseFeed* pose_feed_ = nullptr;
 };
 
 // Readings a history keeps: 40 s at 100 Hz, 10 s at 400 Hz.

@@ -79,4 +79,9 @@ class LidarSource {
   Handoff<ScanSlot> scans_;
 };
 
+// The UDP port the LiDAR's own IMU sends to (imu.source ouster or livox):
+// lidar.imu_port, else the Ouster's metadata (udp_port_imu) or the Livox
+// model's; 0 without one. Throws adit::InputError for unreadable metadata.
+std::uint16_t lidar_imu_port(const config::Config& c);
+
 }  // namespace adit::daemon

@@ -37,7 +37,7 @@ class LivoxImu final : public PacketImu {
   LivoxImu(const config::Config& config, const ImuMounting& mounting, bool replay);
 
   // Assembly thread: one IMU datagram received at `host_time_ns`; `lidar_clock` is the LiDAR stream's estimate.
-  void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
+  void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns, std::int64_t received_mono_ns,
             const drivers::ClockOffsetEstimator& lidar_clock) override;
 
   const char* imu_name() const override { return "livox"; }

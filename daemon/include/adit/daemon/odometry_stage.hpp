@@ -44,6 +44,8 @@ class OdometryStage {
   std::int64_t last_stamp_ns() const { return last_stamp_ns_; }
   // The IMU source's figures into the pipeline's stats (the odometry thread after each scan; anyone after join()).
   void copy_imu_stats();
+  // Before start(): each LiDAR-inertial scan's filter state anchors the IMU-rate pose.
+  void anchor_imu_poses_in(ImuPoseFeed* feed) { imu_poses_ = feed; }
 
  private:
   void loop();
@@ -58,6 +60,7 @@ class OdometryStage {
   std::optional<Handoff<MapSlot>> map_slots_;
   std::int64_t first_stamp_ns_ = 0;
   std::int64_t last_stamp_ns_ = 0;
+  ImuPoseFeed* imu_poses_ = nullptr;
 };
 
 }  // namespace adit::daemon

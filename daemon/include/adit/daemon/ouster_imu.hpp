@@ -44,8 +44,9 @@ class OusterImu final : public PacketImu {
   std::uint16_t port() const { return port_; }
 
   // Assembly thread: one datagram from the IMU port, received at
-  // `host_time_ns`; `lidar_clock` is the LiDAR stream's sensor-clock estimate.
-  void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
+  // `host_time_ns` (monotonic: `received_mono_ns`); `lidar_clock` is the
+  // LiDAR stream's sensor-clock estimate.
+  void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns, std::int64_t received_mono_ns,
             const drivers::ClockOffsetEstimator& lidar_clock) override;
 
   const char* imu_name() const override { return "ouster"; }

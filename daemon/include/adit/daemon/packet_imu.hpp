@@ -37,10 +37,11 @@ class PacketImu : public ImuSource {
   // IMU packet that arrived before it has been pushed (a replay's catch_up
   // stops waiting once the LiDAR is 0.1 s past what it waits for).
   void lidar_reached(double t) { lidar_t_.store(t, std::memory_order_release); }
-  // Assembly thread: one IMU datagram received at `host_time_ns`;
-  // `lidar_clock` is the LiDAR stream's sensor-clock estimate. A damaged or
-  // unclockable packet is counted (ImuMonitor), never thrown.
-  virtual void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns,
+  // Assembly thread: one IMU datagram received at `host_time_ns`
+  // (monotonic: `received_mono_ns`, from which the IMU-rate pose's latency
+  // counts); `lidar_clock` is the LiDAR stream's sensor-clock estimate. A
+  // damaged or unclockable packet is counted (ImuMonitor), never thrown.
+  virtual void push(std::span<const std::uint8_t> payload, std::int64_t host_time_ns, std::int64_t received_mono_ns,
                     const drivers::ClockOffsetEstimator& lidar_clock) = 0;
   // Assembly thread: no more packets.
   void close() { readings_.close(); }
@@ -62,9 +63,9 @@ class PacketImu : public ImuSource {
   static bool near_lidar(const drivers::ClockEstimate& lidar, std::int64_t sensor_ns);
   // Assembly thread: packet `n`'s reading in the IMU's axes, stamped at
   // `sensor_ns` on the sensor clock `lidar_clock` estimates (checked by
-  // near_lidar), on to the odometry.
+  // near_lidar), on to the odometry and the IMU-rate pose.
   void hand_on(const Eigen::Vector3d& specific_force, const Eigen::Vector3d& angular_rate, std::int64_t sensor_ns,
-               const drivers::ClockOffsetEstimator& lidar_clock, std::uint64_t n);
+               const drivers::ClockOffsetEstimator& lidar_clock, std::uint64_t n, std::int64_t received_mono_ns);
 
   ImuStats stats_;
   ImuMonitor monitor_;

@@ -28,6 +28,8 @@
 
 namespace adit::daemon {
 
+class ImuPoseFeed;
+
 class LoopClosureStage;
 class JournalWriter;
 struct CanFeedStats;
@@ -107,6 +109,8 @@ class Pipeline {
   const JournalWriter* journal() const;
   // The CAN thread's counters (bus health, frames); null without a CAN feed.
   const CanFeedStats* can_stats() const;
+  // The IMU-rate pose (its count, and its latencies after join()); null without an IMU or with imu.pose_horizon_s 0.
+  const ImuPoseFeed* imu_poses() const;
 
  private:
   struct Impl;

@@ -64,6 +64,8 @@ class ScanOdometry {
   const MotionAidCounts& counts() const { return counts_; }
   // The IMU the odometry reads (its readings, mounting and stats), or null.
   const ImuSource* imu() const { return imu_; }
+  // The LiDAR-inertial filter's state after the last scan it corrected (result().inertial).
+  const slam::InertialState& inertial_state() const { return odometry_.inertial().state(); }
 
  private:
   std::optional<slam::MotionPrior> wheel_prior_for(double previous, double t);

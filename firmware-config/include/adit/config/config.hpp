@@ -142,6 +142,10 @@ struct ImuSection {
   double accel_noise_density = 2.0e-3;   // m/s²/√Hz
   double gyro_bias_walk = 1.9e-5;        // rad/s²/√Hz
   double accel_bias_walk = 3.0e-3;       // m/s³/√Hz
+  // The pose at the IMU's rate (LCM POSE_IMU, for a flight controller) goes
+  // on this long past the latest LiDAR-inertial scan, then stops until the
+  // next one (dead reckoning on a MEMS unit is metres off within seconds); 0 = none.
+  double pose_horizon_s = 0.5;
 };
 
 // A GPIO line: by offset on the chip, or by its name (one of them).

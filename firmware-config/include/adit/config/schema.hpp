@@ -169,6 +169,7 @@ void describe(V& v, ImuSection& s) {
   v.optional("accel_noise_density", s.accel_noise_density, Range<double>{1e-6, 10.0});
   v.optional("gyro_bias_walk", s.gyro_bias_walk, Range<double>{0.0, 1.0});
   v.optional("accel_bias_walk", s.accel_bias_walk, Range<double>{0.0, 10.0});
+  v.optional("pose_horizon_s", s.pose_horizon_s, Range<double>{0.0, 10.0});
 }
 
 template <typename V>

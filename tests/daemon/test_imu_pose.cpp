@@ -1,0 +1,154 @@
+// The pose at the IMU's rate (daemon/imu_pose_feed.hpp, imu_pose_publisher.hpp):
+// on LCM, each as pose_t on ADIT/<payload>/POSE_IMU; from aditd's pipeline on
+// a simulated LiDAR-inertial walk, one pose per IMU reading that follows the
+// true path as closely as the scan-rate poses do; from aditd itself.
+
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "../slam/smooth_motion.hpp"
+#include "adit/config/load.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
+#include "adit/daemon/imu_pose_publisher.hpp"
+#include "adit/daemon/pipeline.hpp"
+#include "adit/pose_t.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/protocol/checked_decode.hpp"
+#include "adit/slam/tum.hpp"
+#include "pipeline_run.hpp"
+#include "pose_counter.hpp"
+#include "run_program.hpp"
+#include "sim_sessions.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using slam::test::Motion;
+
+constexpr double kRate = 200.0;
+
+TEST(ImuPosePublisher, EachPoseGoesOutOnPoseImu) {
+  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 23) % 30000);
+  const std::string payload = fmt::format("imu{}", ::getpid());
+  lcm::LCM listener(url);
+  std::vector<pose_t> received;
+  struct Handler {
+    std::vector<pose_t>* out;
+    void on(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      pose_t p;
+      if (protocol::checked_decode(rbuf->data, rbuf->data_size, p)) out->push_back(p);
+    }
+  } handler{&received};
+  listener.subscribe(protocol::channel_name(payload, protocol::Channel::imu_pose), &Handler::on, &handler);
+
+  ImuPosePublisher publisher(url, payload);
+  const Motion m;
+  for (int k = 0; k < 20; ++k) {
+    publisher.publish(m.state(1.0 + k / kRate));
+  }
+  for (int i = 0; i < 100 && received.size() < 20; ++i) listener.handleTimeout(20);
+  ASSERT_EQ(received.size(), 20U);
+  EXPECT_EQ(publisher.published(), 20U);
+  for (std::size_t k = 0; k < received.size(); ++k) {
+    const pose_t& p = received[k];
+    const double t = 1.0 + static_cast<double>(k) / kRate;
+    EXPECT_EQ(p.seq, static_cast<std::int64_t>(k));
+    EXPECT_EQ(p.utime, static_cast<std::int64_t>(t * 1e6));
+    EXPECT_EQ(p.flags, pose_t::FLAG_VALID);
+    const Eigen::Vector3d truth = m.position(t);
+    EXPECT_NEAR(p.position[0], truth.x(), 1e-9);
+    EXPECT_NEAR(p.position[2], truth.z(), 1e-9);
+    const Eigen::Quaterniond q(m.rotation(t));
+    EXPECT_NEAR(std::abs(p.orientation[0] * q.w() + p.orientation[1] * q.x() + p.orientation[2] * q.y() +
+                         p.orientation[3] * q.z()),
+                1.0, 1e-9);
+  }
+}
+
+// aditd's pipeline replaying a simulated hand-held walk (OS1-64, its IMU at
+// 100 Hz in the same capture) at the recorded pace, as a live sensor sends
+// it: a pose per IMU reading, scored against the truth as the scan-rate
+// trajectory is. (A CAN log is read ahead of the LiDAR in a replay: its
+// readings pass the horizon, and the IMU-rate pose is a live matter there.)
+TEST(ImuPose, ThePipelineGivesAPosePerImuReadingThatFollowsTheTruth) {
+  const std::filesystem::path session = test::handheld_os1_9s();
+  const std::filesystem::path work = test::binary_dir() / fmt::format("imu-pose-{}", ::getpid());
+  std::filesystem::remove_all(work);
+  config::Config c = config::load_config(session / "session.yaml");
+  c.payload.state_dir = (work / "state").string();
+  c.threads.lock_memory = false;
+  ASSERT_TRUE(c.imu.enabled);
+  ASSERT_EQ(c.lidar.replay_speed, 1.0);
+  slam::Trajectory imu_rate;
+  imu_rate.stamps.reserve(4000);
+  imu_rate.poses.reserve(4000);
+  PipelineOptions options;
+  options.trajectory_file = work / "trajectory.tum";
+  options.mapping = false;
+  options.sinks.imu_pose = [&](const slam::InertialState& s) {
+    imu_rate.stamps.push_back(s.t);
+    imu_rate.poses.push_back(s.pose);
+  };
+  Pipeline pipeline(c, options);
+  pipeline.start();
+  pipeline.join();
+  ASSERT_NE(pipeline.imu_poses(), nullptr);
+  EXPECT_EQ(pipeline.imu_poses()->poses(), imu_rate.size());
+  // 9 s at 100 Hz, from the first LiDAR-inertial scan on.
+  EXPECT_GE(imu_rate.size(), 800U);
+  slam::write_tum(work / "imu_rate.tum", imu_rate);
+
+  const auto ape = [&](const std::filesystem::path& est) {
+    const test::CommandRun eval = test::run_adit(fmt::format("eval traj --ref {} --est {} --json",
+                                                             (session / "truth_body.tum").string(), est.string()));
+    EXPECT_EQ(eval.status, 0) << eval.output;
+    return nlohmann::json::parse(eval.output.substr(eval.output.find('{')))["ape"]["translation_m"];
+  };
+  const nlohmann::json scans = ape(work / "trajectory.tum");
+  const nlohmann::json readings = ape(work / "imu_rate.tum");
+  std::printf("APE at scan rate: rmse %.4f m, max %.4f m; at the IMU's rate: rmse %.4f m, max %.4f m\n",
+              scans["rmse"].get<double>(), scans["max"].get<double>(), readings["rmse"].get<double>(),
+              readings["max"].get<double>());
+  // Carried at most a scan and its registration past the scan: within a
+  // centimetre of the scan-rate poses' error.
+  EXPECT_LT(readings["rmse"].get<double>(), scans["rmse"].get<double>() + 0.01);
+  EXPECT_LT(readings["max"].get<double>(), scans["max"].get<double>() + 0.01);
+}
+
+// aditd as a flight controller meets it: the hand-held walk replayed at its
+// pace, the IMU-rate pose on ADIT/<payload>/POSE_IMU beside the scan-rate one.
+TEST(ImuPose, AditdSendsItOnPoseImuAtTheImuRate) {
+  const std::filesystem::path session = test::handheld_os1_9s();
+  const std::filesystem::path work = test::binary_dir() / fmt::format("imu-pose-aditd-{}", ::getpid());
+  std::filesystem::remove_all(work);
+  std::filesystem::create_directories(work);
+  const std::string payload = fmt::format("imuaditd{}", ::getpid());
+  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 31) % 30000);
+  const std::filesystem::path config = work / "aditd.yaml";
+  std::ofstream(config) << test::aditd_yaml_for(session, work / "state",
+                                                {payload, url, false, "threads:\n  lock_memory: false\n"});
+  test::PoseCounter scans(url, payload);
+  test::PoseCounter imu_rate(url, payload, protocol::Channel::imu_pose);
+  test::Daemon aditd({(test::binary_dir() / "bin/aditd").string(), "--config", config.string(), "--once"},
+                     work / "aditd.log");
+  ASSERT_EQ(aditd.wait_exit(90), 0) << "see " << (work / "aditd.log").string();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the last messages in flight
+  std::printf("POSE: %zu, POSE_IMU: %zu\n", scans.count(), imu_rate.count());
+  // 100 Hz over the 9 s walk from the first LiDAR-inertial scan on, 10 Hz on POSE.
+  EXPECT_GE(imu_rate.count(), 750U);
+  EXPECT_EQ(imu_rate.valid(), imu_rate.count());
+  EXPECT_GE(imu_rate.count(), 8 * scans.count());
+}
+
+}  // namespace
+}  // namespace adit::daemon
