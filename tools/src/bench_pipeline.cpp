@@ -10,13 +10,17 @@
 #include <cerrno>
 #include <ctime>
 #include <exception>
+#include <optional>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/daemon/heartbeat.hpp"
+#include "adit/daemon/imu_pose_publisher.hpp"
+#include "adit/daemon/lidar_source.hpp"
 #include "adit/daemon/pipeline.hpp"
 #include "adit/drivers/lidar/registry.hpp"
 #include "adit/drivers/pcap_reader.hpp"
@@ -28,6 +32,7 @@ namespace adit::tools {
 namespace {
 
 constexpr double kLatencyTargetMs = 10.0;    // p99, issue #6
+constexpr const char* kBenchLcmUrl = "udpm://239.255.76.67:7667?ttl=0";  // this host only
 constexpr std::int64_t kQuietNs = 500'000'000;   // everything sent arrived and nothing moved since: done
 constexpr std::int64_t kGiveUpNs = 5'000'000'000; // nothing moved for this long: the rest was lost
 
@@ -90,7 +95,7 @@ struct LoopbackRun {
   SendTotals sent;
 };
 
-LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
+LoopbackRun run_over_loopback(const config::Config& file_config, double speed, const daemon::PipelineSinks& sinks) {
   config::Config c = file_config;
   const int capture_port = data_port_of(file_config);
   c.lidar.source = config::LidarSource::udp;
@@ -98,8 +103,18 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
   c.lidar.port = free_loopback_port();
   c.lidar.interface.clear();
   c.lidar.multicast_group.clear();
+  // The LiDAR's own IMU packets (an Ouster's, a Mid-360's) to a port of their own, as the sensor sends them.
+  std::vector<SendRoute> routes{{capture_port, static_cast<std::uint16_t>(c.lidar.port)}};
+  if (const std::uint16_t imu_capture_port = daemon::lidar_imu_port(file_config);
+      imu_capture_port != 0 && imu_capture_port != capture_port) {
+    do c.lidar.imu_port = free_loopback_port();
+    while (c.lidar.imu_port == c.lidar.port);
+    routes.push_back({imu_capture_port, static_cast<std::uint16_t>(c.lidar.imu_port)});
+  }
   const std::int64_t send_at_ns = align_recorded_wheels(c, speed, capture_port);
-  daemon::Pipeline pipeline(c, {});
+  daemon::PipelineOptions options;
+  options.sinks = sinks;
+  daemon::Pipeline pipeline(c, options);
 
   LoopbackRun run;
   std::atomic<bool> stop_sending{false};
@@ -113,8 +128,7 @@ LoopbackRun run_over_loopback(const config::Config& file_config, double speed) {
     sender = std::thread([&] {
       try {
         if (send_at_ns != 0) sleep_until_realtime(send_at_ns);
-        run.sent = send_capture(c.lidar.pcap, "127.0.0.1", static_cast<std::uint16_t>(c.lidar.port), speed,
-                                capture_port, stop_sending);
+        run.sent = send_capture(c.lidar.pcap, "127.0.0.1", routes, speed, stop_sending);
       } catch (...) {
         send_error = std::current_exception();
       }
@@ -150,13 +164,22 @@ int bench_pipeline(const BenchPipelineOptions& o) {
 
   // The file's pipeline is gone before the loopback run, whose resident size
   // would otherwise hold both (the peak, VmHWM, is the process's and does).
+  // The IMU-rate pose goes out over LCM as aditd sends it (to this host only,
+  // ttl=0), so its latency includes the send.
+  std::optional<daemon::ImuPosePublisher> imu_poses;
+  daemon::PipelineSinks sinks;
+  if (config.imu.enabled && config.imu.pose_horizon_s > 0.0) {
+    imu_poses.emplace(kBenchLcmUrl, "adit-bench");
+    sinks.imu_pose = [&](const slam::InertialState& s) { imu_poses->publish(s); };
+  }
   const PipelineFigures file = [&] {
     daemon::PipelineOptions file_options;
     file_options.replay_speed = o.speed;
+    file_options.sinks = sinks;
     daemon::Pipeline file_pipeline(config, file_options);
     return run_pipeline(file_pipeline);
   }();
-  const LoopbackRun udp = run_over_loopback(config, o.speed);
+  const LoopbackRun udp = run_over_loopback(config, o.speed, sinks);
   const std::uint64_t lost = udp.sent.sent > udp.figures.datagrams ? udp.sent.sent - udp.figures.datagrams : 0;
 
   if (o.json) {

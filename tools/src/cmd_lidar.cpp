@@ -213,7 +213,8 @@ int decode(const DecodeOptions& o, const std::string& out_dir, const std::string
 int pcap_send(const std::string& file, const std::string& to, double speed, int only_port) {
   const auto [host, port] = drivers::parse_host_port(to, "--to");
   const std::atomic<bool> never{false};
-  const SendTotals totals = send_capture(file, host, port, speed, only_port, never);
+  const SendRoute route{only_port, port};
+  const SendTotals totals = send_capture(file, host, std::span(&route, 1), speed, never);
   fmt::print("sent {} datagrams to {} ({} refused)\n", totals.sent, to, totals.refused);
   return totals.refused == 0 ? kExitOk : kExitFailure;
 }

@@ -8,6 +8,7 @@
 
 #include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
 #include "process_memory.hpp"
 
 namespace adit::tools {
@@ -101,6 +102,13 @@ PipelineFigures run_pipeline(daemon::Pipeline& pipeline, const RunHooks& hooks, 
   f.spilled_keyframes = s.spilled_keyframes.load();
   f.map_mb = 1e-6 * static_cast<double>(s.map_bytes.load());
   f.keyframe_mb = 1e-6 * static_cast<double>(s.keyframe_bytes.load());
+  if (const daemon::ImuPoseFeed* imu = pipeline.imu_poses()) {
+    f.imu_pose = true;
+    f.imu_poses = imu->poses();
+    f.imu_pose_latency_median_ms = quantile(imu->latency_ms(), 0.5);
+    f.imu_pose_latency_p99_ms = quantile(imu->latency_ms(), 0.99);
+    f.imu_pose_latency_max_ms = quantile(imu->latency_ms(), 1.0);
+  }
   return f;
 }
 
@@ -151,6 +159,12 @@ nlohmann::json figures_json(const PipelineFigures& f, double from_fraction) {
                             {"heap_in_use_from_mb", g->heap_from_mb}, {"heap_in_use_end_mb", g->heap_end_mb},
                             {"map_from_mb", g->map_from_mb}, {"map_end_mb", g->map_end_mb},
                             {"max_beyond_map_mb", g->max_beyond_map_mb}};
+  if (f.imu_pose)
+    j["imu_poses"] = {{"count", f.imu_poses},
+                      {"latency_ms",
+                       {{"median", f.imu_pose_latency_median_ms},
+                        {"p99", f.imu_pose_latency_p99_ms},
+                        {"max", f.imu_pose_latency_max_ms}}}};
   if (f.mapping)
     j["map"] = {{"points", f.map_points},           {"tiles", f.map_tiles},
                 {"resident_tiles", f.resident_tiles}, {"evicted_tiles", f.evicted_tiles},
@@ -187,6 +201,10 @@ std::string figures_text(const PipelineFigures& f, double from_fraction) {
         f.map_points, f.map_tiles, f.resident_tiles, f.map_mb, f.evicted_tiles, f.restored_tiles, f.compacted_tiles,
         f.lost_candidates,
         f.tile_file_errors, f.keyframes, f.keyframes - f.spilled_keyframes, f.keyframe_mb);
+  if (f.imu_pose)
+    text += fmt::format("\nIMU-rate poses: {}; latency from the IMU reading's arrival: median {:.3f} ms, p99 {:.3f} ms, "
+                        "max {:.3f} ms",
+                        f.imu_poses, f.imu_pose_latency_median_ms, f.imu_pose_latency_p99_ms, f.imu_pose_latency_max_ms);
   return text + "\n";
 }
 

@@ -75,6 +75,13 @@ struct PipelineFigures {
   std::uint64_t spilled_keyframes = 0;
   double map_mb = 0.0;       // resident tiles' structures
   double keyframe_mb = 0.0;  // keyframes' downsampled scans
+  // The IMU-rate pose (daemon/imu_pose_feed.hpp): how many, and each one's
+  // latency from its IMU packet's (or CAN frame's) arrival to the sink's return.
+  bool imu_pose = false;
+  std::uint64_t imu_poses = 0;
+  double imu_pose_latency_median_ms = 0.0;
+  double imu_pose_latency_p99_ms = 0.0;
+  double imu_pose_latency_max_ms = 0.0;
   double speed() const { return duration_s > 0.0 ? sensor_span_s / duration_s : 0.0; }  // × real time
 };
 
