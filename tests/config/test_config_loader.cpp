@@ -165,6 +165,7 @@ TEST(ConfigLoader, ConditionalRequirementsNameTheMissingKey) {
   EXPECT_EQ(axis.key(), "imu.accel_z_signal");
   EXPECT_EQ(axis.reason(), "required when the IMU is enabled");
   EXPECT_EQ(parse_error(can_and_wheels + "imu:\n  gravity_sigma_deg: 0\n").key(), "imu.gravity_sigma_deg");
+  EXPECT_EQ(parse_error(can_and_wheels + "imu:\n  pose_horizon_s: -0.1\n").key(), "imu.pose_horizon_s");
   const std::string accel = "imu:\n  enabled: true\n  accel_x_signal: ax\n  accel_y_signal: ay\n  accel_z_signal: az\n";
   const InputError gyro = parse_error(can_and_wheels + accel + "  gyro_x_signal: gx\n  gyro_z_signal: gz\n");
   EXPECT_EQ(gyro.key(), "imu.gyro_y_signal");

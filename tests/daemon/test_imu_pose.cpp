@@ -134,9 +134,15 @@ TEST(ImuPose, AditdSendsItOnPoseImuAtTheImuRate) {
   std::filesystem::create_directories(work);
   const std::string payload = fmt::format("imuaditd{}", ::getpid());
   const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 31) % 30000);
+  std::string yaml =
+      test::aditd_yaml_for(session, work / "state", {payload, url, false, "threads:\n  lock_memory: false\n"});
+  // A horizon of 2 s: a sanitizer build's odometry, mapping beside it, lags
+  // the replay by its whole scan queue (0.5 s), which the default would cut.
+  const std::string imu_section = "\nimu:\n  enabled: true\n";
+  ASSERT_NE(yaml.find(imu_section), std::string::npos) << yaml;
+  yaml.replace(yaml.find(imu_section), imu_section.size(), imu_section + "  pose_horizon_s: 2\n");
   const std::filesystem::path config = work / "aditd.yaml";
-  std::ofstream(config) << test::aditd_yaml_for(session, work / "state",
-                                                {payload, url, false, "threads:\n  lock_memory: false\n"});
+  std::ofstream(config) << yaml;
   test::PoseCounter scans(url, payload);
   test::PoseCounter imu_rate(url, payload, protocol::Channel::imu_pose);
   test::Daemon aditd({(test::binary_dir() / "bin/aditd").string(), "--config", config.string(), "--once"},

@@ -3,7 +3,8 @@
 // owns the LCM socket, publishes poses, status and map tiles handed over by
 // the pipeline through lock-free queues, answers tile requests with only the
 // missing chunks, and acknowledges commands through the session state machine.
-// LCM is confined to this file's implementation and the `adit` client.
+// LCM is confined to this file's implementation, the IMU-rate pose's sender
+// (imu_pose_publisher.hpp, which needs no queue) and the `adit` client.
 
 #include <array>
 #include <atomic>
