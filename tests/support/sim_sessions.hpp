@@ -2,6 +2,7 @@
 // Simulated sessions the daemon's tests share, generated once per build tree.
 
 #include <filesystem>
+#include <string>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -11,26 +12,25 @@
 
 namespace adit::test {
 
-// A 12 s drive of the wheeled robot through the mine with a VLP-16, CAN wheels and accelerometer (seed 7).
-inline std::filesystem::path mine_drive_12s() {
-  const std::filesystem::path dir = binary_dir() / "e2e-session-imu";
+// The session `adit sim OPTIONS` writes to binary_dir()/NAME, made once.
+inline std::filesystem::path simulated_session(const std::string& name, const std::string& options) {
+  const std::filesystem::path dir = binary_dir() / name;
   if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim = run_adit(fmt::format(
-        "sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out {}", dir.string()));
+    const CommandRun sim = run_adit(fmt::format("sim {} --out {}", options, dir.string()));
     EXPECT_EQ(sim.status, 0) << sim.output;
   }
   return dir;
 }
 
+// A 12 s drive of the wheeled robot through the mine with a VLP-16, CAN wheels and accelerometer (seed 7).
+inline std::filesystem::path mine_drive_12s() {
+  return simulated_session("e2e-session-imu", "--scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7");
+}
+
 // A 9 s walk through the mine with a hand-held OS1-64, its IMU packets in the capture (seed 1).
 inline std::filesystem::path handheld_os1_9s() {
-  const std::filesystem::path dir = binary_dir() / "session-handheld-os1";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim = run_adit(fmt::format(
-        "sim --scene mine --platform handheld --sensor OS1-64 --duration 9 --seed 1 --out {}", dir.string()));
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
+  return simulated_session("session-handheld-os1",
+                           "--scene mine --platform handheld --sensor OS1-64 --duration 9 --seed 1");
 }
 
 }  // namespace adit::test
