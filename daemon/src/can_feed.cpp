@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "adit/common/clock.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/daemon/can_imu_pairing.hpp"

@@ -5,6 +5,7 @@
 #include "adit/daemon/odometry_stage.hpp"
 
 #include "adit/common/clock.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
 
 namespace adit::daemon {
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "adit/common/clock.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
 
 namespace adit::daemon {
 

@@ -7,6 +7,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/daemon/can_feed.hpp"
+#include "adit/daemon/imu_pose_feed.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/lidar_source.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"

@@ -23,7 +23,7 @@ void ImuExtrapolator::step(const ImuSample& from, const ImuSample& to) {
 }
 
 void ImuExtrapolator::anchor(const InertialState& state) {
-  anchor_ = state;
+  anchor_t_ = state.t;
   current_ = state;
   // Readings already past the horizon (a replayed log read far ahead): none
   // of them, nor any later one, gives a pose from this anchor.
@@ -44,7 +44,7 @@ std::optional<InertialState> ImuExtrapolator::add(const ImuSample& reading) {
   if (count_ > 0 && !(reading.t > kept(count_ - 1).t)) return std::nullopt;  // out of order: not kept
   const ImuSample* previous = count_ > 0 ? &kept(count_ - 1) : nullptr;
   const bool gap = previous == nullptr || reading.t - previous->t > config_.max_sample_gap_s;
-  if (anchor_ && current_valid_) {
+  if (anchor_t_ && current_valid_) {
     if (gap && reading.t - current_.t > config_.max_sample_gap_s) current_valid_ = false;
     else if (previous != nullptr && !gap) step(*previous, reading);
     else step(reading, reading);  // the anchor's time is within a gap's reach of this first reading
@@ -57,7 +57,7 @@ std::optional<InertialState> ImuExtrapolator::add(const ImuSample& reading) {
     ring_[head_] = reading;
     head_ = (head_ + 1) % ring_.size();
   }
-  if (!anchor_ || !current_valid_ || reading.t - anchor_->t > config_.max_horizon_s) return std::nullopt;
+  if (!anchor_t_ || !current_valid_ || reading.t - *anchor_t_ > config_.max_horizon_s) return std::nullopt;
   return current_;
 }
 

@@ -162,8 +162,6 @@ int bench_pipeline(const BenchPipelineOptions& o) {
   if (config.lidar.source != config::LidarSource::pcap)
     throw InputError(o.inputs.config_file, "lidar.source", "the bench needs a capture: give --pcap or lidar.source: pcap");
 
-  // The file's pipeline is gone before the loopback run, whose resident size
-  // would otherwise hold both (the peak, VmHWM, is the process's and does).
   // The IMU-rate pose goes out over LCM as aditd sends it (to this host only,
   // ttl=0), so its latency includes the send.
   std::optional<daemon::ImuPosePublisher> imu_poses;
@@ -172,6 +170,8 @@ int bench_pipeline(const BenchPipelineOptions& o) {
     imu_poses.emplace(kBenchLcmUrl, "adit-bench");
     sinks.imu_pose = [&](const slam::InertialState& s) { imu_poses->publish(s); };
   }
+  // The file's pipeline is gone before the loopback run, whose resident size
+  // would otherwise hold both (the peak, VmHWM, is the process's and does).
   const PipelineFigures file = [&] {
     daemon::PipelineOptions file_options;
     file_options.replay_speed = o.speed;

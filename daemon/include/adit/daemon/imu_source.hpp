@@ -17,11 +17,12 @@
 
 #include <Eigen/Core>
 
-#include "adit/daemon/imu_pose_feed.hpp"
 #include "adit/daemon/imu_stats.hpp"
 #include "adit/slam/motion_history.hpp"
 
 namespace adit::daemon {
+
+class ImuPoseFeed;  // imu_pose_feed.hpp
 
 // The IMU's pose in the body frame.
 struct ImuMounting {

@@ -29,7 +29,6 @@
 namespace adit::daemon {
 
 class ImuPoseFeed;
-
 class LoopClosureStage;
 class JournalWriter;
 struct CanFeedStats;

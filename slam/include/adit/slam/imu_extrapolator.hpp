@@ -50,7 +50,7 @@ class ImuExtrapolator {
   std::vector<ImuSample> ring_;  // the newest `count_` readings from head_
   std::size_t head_ = 0;
   std::size_t count_ = 0;
-  std::optional<InertialState> anchor_;
+  std::optional<double> anchor_t_;  // the latest anchor's time
   InertialState current_;
   bool current_valid_ = false;  // current_ follows the anchor through every reading since
 };
