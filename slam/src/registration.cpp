@@ -186,9 +186,12 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
   result.sweep_velocity = velocity;
   result.pose = prior.mean;
   // Graduated kernel: start wide enough to pull in from the prediction's
-  // error, halve the scale every iteration down to the floor set by the
-  // sensor's noise (so that associations made early cannot bias the end
-  // result), then iterate at the floor until the update is negligible.
+  // error, halve the scale down to the floor set by the sensor's noise (so
+  // that associations made early cannot bias the end result), then iterate
+  // at the floor until the update is negligible. The scale halves only once
+  // an iteration's update is below config.narrow_below_step: from a good
+  // prediction that is every iteration, from one that missed a turn the
+  // wide kernel pulls until the pose has come in (decision 042).
   double kappa = std::max(kernel_scale_m, config.min_kernel_scale_m);
   const double data_scale = 1.0 / (config.point_sigma_m * config.point_sigma_m);
   NormalEquations ne;
@@ -255,7 +258,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
     const bool last_level = kappa <= config.min_kernel_scale_m;
     const double step_norm = std::sqrt(delta.squaredNorm() + static_cast<double>(duration * duration) * delta_velocity.squaredNorm());
     if (last_level && step_norm < config.convergence_norm) break;
-    kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
+    if (step_norm < config.narrow_below_step) kappa = std::max(0.5 * kappa, config.min_kernel_scale_m);
   }
   result.sweep_velocity = velocity;
   result.correspondences = ne.count;

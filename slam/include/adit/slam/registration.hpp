@@ -34,6 +34,11 @@ struct RegistrationConfig {
   int max_iterations = 30;
   double convergence_norm = 5e-4;       // settle when the update is below this (m, rad)
   double min_kernel_scale_m = 0.05;     // the robust kernel's final scale (about 2-3 σ of range noise)
+  // The robust kernel's scale halves only after an iteration whose update
+  // (m, rad) is below this: narrowed while the pose is still far off, the
+  // kernel weighs the residuals that would pull it in to nothing and the
+  // prior holds it there (decision 042).
+  double narrow_below_step = 0.01;
   float max_plane_error_m = 0.1F;       // a map neighbour farther than this from its plane: not a plane
   // Planes are searched again once the pose moved this far since the last
   // search (with a `planes` buffer; without one, every iteration).
