@@ -12,7 +12,9 @@
 // both match a few dozen to a few hundred points, and a 5 % margin is a tie
 // (decision 040).
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <Eigen/Core>
 
@@ -38,6 +40,36 @@ void search_start(double reach_m, double step_m, double margin, double noise_sig
   }
   const double n = static_cast<double>(predicted.correspondences);
   if (static_cast<double>(best.correspondences) - n <= noise_sigmas * std::sqrt(n)) best = predicted;
+}
+
+// The same over turns: the registration is also started from the prediction
+// turned about the body's z axis by ±`step_rad`, ±2·`step_rad`, … up to
+// `reach_rad` (at most half a turn), nearest first, with the same rule for
+// the winner. Every turn is tried: stopping at the first that fits as well
+// as the scans before did takes a nearer wrong fit on real scans (decision
+// 042). `register_from(yaw)` registers from the prediction turned by yaw.
+// Returns the winner's turn (0: the prediction kept).
+template <typename RegisterFrom>
+double search_rotation(double reach_rad, double step_rad, double margin, double noise_sigmas,
+                       RegisterFrom&& register_from, RegistrationResult& best) {
+  const RegistrationResult predicted = best;
+  double winner = 0.0;
+  const auto steps = static_cast<int>(std::floor(std::min(reach_rad, std::numbers::pi) / step_rad + 1e-9));
+  for (int k = 1; k <= steps; ++k) {
+    const double yaw = k * step_rad;
+    for (const double turn : {yaw, -yaw}) {
+      if (turn < 0.0 && yaw >= std::numbers::pi - 1e-9) continue;  // half a turn either way is one start
+      const RegistrationResult alternative = register_from(turn);
+      if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences)) {
+        best = alternative;
+        winner = turn;
+      }
+    }
+  }
+  const double n = static_cast<double>(predicted.correspondences);
+  if (static_cast<double>(best.correspondences) - n > noise_sigmas * std::sqrt(n)) return winner;
+  best = predicted;
+  return 0.0;
 }
 
 }  // namespace adit::slam

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "adit/slam/deskew.hpp"
@@ -53,6 +54,40 @@ TEST(Odometry, TracksASmoothPathThroughAHall) {
   EXPECT_LT((r.pose.translation() - expected.translation()).norm(), 0.02) << r.pose.translation().transpose();
   EXPECT_LT(Eigen::AngleAxisd(r.pose.linear().transpose() * expected.linear()).angle(), 0.2 * M_PI / 180);
   EXPECT_EQ(r.status, OdometryStatus::ok);
+}
+
+// A hand-held scanner jerked round between two scans: the constant-velocity
+// prediction misses the turn by 20°, and by 20° the other way on the next
+// scan, when it carries the jerk on. One registration does not pull in from
+// that far; the rotation search (started from turns of the prediction, every
+// 0.1 rad) finds it. Returns the worst rotation error, degrees.
+double worst_rotation_error_after_a_jerk(double max_turn_rate_radps) {
+  const auto hall = test::room(400000, 23, 25.0F, 12.0F, 4.0F);
+  OdometryConfig config;
+  config.max_range_m = 30.0F;
+  config.max_turn_rate_radps = max_turn_rate_radps;
+  Odometry odometry(config);
+  double worst = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    const double t = 0.1 * k;
+    const double jerk = k >= 10 ? 0.35 : 0.0;
+    const Eigen::Isometry3d truth = planar_pose(-8.0 + 1.0 * t, 0.3 * std::sin(0.5 * t), 0.2 * t + jerk);
+    const auto scan = observe(hall, truth, 20000, 300 + static_cast<unsigned>(k));
+    const OdometryResult r = odometry.process({static_cast<std::int64_t>(std::llround(t * 1e9)), scan, {}});
+    EXPECT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
+    const Eigen::Isometry3d expected = planar_pose(-8.0, 0.0, 0.0).inverse() * truth;
+    worst = std::max(worst, Eigen::AngleAxisd(r.pose.linear().transpose() * expected.linear()).angle() * 180.0 / M_PI);
+  }
+  return worst;
+}
+
+TEST(Odometry, ATurnThePredictionMissedIsFoundByTheRotationSearch) {
+  const double searched = worst_rotation_error_after_a_jerk(OdometryConfig{}.max_turn_rate_radps);
+  const double unsearched = worst_rotation_error_after_a_jerk(0.0);
+  std::printf("worst rotation error after a 20 degree jerk: %.3f deg with the rotation search, %.3f without\n", searched,
+              unsearched);
+  EXPECT_LT(searched, 0.2);
+  EXPECT_GT(unsearched, 5.0);  // the test bites: one registration stays in the prediction's basin
 }
 
 // The local map is pruned only after each map_removal_step_m of travel, so

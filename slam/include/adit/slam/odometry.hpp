@@ -77,6 +77,14 @@ struct OdometryConfig {
   // The search's winner must beat the prediction's registration by this many
   // √n correspondences (n the prediction's): more than counting noise (decision 040).
   double start_search_noise_sigmas = 3.0;
+  // A turn the prediction missed: when the registration explains fewer than
+  // min_correspondence_share of the last scan's correspondences (or no
+  // velocity is known), it is also started from the prediction turned about
+  // the body's z, every rotation_search_step_rad up to what max_turn_rate_radps
+  // covers between the two scans (0: no search; decision 042). One start
+  // pulls in from about ±3° on real HDL-64 scans, hence the step.
+  double max_turn_rate_radps = 5.0;
+  double rotation_search_step_rad = 0.1;
   double max_scan_gap_s = 1.0;           // a longer gap forgets the velocity
   // The constant-velocity prediction's standard deviation per scan, used as a
   // weak prior so that degenerate directions stay anchored to the prediction.
