@@ -2,7 +2,9 @@
 // handheld walk (a 2 s stand, then turns of up to 120°/s) the LiDAR-inertial
 // odometry follows the truth to centimetres and degrees; `--imu off` runs the
 // same scans LiDAR only, for comparison, and prints the same figures.
+// `--spin-deg` puts a hand-held scanner's turns into real scans.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -52,6 +54,32 @@ TEST(CmdBenchOdometry, TheImuCarriesAHandheldWalkThatLidarAloneLoses) {
   const double lidar_ape = printed_figure(lidar.output, "adit odometry: APE", "rmse ");
   EXPECT_TRUE(std::isfinite(lidar_ape)) << lidar.output;
   EXPECT_GT(lidar_ape, 3.0 * lio_ape) << lio.output << lidar.output;
+}
+
+// Real scans turned by up to ±5° a scan from the fifth on: the trajectory
+// written with the turns taken back out lies on the run without them, and
+// `--max-turn-rate 0` (no rotation search) shows what the turns cost without
+// it (decision 042).
+TEST(CmdBenchOdometry, SpunRealScansTrackAndComeBackOutUnturned) {
+  ADIT_REQUIRE_SHARED_DATA(dir, "sequences/hdl64-urban-22");
+  const auto out = adit::test::binary_dir() / "test-sessions" / "bench-odometry-spin";
+  std::filesystem::create_directories(out);
+  const std::string scans = "bench odometry --baseline none --scans " + dir.string();
+  const auto rotation_max_deg = [&](const std::string& options, const std::string& name) {
+    const std::string file = (out / name).string();
+    const CommandRun run = adit(scans + " " + options + " --out " + file);
+    EXPECT_EQ(run.status, 0) << run.output;
+    const CommandRun eval = adit("eval traj --align none --json --ref " + (out / "unturned.tum").string() + " --est " + file);
+    EXPECT_EQ(eval.status, 0) << eval.output;
+    return nlohmann::json::parse(eval.output)["ape"]["rotation_deg"]["max"].get<double>();
+  };
+  const CommandRun unturned = adit(scans + " --out " + (out / "unturned.tum").string());
+  ASSERT_EQ(unturned.status, 0) << unturned.output;
+  const double searched = rotation_max_deg("--spin-deg 5 --spin-from 5 --spin-seed 2", "searched.tum");
+  const double unsearched = rotation_max_deg("--spin-deg 5 --spin-from 5 --spin-seed 2 --max-turn-rate 0", "plain.tum");
+  // Measured 2026-11-27: 0.029° and 18.5°.
+  EXPECT_LT(searched, 0.3);
+  EXPECT_GT(unsearched, 3.0);
 }
 
 }  // namespace

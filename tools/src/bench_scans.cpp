@@ -1,6 +1,10 @@
 #include "bench_scans.hpp"
 
 #include <algorithm>
+#include <numbers>
+#include <random>
+
+#include <Eigen/Geometry>
 
 #include "adit/common/error.hpp"
 #include "adit/drivers/lidar/decode_stream.hpp"
@@ -22,9 +26,23 @@ BenchScan to_bench_scan(const drivers::LidarScan& scan, bool timed) {
   return out;
 }
 
-}  // namespace
+// Scan k's sensor turned by spin_k = spin_k-1 + U(±spin_deg) about its z:
+// its points are seen from Rz(spin_k), p' = Rz(spin_k)ᵀ·p.
+void spin(std::vector<BenchScan>& scans, double spin_deg, unsigned seed, std::size_t from) {
+  if (spin_deg <= 0.0) return;
+  std::mt19937 rng(seed);
+  const double step = spin_deg * std::numbers::pi / 180.0;
+  std::uniform_real_distribution<double> turn(-step, step);
+  double yaw = 0.0;
+  for (std::size_t k = std::max<std::size_t>(from, 1); k < scans.size(); ++k) {
+    yaw += turn(rng);
+    scans[k].spin_rad = yaw;
+    const Eigen::Matrix3f to_sensor = Eigen::AngleAxisf(static_cast<float>(-yaw), Eigen::Vector3f::UnitZ()).toRotationMatrix();
+    for (Eigen::Vector3f& p : scans[k].points) p = to_sensor * p;
+  }
+}
 
-std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
+std::vector<BenchScan> load(const BenchInput& input) {
   std::vector<BenchScan> scans;
   const auto full = [&] { return input.max_scans > 0 && scans.size() >= input.max_scans; };
   std::size_t seen = 0;
@@ -47,6 +65,14 @@ std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
   drivers::UdpDatagram d;
   while (!full() && reader.next(d))
     if (d.dst_port == decoder->default_port()) stream.push(d.payload, d.capture_time_ns);
+  return scans;
+}
+
+}  // namespace
+
+std::vector<BenchScan> load_bench_scans(const BenchInput& input) {
+  std::vector<BenchScan> scans = load(input);
+  spin(scans, input.spin_deg, input.spin_seed, input.spin_from);
   return scans;
 }
 

@@ -56,6 +56,8 @@ struct BenchOptions {
   bool fixed_sweep_velocity = false;  // deskew with the prediction's velocity only
   double sweep_velocity_sigma_radps = slam::OdometryConfig{}.sweep_velocity_sigma_radps;
   std::size_t target_registration_points = slam::OdometryConfig{}.target_registration_points;
+  double max_turn_rate_radps = slam::OdometryConfig{}.max_turn_rate_radps;
+  double narrow_below_step = slam::RegistrationConfig{}.narrow_below_step;
 };
 
 template <typename F>
@@ -119,6 +121,8 @@ int bench_odometry(const BenchOptions& o) {
   config.estimate_sweep_velocity = !o.fixed_sweep_velocity;
   config.sweep_velocity_sigma_radps = o.sweep_velocity_sigma_radps;
   config.target_registration_points = o.target_registration_points;
+  config.max_turn_rate_radps = o.max_turn_rate_radps;
+  config.registration.narrow_below_step = o.narrow_below_step;
   const auto most_points = static_cast<std::size_t>(quantile(sizes, 1.0));
   config.max_scan_points = std::max<std::size_t>(most_points, 1);  // room for the largest, as aditd for its sensor
   // The payload as aditd reads it: its extrinsics, ranges and CAN bus; or
@@ -166,7 +170,9 @@ int bench_odometry(const BenchOptions& o) {
     if (r.registration_points > 0) voxels.push_back(r.registration_voxel_m);
     if (r.status == slam::OdometryStatus::ok || r.status == slam::OdometryStatus::degenerate)
       weakest.push_back(r.registration.weakest_eigenvalue);
-    estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns), r.pose);
+    // With --spin the added turn is taken back out: the trajectory compares with the run without it.
+    estimate.push_back(1e-9 * static_cast<double>(scan.stamp_ns),
+                       r.pose * Eigen::AngleAxisd(-scan.spin_rad, Eigen::Vector3d::UnitZ()));
   }
   if (can) {
     can->stop();
@@ -195,6 +201,7 @@ int bench_odometry(const BenchOptions& o) {
              median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
              peak_resident_mb(), quantile(used_points, 0.5), quantile(used_points, 1.0), voxels.empty() ? 0.0 : quantile(voxels, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
              quantile(weakest, 0.1), o.degeneracy_threshold);
+  fmt::print("adit path: {:.2f} m\n", eval::path_length(estimate.poses));
   if (!o.out.empty()) {
     std::ofstream out(o.out);
     slam::write_tum(out, estimate);
@@ -248,6 +255,20 @@ void register_bench_commands(CLI::App& app, int& status) {
   odometry->add_option("--max-scans", o->input.max_scans, "Use at most this many scans (0 = all)");
   odometry->add_option("--every", o->input.every, "Keep one scan in this many (larger steps between scans)")
       ->check(CLI::PositiveNumber);
+  odometry->add_option("--spin-deg", o->input.spin_deg,
+                       "Turn the sensor about its z by a random step within ±this from one scan to the next, on top of "
+                       "its own motion (fast hand-held turns put into real scans); --out takes the turn back out")
+      ->check(CLI::NonNegativeNumber);
+  odometry->add_option("--spin-seed", o->input.spin_seed, "Seed of --spin-deg's steps")->capture_default_str();
+  odometry->add_option("--spin-from", o->input.spin_from, "First scan (counted after --every) that --spin-deg turns")
+      ->capture_default_str();
+  odometry->add_option("--max-turn-rate", o->max_turn_rate_radps,
+                       "Fastest turn the rotation search covers between two scans, rad/s (0 = no rotation search)")
+      ->capture_default_str();
+  odometry->add_option("--narrow-below-step", o->narrow_below_step,
+                       "The registration kernel halves only after an update below this, m and rad (inf: every "
+                       "iteration, as before decision 042)")
+      ->capture_default_str();
   odometry->add_option("--truth", o->truth, "Ground-truth trajectory (TUM) for drift");
   odometry->add_option("--out", o->out, "Write adit's trajectory (TUM) here");
   odometry->add_option("--baseline-out", o->baseline_out, "Write the baseline's trajectory (TUM) here");
