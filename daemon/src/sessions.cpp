@@ -157,6 +157,8 @@ namespace {
 constexpr std::int32_t kFlagValid = 1;
 constexpr std::int32_t kFlagDegenerate = 2;
 constexpr std::int32_t kFlagHeld = 4;
+constexpr std::int32_t kFlagLost = 8;
+constexpr std::int32_t kFlagRelocalised = 16;
 
 std::string utc_id() {
   const std::time_t now = std::time(nullptr);
@@ -186,7 +188,9 @@ PoseSample pose_sample_of(const slam::OdometryResult& r) {
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) p.covariance[static_cast<std::size_t>(6 * i + j)] = r.covariance(i, j);
   p.flags = (r.valid ? kFlagValid : 0) | (r.status == slam::OdometryStatus::degenerate ? kFlagDegenerate : 0) |
-            (r.status == slam::OdometryStatus::too_few_points ? kFlagHeld : 0);
+            (r.status == slam::OdometryStatus::too_few_points || r.status == slam::OdometryStatus::lost ? kFlagHeld : 0) |
+            (r.status == slam::OdometryStatus::lost ? kFlagLost : 0) |
+            (r.status == slam::OdometryStatus::relocalised ? kFlagRelocalised : 0);
   return p;
 }
 
@@ -426,7 +430,8 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"scans", {{"total", s.scans.load()}, {"incomplete", s.incomplete_scans.load()},
                    {"dropped", s.dropped_scans.load()}, {"skipped_at_start", s.skipped_start_scans.load()}}},
         {"poses", {{"total", s.poses.load()}, {"invalid", s.invalid_poses.load()},
-                   {"degenerate", s.degenerate_poses.load()}, {"with_wheel_prior", s.wheel_priors.load()},
+                   {"degenerate", s.degenerate_poses.load()}, {"lost", s.lost_poses.load()},
+                   {"relocalised", s.relocalised_poses.load()}, {"with_wheel_prior", s.wheel_priors.load()},
                    {"wheels_missing", s.scans_without_wheels.load()},
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},

@@ -31,6 +31,8 @@ std::string_view to_string(OdometryStatus status) {
     case OdometryStatus::too_few_points: return "too few points";
     case OdometryStatus::time_went_back: return "time went backwards";
     case OdometryStatus::degenerate: return "degenerate";
+    case OdometryStatus::lost: return "lost";
+    case OdometryStatus::relocalised: return "relocalised";
   }
   return "?";
 }
@@ -266,6 +268,26 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
                  },
                  result.registration);
   }
+  // Lost: the searches found nothing that fits as the last tracked scan did
+  // (a view filled by something passing, a turn beyond the search). A wrong
+  // pose in the map would corrupt every scan after it, so the scan is held on
+  // the prediction, kept out of the map, and the next one searched from wide
+  // (decision 043).
+  const bool relocalised = lost_scans_ > 0;
+  if (last_correspondences_ > 0.0 && lost_scans_ < config_.max_lost_scans &&
+      static_cast<double>(result.registration.correspondences) <
+          config_.lost_correspondence_share * last_correspondences_) {
+    ++lost_scans_;
+    reacquire_ = true;
+    pose_ = predicted;
+    start_to_mid_.setIdentity();
+    mid_offset_s_ = 0.0;
+    last_stamp_ns_ = scan.stamp_ns;
+    result.pose = pose_;
+    result.status = OdometryStatus::lost;
+    return result;
+  }
+  lost_scans_ = 0;
   velocity_known_ = true;
   last_correspondences_ = static_cast<double>(result.registration.correspondences);
   const Eigen::Isometry3d corrected = result.registration.pose;
@@ -304,7 +326,9 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   result.pose = pose_;
   result.covariance = result.registration.covariance;
   result.valid = true;
-  result.status = result.registration.degenerate ? OdometryStatus::degenerate : OdometryStatus::ok;
+  result.status = relocalised                     ? OdometryStatus::relocalised
+                  : result.registration.degenerate ? OdometryStatus::degenerate
+                                                   : OdometryStatus::ok;
   // The IMU did not cover this scan (a dropout, or it just began): the
   // filter starts again from the scan's pose.
   const Eigen::Isometry3d to_body = pose_.inverse();

@@ -7,6 +7,8 @@
 
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/scan_odometry.hpp"
+#include "adit/daemon/sessions.hpp"
+#include "adit/pose_t.hpp"
 #include "can_logs.hpp"
 
 namespace adit::daemon {
@@ -112,6 +114,25 @@ TEST(ScanOdometry, RunsOnACanImuWithoutWheelsAndKeepsItsReadingsForEachScan) {
   EXPECT_EQ(counts.wheel_priors + counts.scans_without_wheels, 0U);
   EXPECT_EQ(counts.gravity_priors + counts.scans_without_gravity, 0U);
   EXPECT_GT(replay.can.imu_stats().gyro_samples.load(), 100U);
+}
+
+// The odometry's status reaches the tablet as pose_t flags (decision 043):
+// a lost scan is held and not valid, the first one tracked again says so.
+TEST(PoseSample, EachOdometryStatusCarriesItsFlags) {
+  const auto flags_of = [](slam::OdometryStatus status, bool valid) {
+    slam::OdometryResult r;
+    r.status = status;
+    r.valid = valid;
+    return pose_sample_of(r).flags;
+  };
+  // pose_t's flags are unnamed enumerators, one enumeration each.
+  const std::int32_t valid = adit::pose_t::FLAG_VALID;
+  const std::int32_t held = adit::pose_t::FLAG_HELD;
+  EXPECT_EQ(flags_of(slam::OdometryStatus::ok, true), valid);
+  EXPECT_EQ(flags_of(slam::OdometryStatus::degenerate, true), valid | adit::pose_t::FLAG_DEGENERATE);
+  EXPECT_EQ(flags_of(slam::OdometryStatus::too_few_points, false), held);
+  EXPECT_EQ(flags_of(slam::OdometryStatus::lost, false), held | adit::pose_t::FLAG_LOST);
+  EXPECT_EQ(flags_of(slam::OdometryStatus::relocalised, true), valid | adit::pose_t::FLAG_RELOCALISED);
 }
 
 }  // namespace

@@ -129,7 +129,8 @@ function onPose(p, live) {
     metrics.lastSeq = p.seq;
     pendingLatency = p.rx;
   }
-  const flag = !p.valid ? ' (invalid)' : p.degenerate ? ' (degenerate)' : p.held ? ' (held)' : '';
+  const flag = p.lost ? ' (LOST: held on the prediction)' : !p.valid ? ' (invalid)' : p.relocalised ? ' (relocalised)'
+    : p.degenerate ? ' (degenerate)' : p.held ? ' (held)' : '';
   el('pose-text').textContent =
     `pose ${p.seq}: ${p.p.map((v) => v.toFixed(2)).join(', ')} m${flag}`;
 }

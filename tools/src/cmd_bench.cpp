@@ -156,12 +156,16 @@ int bench_odometry(const BenchOptions& o) {
   std::size_t wheel_rejected = 0;
   std::size_t inertial = 0;
   std::size_t standstill = 0;
+  std::size_t lost = 0;
+  std::size_t relocalised = 0;
   for (const BenchScan& scan : scans) {
     to_lidar_scan(scan, lidar_scan);
     const slam::OdometryResult& r = odometry.process(lidar_scan);
     ms.push_back(odometry.registration_ms());
     degenerate += r.status == slam::OdometryStatus::degenerate ? 1 : 0;
     invalid += r.valid ? 0 : 1;
+    lost += r.status == slam::OdometryStatus::lost ? 1 : 0;
+    relocalised += r.status == slam::OdometryStatus::relocalised ? 1 : 0;
     wheel_rejected += r.wheel_rejected ? 1 : 0;
     inertial += r.inertial ? 1 : 0;
     standstill += r.standstill ? 1 : 0;
@@ -195,10 +199,10 @@ int bench_odometry(const BenchOptions& o) {
   }
   const double median = quantile(ms, 0.5);
   fmt::print("adit odometry: median {:.2f} ms, p99 {:.2f} ms per scan = {:.1f}x real time; "
-             "{} degenerate, {} invalid; resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
+             "{} degenerate, {} invalid ({} lost, {} relocalised); resident +{:.0f} MB (map and buffers), process peak {:.0f} MB\n"
              "  registration: {:.0f} points (at most {:.0f}) at {:.2f} m voxels, {:.0f} iterations per scan (medians); weakest direction's "
              "eigenvalue median {:.4f}, 10th percentile {:.4f} (degenerate below {})\n",
-             median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, resident_mb() - rss_before,
+             median, quantile(ms, 0.99), 1e3 * period_s / median, degenerate, invalid, lost, relocalised, resident_mb() - rss_before,
              peak_resident_mb(), quantile(used_points, 0.5), quantile(used_points, 1.0), voxels.empty() ? 0.0 : quantile(voxels, 0.5), quantile(iterations, 0.5), quantile(weakest, 0.5),
              quantile(weakest, 0.1), o.degeneracy_threshold);
   fmt::print("adit path: {:.2f} m\n", eval::path_length(estimate.poses));

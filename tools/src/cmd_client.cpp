@@ -51,6 +51,8 @@ std::string pose_flags(std::int32_t flags) {
   std::string out = (flags & pose_t::FLAG_VALID) ? "valid" : "INVALID";
   if (flags & pose_t::FLAG_DEGENERATE) out += ",degenerate";
   if (flags & pose_t::FLAG_HELD) out += ",held";
+  if (flags & pose_t::FLAG_LOST) out += ",LOST";
+  if (flags & pose_t::FLAG_RELOCALISED) out += ",relocalised";
   return out;
 }
 

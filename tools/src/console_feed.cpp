@@ -65,7 +65,9 @@ nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms) {
           {"q", {p.orientation[0], p.orientation[1], p.orientation[2], p.orientation[3]}},
           {"valid", (p.flags & pose_t::FLAG_VALID) != 0},
           {"degenerate", (p.flags & pose_t::FLAG_DEGENERATE) != 0},
-          {"held", (p.flags & pose_t::FLAG_HELD) != 0}};
+          {"held", (p.flags & pose_t::FLAG_HELD) != 0},
+          {"lost", (p.flags & pose_t::FLAG_LOST) != 0},
+          {"relocalised", (p.flags & pose_t::FLAG_RELOCALISED) != 0}};
 }
 
 LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)

@@ -85,6 +85,14 @@ struct OdometryConfig {
   // pulls in from about ±3° on real HDL-64 scans, hence the step.
   double max_turn_rate_radps = 5.0;
   double rotation_search_step_rad = 0.1;
+  // Lost: after the searches the registration still matches fewer than
+  // lost_correspondence_share of the last tracked scan's correspondences.
+  // The scan is held on the prediction and kept out of the map, and the next
+  // one is judged against the last tracked scan again. After max_lost_scans
+  // in a row the scene has changed, not the fit: tracking restarts from the
+  // registration (decision 043).
+  double lost_correspondence_share = 0.5;
+  int max_lost_scans = 10;
   double max_scan_gap_s = 1.0;           // a longer gap forgets the velocity
   // The constant-velocity prediction's standard deviation per scan, used as a
   // weak prior so that degenerate directions stay anchored to the prediction.
@@ -168,6 +176,8 @@ enum class OdometryStatus : std::uint8_t {
   too_few_points,     // held on the prediction
   time_went_back,     // scan ignored
   degenerate,         // valid, but some directions come from the prior only
+  lost,               // the fit collapsed: held on the prediction, kept out of the map
+  relocalised,        // valid: the first scan tracked again after lost ones
 };
 
 std::string_view to_string(OdometryStatus status);
@@ -230,7 +240,8 @@ class Odometry {
   bool started_ = false;
   bool reacquire_ = false;       // the next registration uses the initial threshold
   bool velocity_known_ = false;  // a registration has measured the motion since the start or the last gap
-  double last_correspondences_ = 0.0;
+  double last_correspondences_ = 0.0;  // the last tracked scan's
+  int lost_scans_ = 0;                 // in a row, up to now
   float registration_voxel_m_;  // this scan's, adapted from the last (see OdometryConfig)
   Eigen::Vector3d removed_far_at_ = Eigen::Vector3d::Zero();  // sensor position at the last remove_far
   Eigen::Isometry3d added_at_ = Eigen::Isometry3d::Identity();  // pose of the last scan the map took
