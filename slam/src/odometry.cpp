@@ -222,17 +222,18 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
       result.wheel_rejected = true;
     }
   }
-  // A turn the prediction missed (a hand-held scanner jerked round, or no
-  // velocity known yet): the registration collapses to a fraction of the
-  // last scan's correspondences, and one registration does not pull in from
-  // beyond a few degrees. It is started again from turns of the prediction
-  // about the body's z, and the start search below from the winning turn
+  // A turn the prediction missed (a hand-held scanner jerked round): the
+  // registration collapses to a fraction of the last scan's correspondences,
+  // and one registration does not pull in from beyond a few degrees. It is
+  // started again from turns of the prediction about the body's z
   // (docs/decisions/042-rotation-search-and-patient-kernel.md).
   const bool collapsed = last_correspondences_ > 0.0 && !enough(result.registration);
   double turn = 0.0;
-  if (!wheel && dt > 0.0 && (!velocity_known_ || collapsed)) {
+  if (!wheel && dt > 0.0 && velocity_known_ && collapsed) {
     const double wide = config_.initial_threshold_m / 3.0;
-    turn = search_rotation(config_.max_turn_rate_radps * dt, config_.rotation_search_step_rad,
+    const double reach = std::min(config_.max_turn_rate_radps * dt,
+                                  0.5 * config_.max_rotation_starts * config_.rotation_search_step_rad);
+    turn = search_rotation(reach, config_.rotation_search_step_rad,
                            config_.wheel_rejection_margin, config_.start_search_noise_sigmas,
                            [&](double yaw) {
                              PosePrior start = constant_velocity;

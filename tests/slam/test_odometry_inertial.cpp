@@ -98,7 +98,10 @@ Outcome run(const std::vector<Eigen::Vector3f>& hall, double period, int scans, 
     ScanInput input{static_cast<std::int64_t>(std::llround(t * 1e9)), points, times};
     if (with_imu) input.imu = imu;
     const OdometryResult r = odometry.process(input);
-    EXPECT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
+    // LiDAR only this walk is lost (decision 043): held scans are not valid.
+    if (with_imu) {
+      EXPECT_TRUE(r.valid) << "scan " << k << ": " << to_string(r.status);
+    }
     result.inertial_scans += r.inertial ? 1 : 0;
     result.standstill_scans += r.standstill ? 1 : 0;
     const Eigen::Isometry3d expected = handheld(0.0).inverse() * handheld(t);

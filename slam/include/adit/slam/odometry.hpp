@@ -78,13 +78,19 @@ struct OdometryConfig {
   // √n correspondences (n the prediction's): more than counting noise (decision 040).
   double start_search_noise_sigmas = 3.0;
   // A turn the prediction missed: when the registration explains fewer than
-  // min_correspondence_share of the last scan's correspondences (or no
-  // velocity is known), it is also started from the prediction turned about
-  // the body's z, every rotation_search_step_rad up to what max_turn_rate_radps
-  // covers between the two scans (0: no search; decision 042). One start
-  // pulls in from about ±3° on real HDL-64 scans, hence the step.
-  double max_turn_rate_radps = 5.0;
+  // min_correspondence_share of the last scan's correspondences, it is also
+  // started from the prediction turned about the body's z, every
+  // rotation_search_step_rad up to what max_turn_rate_radps covers between
+  // the two scans (0: no search), at most max_rotation_starts starts (a
+  // search's cost: a slow core must not stall the pipeline; decision 042).
+  // One start pulls in from about ±3° on real HDL-64 scans, hence the step.
+  // Off by default: on a core too slow for the scan rate, dropped scans make
+  // the predictions miss, each miss a search, and the search's cost drops
+  // more scans (seen under AddressSanitizer at 4x speed). 5 rad/s for a
+  // hand-held scanner without an IMU (a 120°/s turn reversed in one interval).
+  double max_turn_rate_radps = 0.0;
   double rotation_search_step_rad = 0.1;
+  int max_rotation_starts = 16;
   // Lost: after the searches the registration still matches fewer than
   // lost_correspondence_share of the last tracked scan's correspondences.
   // The scan is held on the prediction and kept out of the map, and the next
