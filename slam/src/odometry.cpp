@@ -228,22 +228,21 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // started again from turns of the prediction about the body's z
   // (docs/decisions/042-rotation-search-and-patient-kernel.md).
   const bool collapsed = last_correspondences_ > 0.0 && !enough(result.registration);
-  double turn = 0.0;
   if (!wheel && dt > 0.0 && velocity_known_ && collapsed) {
     const double wide = config_.initial_threshold_m / 3.0;
     const double reach = std::min(config_.max_turn_rate_radps * dt,
                                   0.5 * config_.max_rotation_starts * config_.rotation_search_step_rad);
-    turn = search_rotation(reach, config_.rotation_search_step_rad,
-                           config_.wheel_rejection_margin, config_.start_search_noise_sigmas,
-                           [&](double yaw) {
-                             PosePrior start = constant_velocity;
-                             start.mean = constant_velocity.mean * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
-                             SweepMotion turning = sweep;
-                             turning.velocity(5) += yaw / dt;  // the turn made over the interval
-                             return register_scan(source_, map_, start, 3.0 * wide, wide / 3.0, config_.registration,
-                                                  planes_, turning);
-                           },
-                           result.registration);
+    search_rotation(reach, config_.rotation_search_step_rad, config_.wheel_rejection_margin,
+                    config_.start_search_noise_sigmas,
+                    [&](double yaw) {
+                      PosePrior start = constant_velocity;
+                      start.mean = constant_velocity.mean * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
+                      SweepMotion turning = sweep;
+                      turning.velocity(5) += yaw / dt;  // the turn made over the interval
+                      return register_scan(source_, map_, start, 3.0 * wide, wide / 3.0, config_.registration, planes_,
+                                           turning);
+                    },
+                    result.registration);
   }
   // No velocity known yet (the first registration, or after the sensor
   // stopped): the prediction is "standing still", but the sensor may already
@@ -260,11 +259,9 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
                  config_.start_search_noise_sigmas,
                  [&](const Eigen::Vector2d& offset) {
                    PosePrior start = constant_velocity;
-                   start.mean = constant_velocity.mean * Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()) *
-                                Eigen::Translation3d(offset.x(), offset.y(), 0.0);
+                   start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);
                    SweepMotion moving = sweep;
                    moving.velocity.head<2>() += offset / dt;
-                   moving.velocity(5) += turn / dt;
                    return register_from(start, moving);
                  },
                  result.registration);

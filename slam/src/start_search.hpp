@@ -22,6 +22,15 @@
 
 namespace adit::slam {
 
+// The searches' last rule: `best` stays only when it matches more than
+// `noise_sigmas`·√n correspondences more than `predicted` (n its count);
+// otherwise the prediction's registration is kept.
+inline void keep_beyond_counting_noise(const RegistrationResult& predicted, double noise_sigmas,
+                                       RegistrationResult& best) {
+  const double n = static_cast<double>(predicted.correspondences);
+  if (static_cast<double>(best.correspondences) - n <= noise_sigmas * std::sqrt(n)) best = predicted;
+}
+
 // `register_from(offset)` registers from the prediction moved by `offset`
 // (m, body x and y) and returns the result.
 template <typename RegisterFrom>
@@ -38,8 +47,7 @@ void search_start(double reach_m, double step_m, double margin, double noise_sig
         best = alternative;
     }
   }
-  const double n = static_cast<double>(predicted.correspondences);
-  if (static_cast<double>(best.correspondences) - n <= noise_sigmas * std::sqrt(n)) best = predicted;
+  keep_beyond_counting_noise(predicted, noise_sigmas, best);
 }
 
 // The same over turns: the registration is also started from the prediction
@@ -48,28 +56,21 @@ void search_start(double reach_m, double step_m, double margin, double noise_sig
 // the winner. Every turn is tried: stopping at the first that fits as well
 // as the scans before did takes a nearer wrong fit on real scans (decision
 // 042). `register_from(yaw)` registers from the prediction turned by yaw.
-// Returns the winner's turn (0: the prediction kept).
 template <typename RegisterFrom>
-double search_rotation(double reach_rad, double step_rad, double margin, double noise_sigmas,
-                       RegisterFrom&& register_from, RegistrationResult& best) {
+void search_rotation(double reach_rad, double step_rad, double margin, double noise_sigmas,
+                     RegisterFrom&& register_from, RegistrationResult& best) {
   const RegistrationResult predicted = best;
-  double winner = 0.0;
   const auto steps = static_cast<int>(std::floor(std::min(reach_rad, std::numbers::pi) / step_rad + 1e-9));
   for (int k = 1; k <= steps; ++k) {
     const double yaw = k * step_rad;
     for (const double turn : {yaw, -yaw}) {
       if (turn < 0.0 && yaw >= std::numbers::pi - 1e-9) continue;  // half a turn either way is one start
       const RegistrationResult alternative = register_from(turn);
-      if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences)) {
+      if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences))
         best = alternative;
-        winner = turn;
-      }
     }
   }
-  const double n = static_cast<double>(predicted.correspondences);
-  if (static_cast<double>(best.correspondences) - n > noise_sigmas * std::sqrt(n)) return winner;
-  best = predicted;
-  return 0.0;
+  keep_beyond_counting_noise(predicted, noise_sigmas, best);
 }
 
 }  // namespace adit::slam
