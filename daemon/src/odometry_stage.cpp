@@ -17,7 +17,8 @@ OdometryStage::OdometryStage(const config::Config& config, const slam::OdometryC
       stats_(stats),
       timings_(timings),
       thread_("odometry", config.threads.odometry, stop),
-      odometry_(config, odometry, can, imu, [this] { return thread_.idle(); }),
+      odometry_(config, odometry, can, imu, [this] { return thread_.idle(); },
+                [this] { return !scans_.falling_behind(); }),
       poses_(kPoseSlots, Overflow::wait, [] { return PoseSlot{}; }) {
   if (mapping) {
     map_slots_.emplace(kMapSlots, overflow, [max_points] {

@@ -32,6 +32,7 @@ void OutputStage::loop() {
     if (r.status == slam::OdometryStatus::degenerate) stats_.degenerate_poses.fetch_add(1, std::memory_order_relaxed);
     if (r.status == slam::OdometryStatus::lost) stats_.lost_poses.fetch_add(1, std::memory_order_relaxed);
     if (r.status == slam::OdometryStatus::relocalised) stats_.relocalised_poses.fetch_add(1, std::memory_order_relaxed);
+    if (r.search_cut) stats_.searches_cut.fetch_add(1, std::memory_order_relaxed);
     if (timings_.latency_ms.size() < kTimingCapacity)
       timings_.latency_ms.push_back(1e-6 * static_cast<double>(slot->pose_mono_ns - slot->last_packet_mono_ns));
     if (sink_) sink_(r);

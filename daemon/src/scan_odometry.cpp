@@ -45,8 +45,8 @@ bool has_gyro(const config::ImuSection& imu) {
 }  // namespace
 
 ScanOdometry::ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
-                           ImuSource* imu, std::function<bool()> idle)
-    : odometry_(with_imu_position(odometry, config.imu.enabled ? imu : nullptr)),
+                           ImuSource* imu, std::function<bool()> idle, std::function<bool()> keeping_up)
+    : odometry_(with_imu_position(odometry, config.imu.enabled ? imu : nullptr), std::move(keeping_up)),
       extrinsic_(isometry_of(config.lidar.extrinsics).cast<float>()),
       can_(can),
       wheels_(can != nullptr && can->has_wheels()),

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "start_search.hpp"
 
@@ -37,8 +38,9 @@ std::string_view to_string(OdometryStatus status) {
   return "?";
 }
 
-Odometry::Odometry(const OdometryConfig& config)
+Odometry::Odometry(const OdometryConfig& config, std::function<bool()> keeping_up)
     : config_(config),
+      keeping_up_(std::move(keeping_up)),
       map_(config.map_voxel_m, config.map_capacity_voxels, config.map_point_spacing_m),
       downsampler_(config.max_scan_points),
       threshold_(config.initial_threshold_m, config.min_motion_m, config.max_range_m),
@@ -232,8 +234,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     const double wide = config_.initial_threshold_m / 3.0;
     const double reach = std::min(config_.max_turn_rate_radps * dt,
                                   0.5 * config_.max_rotation_starts * config_.rotation_search_step_rad);
-    search_rotation(reach, config_.rotation_search_step_rad, config_.wheel_rejection_margin,
-                    config_.start_search_noise_sigmas,
+    result.search_cut |= !search_rotation(reach, config_.rotation_search_step_rad, config_.wheel_rejection_margin,
+                    config_.start_search_noise_sigmas, [this] { return keeping_up(); },
                     [&](double yaw) {
                       PosePrior start = constant_velocity;
                       start.mean = constant_velocity.mean * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
@@ -255,8 +257,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   // clearly more of the scan wins (as a slipped wheel is overruled above;
   // docs/decisions/012-start-search.md).
   if (!wheel && !velocity_known_ && dt > 0.0) {
-    search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m, config_.wheel_rejection_margin,
-                 config_.start_search_noise_sigmas,
+    result.search_cut |= !search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m,
+                 config_.wheel_rejection_margin, config_.start_search_noise_sigmas, [this] { return keeping_up(); },
                  [&](const Eigen::Vector2d& offset) {
                    PosePrior start = constant_velocity;
                    start.mean = constant_velocity.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);

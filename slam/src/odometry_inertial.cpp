@@ -105,8 +105,8 @@ void Odometry::register_inertial(const ScanInput& scan, const std::optional<Moti
   // the start search of the LiDAR-only step, for the translation (the
   // gyroscope has the rotation).
   if (!wheel && !velocity_known_ && dt > 0.0)
-    search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m, config_.wheel_rejection_margin,
-                 config_.start_search_noise_sigmas,
+    result.search_cut |= !search_start(config_.max_start_speed_mps * dt, config_.start_search_step_m,
+                 config_.wheel_rejection_margin, config_.start_search_noise_sigmas, [this] { return keeping_up(); },
                  [&](const Eigen::Vector2d& offset) {
                    PosePrior start = prior;
                    start.mean = prior.mean * Eigen::Translation3d(offset.x(), offset.y(), 0.0);

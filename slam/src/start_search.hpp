@@ -32,22 +32,30 @@ inline void keep_beyond_counting_noise(const RegistrationResult& predicted, doub
 }
 
 // `register_from(offset)` registers from the prediction moved by `offset`
-// (m, body x and y) and returns the result.
-template <typename RegisterFrom>
-void search_start(double reach_m, double step_m, double margin, double noise_sigmas, RegisterFrom&& register_from,
-                  RegistrationResult& best) {
+// (m, body x and y) and returns the result. Each start waits for `go_on()`:
+// when it says false (the odometry fell behind its input, decision 044) the
+// search stops with what it has, and returns false. True: every start tried.
+template <typename GoOn, typename RegisterFrom>
+bool search_start(double reach_m, double step_m, double margin, double noise_sigmas, GoOn&& go_on,
+                  RegisterFrom&& register_from, RegistrationResult& best) {
   const RegistrationResult predicted = best;
   const auto steps = static_cast<int>(std::floor(reach_m / step_m + 1e-9));
-  for (int k = 1; k <= steps; ++k) {
+  bool complete = true;
+  for (int k = 1; k <= steps && complete; ++k) {
     const double d = k * step_m;
     for (const Eigen::Vector2d& offset :
          {Eigen::Vector2d(d, 0.0), Eigen::Vector2d(-d, 0.0), Eigen::Vector2d(0.0, d), Eigen::Vector2d(0.0, -d)}) {
+      if (!go_on()) {
+        complete = false;
+        break;
+      }
       const RegistrationResult alternative = register_from(offset);
       if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences))
         best = alternative;
     }
   }
   keep_beyond_counting_noise(predicted, noise_sigmas, best);
+  return complete;
 }
 
 // The same over turns: the registration is also started from the prediction
@@ -55,22 +63,29 @@ void search_start(double reach_m, double step_m, double margin, double noise_sig
 // `reach_rad` (at most half a turn), nearest first, with the same rule for
 // the winner. Every turn is tried: stopping at the first that fits as well
 // as the scans before did takes a nearer wrong fit on real scans (decision
-// 042). `register_from(yaw)` registers from the prediction turned by yaw.
-template <typename RegisterFrom>
-void search_rotation(double reach_rad, double step_rad, double margin, double noise_sigmas,
+// 042). `register_from(yaw)` registers from the prediction turned by yaw;
+// `go_on` and the result as search_start's.
+template <typename GoOn, typename RegisterFrom>
+bool search_rotation(double reach_rad, double step_rad, double margin, double noise_sigmas, GoOn&& go_on,
                      RegisterFrom&& register_from, RegistrationResult& best) {
   const RegistrationResult predicted = best;
   const auto steps = static_cast<int>(std::floor(std::min(reach_rad, std::numbers::pi) / step_rad + 1e-9));
-  for (int k = 1; k <= steps; ++k) {
+  bool complete = true;
+  for (int k = 1; k <= steps && complete; ++k) {
     const double yaw = k * step_rad;
     for (const double turn : {yaw, -yaw}) {
       if (turn < 0.0 && yaw >= std::numbers::pi - 1e-9) continue;  // half a turn either way is one start
+      if (!go_on()) {
+        complete = false;
+        break;
+      }
       const RegistrationResult alternative = register_from(turn);
       if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences))
         best = alternative;
     }
   }
   keep_beyond_counting_noise(predicted, noise_sigmas, best);
+  return complete;
 }
 
 }  // namespace adit::slam

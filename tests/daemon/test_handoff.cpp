@@ -48,6 +48,26 @@ TEST(Handoff, WaitPolicyRefusesInsteadOfDropping) {
   EXPECT_EQ(handoff.dropped(), 0U);
 }
 
+// The odometry's searches ask this before each extra registration: a live
+// stream is behind while items wait behind the one in hand; a file replay
+// never drops, so never is.
+TEST(Handoff, FallingBehindWhileALiveStreamHasItemsWaiting) {
+  Handoff<int> live(3, Overflow::drop_oldest, [] { return 0; });
+  live.publish(live.acquire());
+  int* in_hand = live.take();
+  EXPECT_FALSE(live.falling_behind());
+  live.publish(live.acquire());
+  EXPECT_TRUE(live.falling_behind());
+  live.release(in_hand);
+  live.release(live.take());
+  EXPECT_FALSE(live.falling_behind());
+
+  Handoff<int> replay(3, Overflow::wait, [] { return 0; });
+  replay.publish(replay.acquire());
+  replay.publish(replay.acquire());
+  EXPECT_FALSE(replay.falling_behind());
+}
+
 // Two threads, a slow consumer and a small pool: every item the consumer sees
 // is intact (its two halves agree), sequence numbers only increase, and every
 // item is either consumed or counted as dropped.

@@ -100,6 +100,9 @@ class Handoff {
   std::uint64_t published() const { return published_.load(std::memory_order_relaxed); }
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
   std::size_t depth() const { return filled_.size(); }
+  // Consumer: a live source's items wait behind the one in hand, so a slow
+  // consumer would soon drop some (a file replay waits instead: never).
+  bool falling_behind() const { return overflow_ == Overflow::drop_oldest && filled_.size() > 0; }
   std::size_t capacity() const { return pool_.size(); }
 
   static constexpr std::chrono::microseconds kPoll{200};

@@ -48,6 +48,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> degenerate_poses{0};
   std::atomic<std::uint64_t> lost_poses{0};         // the fit collapsed: held, kept out of the map
   std::atomic<std::uint64_t> relocalised_poses{0};  // tracked again after lost ones
+  std::atomic<std::uint64_t> searches_cut{0};       // a rotation or start search stopped short: scans were waiting
   std::atomic<std::uint64_t> bad_packets{0};
   // The link as the scan assembler sees it (drivers/lidar/scan_assembler.hpp):
   // packets missing from the sequence, repeated, arriving late (skipped), and

@@ -48,8 +48,10 @@ class ScanOdometry {
   // `imu`: the IMU source (the CAN feed itself, or the Ouster's), or null.
   // `idle` is called while a replayed source lags the scan: it beats the
   // caller's heartbeat and returns false to stop waiting.
+  // `keeping_up` (empty: always) is slam::Odometry's: whether no scan waits
+  // behind the one in hand, for the searches (docs/decisions/044).
   ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can, ImuSource* imu,
-               std::function<bool()> idle);
+               std::function<bool()> idle, std::function<bool()> keeping_up = {});
   // The CAN feed's own IMU, if it has one.
   ScanOdometry(const config::Config& config, const slam::OdometryConfig& odometry, CanFeed* can,
                std::function<bool()> idle)

@@ -9,6 +9,7 @@
 // valid = false and a reason, and the pose is held on the prediction.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -84,11 +85,12 @@ struct OdometryConfig {
   // the two scans (0: no search), at most max_rotation_starts starts (a
   // search's cost: a slow core must not stall the pipeline; decision 042).
   // One start pulls in from about ±3° on real HDL-64 scans, hence the step.
-  // Off by default: on a core too slow for the scan rate, dropped scans make
-  // the predictions miss, each miss a search, and the search's cost drops
-  // more scans (seen under AddressSanitizer at 4x speed). 5 rad/s for a
-  // hand-held scanner without an IMU (a 120°/s turn reversed in one interval).
-  double max_turn_rate_radps = 0.0;
+  // 5 rad/s: a hand-held turn of 120°/s reversed within one interval. A
+  // search starts a registration only while the odometry keeps up with its
+  // input (Odometry's `keeping_up`): on a core too slow for the scan rate,
+  // dropped scans made the predictions miss, each miss a search, and the
+  // searches' cost dropped more scans (decision 044).
+  double max_turn_rate_radps = 5.0;
   double rotation_search_step_rad = 0.1;
   int max_rotation_starts = 16;
   // Lost: after the searches the registration still matches fewer than
@@ -197,6 +199,7 @@ struct OdometryResult {
   bool wheel_rejected = false;  // the wheel prior disagreed with the scan (or the IMU); it was not used
   bool inertial = false;        // the IMU predicted and deskewed this scan
   bool standstill = false;      // the body appeared still: the filter took a zero-velocity update
+  bool search_cut = false;      // a rotation or start search stopped short: the odometry was behind its input
   Vector6d sweep_velocity = Vector6d::Zero();  // body twist per second over the scan, as deskewed
   RegistrationResult registration;
   std::size_t input_points = 0;
@@ -211,7 +214,11 @@ bool wheel_motion_implausible(const Eigen::Isometry3d& wheel_delta, const Vector
 
 class Odometry {
  public:
-  explicit Odometry(const OdometryConfig& config);
+  // `keeping_up`, when given, says whether the odometry keeps up with its
+  // input (no scan waiting behind this one in a live stream); the searches
+  // start a registration only while it returns true (decision 044). Empty:
+  // always (a file replayed as fast as it goes, a test).
+  explicit Odometry(const OdometryConfig& config, std::function<bool()> keeping_up = {});
 
   OdometryResult process(const ScanInput& scan, const std::optional<MotionPrior>& wheel = std::nullopt);
 
@@ -226,6 +233,7 @@ class Odometry {
 
  private:
   OdometryConfig config_;
+  std::function<bool()> keeping_up_;
   VoxelHashMap map_;
   VoxelDownsampler downsampler_;
   Deskewer deskewer_;
@@ -251,6 +259,7 @@ class Odometry {
   float registration_voxel_m_;  // this scan's, adapted from the last (see OdometryConfig)
   Eigen::Vector3d removed_far_at_ = Eigen::Vector3d::Zero();  // sensor position at the last remove_far
   Eigen::Isometry3d added_at_ = Eigen::Isometry3d::Identity();  // pose of the last scan the map took
+  bool keeping_up() const { return !keeping_up_ || keeping_up_(); }
   // LiDAR-inertial odometry (odometry_inertial.cpp).
   // Whether the scan's IMU readings can carry the filter over it: then the
   // filter is propagated to the scan and its sweep's motion predicted.
