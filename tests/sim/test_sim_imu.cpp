@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string_view>
 #include <vector>
 
 #include "adit/sim/imu.hpp"
@@ -37,18 +38,23 @@ double rotation_angle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a.transpose() * b).angle();
 }
 
+// The simulator's path for a platform (its scene's, as adit sim makes it).
+BodyTrack platform_path(const char* platform, double duration_s, unsigned seed) {
+  SimOptions s;
+  s.platform = platform;
+  s.duration_s = duration_s;
+  s.seed = seed;
+  return simulated_path(simulated_scene(s), s);
+}
+
 // q ← q·exp(ω·T) over the samples, from the track's orientation half a period
 // before the first: the track's orientation half a period after the last, on
 // every platform and at every rate, to float precision.
 TEST(SimImu, NoiselessGyroIntegratesToTheTrackRotation) {
   for (const char* platform : {"robot", "drone", "handheld"}) {
-    SimOptions s;
-    s.platform = platform;
-    s.duration_s = 30.0;
-    s.seed = 3;
-    const BodyTrack body = simulated_path(simulated_scene(s), s);
+    const BodyTrack body = platform_path(platform, 30.0, 3);
     for (const double rate : {100.0, 200.0, 400.0}) {
-      const ImuOptions o = noiseless(rate, s.platform == "robot" ? ImuMotion::wheeled : ImuMotion::smooth);
+      const ImuOptions o = noiseless(rate, std::string_view(platform) == "robot" ? ImuMotion::wheeled : ImuMotion::smooth);
       const std::vector<ImuSample> samples = simulate_imu(body, o);
       ASSERT_EQ(samples.size(), static_cast<std::size_t>(30.0 * rate) + 1);
       const double T = 1.0 / rate;
@@ -309,12 +315,8 @@ double worst_dead_reckoning_error(const BodyTrack& body, ImuMotion motion) {
 // is not a wheeled vehicle's (drone 0.12 m, hand-held 0.19 m): the test bites.
 TEST(SimImu, NoiselessAccelerometerDeadReckonsAlongTheTrack) {
   for (const char* platform : {"robot", "drone", "handheld"}) {
-    SimOptions s;
-    s.platform = platform;
-    s.duration_s = 60.0;
-    s.seed = 2;
-    const BodyTrack body = simulated_path(simulated_scene(s), s);
-    const bool robot = s.platform == "robot";
+    const BodyTrack body = platform_path(platform, 60.0, 2);
+    const bool robot = std::string_view(platform) == "robot";
     const double own = worst_dead_reckoning_error(body, robot ? ImuMotion::wheeled : ImuMotion::smooth);
     const double other = worst_dead_reckoning_error(body, robot ? ImuMotion::smooth : ImuMotion::wheeled);
     std::printf("%s: worst 0.5 s dead-reckoning error %.4f m with its own model, %.4f m with the other\n", platform, own,
