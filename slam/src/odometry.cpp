@@ -199,10 +199,6 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   };
   // An alternative start replaces the registration only when it explains
   // clearly more of the scan: where the scan cannot tell, the first keeps it.
-  const auto explains_clearly_more = [&](const RegistrationResult& alternative) {
-    return static_cast<double>(alternative.correspondences) >
-           (1.0 + config_.wheel_rejection_margin) * static_cast<double>(result.registration.correspondences);
-  };
   result.registration = register_from(prior, sweep);
   // Wheels that slipped (or a wrong encoder) put the prediction where the
   // scan no longer overlaps the map: far fewer correspondences than the last
@@ -219,7 +215,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
     constant_sweep.velocity = velocity_;
     constant_sweep.information = sweep_information.asDiagonal();
     const RegistrationResult alternative = register_from(constant_velocity, constant_sweep);
-    if (explains_clearly_more(alternative)) {
+    if (explains_clearly_more(alternative, result.registration, config_.wheel_rejection_margin)) {
       result.registration = alternative;
       result.wheel_rejected = true;
     }

@@ -31,6 +31,24 @@ inline void keep_beyond_counting_noise(const RegistrationResult& predicted, doub
   if (static_cast<double>(best.correspondences) - n <= noise_sigmas * std::sqrt(n)) best = predicted;
 }
 
+// The rule for a rival registration (a search's start, the wheels' check of
+// decision 006): it replaces `best` only when it explains clearly more of the
+// scan, `margin` more correspondences.
+inline bool explains_clearly_more(const RegistrationResult& alternative, const RegistrationResult& best,
+                                  double margin) {
+  return static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences);
+}
+
+// One start of a search: registered from `start` and kept by the rule above,
+// if `go_on()` allows it; false (nothing tried) when it does not.
+template <typename GoOn, typename RegisterFrom, typename Start>
+bool try_start(GoOn& go_on, RegisterFrom& register_from, const Start& start, double margin, RegistrationResult& best) {
+  if (!go_on()) return false;
+  const RegistrationResult alternative = register_from(start);
+  if (explains_clearly_more(alternative, best, margin)) best = alternative;
+  return true;
+}
+
 // `register_from(offset)` registers from the prediction moved by `offset`
 // (m, body x and y) and returns the result. Each start waits for `go_on()`:
 // when it says false (the odometry fell behind its input, decision 044) the
@@ -45,13 +63,8 @@ bool search_start(double reach_m, double step_m, double margin, double noise_sig
     const double d = k * step_m;
     for (const Eigen::Vector2d& offset :
          {Eigen::Vector2d(d, 0.0), Eigen::Vector2d(-d, 0.0), Eigen::Vector2d(0.0, d), Eigen::Vector2d(0.0, -d)}) {
-      if (!go_on()) {
-        complete = false;
-        break;
-      }
-      const RegistrationResult alternative = register_from(offset);
-      if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences))
-        best = alternative;
+      complete = try_start(go_on, register_from, offset, margin, best);
+      if (!complete) break;
     }
   }
   keep_beyond_counting_noise(predicted, noise_sigmas, best);
@@ -75,13 +88,8 @@ bool search_rotation(double reach_rad, double step_rad, double margin, double no
     const double yaw = k * step_rad;
     for (const double turn : {yaw, -yaw}) {
       if (turn < 0.0 && yaw >= std::numbers::pi - 1e-9) continue;  // half a turn either way is one start
-      if (!go_on()) {
-        complete = false;
-        break;
-      }
-      const RegistrationResult alternative = register_from(turn);
-      if (static_cast<double>(alternative.correspondences) > (1.0 + margin) * static_cast<double>(best.correspondences))
-        best = alternative;
+      complete = try_start(go_on, register_from, turn, margin, best);
+      if (!complete) break;
     }
   }
   keep_beyond_counting_noise(predicted, noise_sigmas, best);
