@@ -52,4 +52,15 @@ void ImuPosePublisher::publish(const slam::InertialState& state) {
     published_.fetch_add(1, std::memory_order_relaxed);
 }
 
+std::optional<std::string> imu_pose_latency_warning(const config::Config& config) {
+  if (!config.imu.enabled || !(config.imu.pose_horizon_s > 0.0)) return std::nullopt;
+  if (config.imu.source == config::ImuSource::can)
+    return "POSE_IMU: a CAN IMU's readings are read on the CAN thread, which runs with the default scheduler: "
+           "the IMU-rate pose may come later than 2 ms after a reading on a busy core (decision 041)";
+  if (config.threads.receiver.policy == config::SchedPolicy::fifo) return std::nullopt;
+  return "POSE_IMU: the LiDAR's IMU is read on the receiver thread, which runs with the default scheduler: the "
+         "IMU-rate pose may come later than 2 ms after a reading on a busy core; set threads.receiver: "
+         "{policy: fifo, priority: 50} (decision 041)";
+}
+
 }  // namespace adit::daemon

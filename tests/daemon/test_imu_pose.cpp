@@ -75,6 +75,30 @@ TEST(ImuPosePublisher, EachPoseGoesOutOnPoseImu) {
   }
 }
 
+// The configurations whose IMU-rate pose runs on a thread without a
+// real-time policy say so at start (decision 041); the payload template's
+// SCHED_FIFO receiver does not.
+TEST(ImuPosePublisher, AConfigurationThatCannotKeepTwoMillisecondsSaysWhy) {
+  config::Config c;
+  c.imu.enabled = true;
+  c.imu.pose_horizon_s = 0.1;
+  c.imu.source = config::ImuSource::ouster;
+  const std::optional<std::string> other = imu_pose_latency_warning(c);
+  ASSERT_TRUE(other.has_value());
+  EXPECT_NE(other->find("threads.receiver"), std::string::npos) << *other;
+  c.threads.receiver.policy = config::SchedPolicy::fifo;
+  EXPECT_FALSE(imu_pose_latency_warning(c).has_value());
+  c.imu.source = config::ImuSource::can;
+  const std::optional<std::string> can = imu_pose_latency_warning(c);
+  ASSERT_TRUE(can.has_value());
+  EXPECT_NE(can->find("CAN thread"), std::string::npos) << *can;
+  c.imu.pose_horizon_s = 0.0;  // no IMU-rate pose published
+  EXPECT_FALSE(imu_pose_latency_warning(c).has_value());
+  c.imu.pose_horizon_s = 0.1;
+  c.imu.enabled = false;
+  EXPECT_FALSE(imu_pose_latency_warning(c).has_value());
+}
+
 // aditd's pipeline replaying a simulated hand-held walk (OS1-64, its IMU at
 // 100 Hz in the same capture) at the recorded pace, as a live sensor sends
 // it: a pose per IMU reading, scored against the truth as the scan-rate

@@ -208,6 +208,7 @@ int bench_pipeline(const BenchPipelineOptions& o) {
              udp.figures.latency_p99_ms, file.latency_p99_ms, udp.figures.beyond_odometry_p99_ms,
              file.beyond_odometry_p99_ms, udp.figures.beyond_odometry_p99_ms - file.beyond_odometry_p99_ms,
              kLatencyTargetMs, udp.figures.latency_p99_ms <= kLatencyTargetMs ? "met" : "NOT met");
+  if (const std::optional<std::string> warning = daemon::imu_pose_latency_warning(config)) fmt::print("note: {}\n", *warning);
   return kExitOk;
 }
 
