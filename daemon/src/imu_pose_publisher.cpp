@@ -23,7 +23,6 @@ struct ImuPosePublisher::Impl {
     if (!lcm.good()) throw std::runtime_error(fmt::format("LCM cannot open '{}'", url));
     message.schema = 1;
     message.flags = adit::pose_t::FLAG_VALID;
-    for (double& c : message.covariance) c = 0.0;
     buffer.resize(static_cast<std::size_t>(message.getEncodedSize()));  // fixed: the session id stays empty
   }
 };
@@ -33,7 +32,7 @@ ImuPosePublisher::ImuPosePublisher(const std::string& lcm_url, const std::string
 
 ImuPosePublisher::~ImuPosePublisher() = default;
 
-void ImuPosePublisher::publish(const slam::InertialState& state) {
+void ImuPosePublisher::publish(const slam::InertialState& state, const slam::Matrix6d& covariance) {
   Impl& i = *impl_;
   adit::pose_t& m = i.message;
   m.utime = static_cast<std::int64_t>(state.t * 1e6);
@@ -47,6 +46,8 @@ void ImuPosePublisher::publish(const slam::InertialState& state) {
   m.orientation[1] = q.x();
   m.orientation[2] = q.y();
   m.orientation[3] = q.z();
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) m.covariance[6 * r + c] = covariance(r, c);  // row-major, as POSE's
   const int size = m.encode(i.buffer.data(), 0, static_cast<int>(i.buffer.size()));
   if (size > 0 && i.lcm.publish(i.channel, i.buffer.data(), static_cast<unsigned>(size)) == 0)
     published_.fetch_add(1, std::memory_order_relaxed);

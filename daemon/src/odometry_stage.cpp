@@ -55,7 +55,7 @@ void OdometryStage::loop() {
       continue;
     }
     const slam::OdometryResult& result = odometry_.process(slot->scan);
-    if (imu_poses_ != nullptr && result.valid && result.inertial) imu_poses_->anchor(odometry_.inertial_state());
+    if (imu_poses_ != nullptr && result.valid && result.inertial) imu_poses_->anchor(odometry_.inertial_state(), odometry_.inertial_covariance());
     const MotionAidCounts& counts = odometry_.counts();
     stats_.wheel_priors.store(counts.wheel_priors, std::memory_order_relaxed);
     stats_.scans_without_wheels.store(counts.scans_without_wheels, std::memory_order_relaxed);

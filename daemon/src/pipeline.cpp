@@ -57,8 +57,8 @@ struct Pipeline::Impl {
     open_files(o.trajectory_file, o.map_trajectory_file, o.record_file);
     if (ImuSource* imu = imu_source_of(c, can.get(), source); imu != nullptr && c.imu.pose_horizon_s > 0.0) {
       slam::ImuExtrapolatorConfig x;
-      x.max_sample_gap_s = odometry_config.inertial.max_sample_gap_s;
-      x.imu_position = imu->mounting().position_m;  // as the odometry's filter has it
+      x.inertial = odometry_config.inertial;
+      x.inertial.imu_position = imu->mounting().position_m;  // as the odometry's filter has it
       x.max_horizon_s = c.imu.pose_horizon_s;
       imu_poses.emplace(x, o.sinks.imu_pose);
       imu->feed_poses_to(&*imu_poses);

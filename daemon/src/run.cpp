@@ -153,7 +153,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   std::optional<ImuPosePublisher> imu_poses;
   if (config.imu.enabled && config.imu.pose_horizon_s > 0.0) {
     imu_poses.emplace(config.lcm.url, config.payload.id);
-    outputs.imu_pose = [&imu_poses](const slam::InertialState& s) { imu_poses->publish(s); };
+    outputs.imu_pose = [&imu_poses](const slam::InertialState& s, const slam::Matrix6d& c) { imu_poses->publish(s, c); };
     if (const std::optional<std::string> warning = imu_pose_latency_warning(config)) log::warn("{}", *warning);
   }
   Sessions sessions(config, std::move(outputs));

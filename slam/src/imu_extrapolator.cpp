@@ -18,13 +18,16 @@ void ImuExtrapolator::step(const ImuSample& from, const ImuSample& to) {
   const kinematics::Reading a{from.angular_rate + s * (to.angular_rate - from.angular_rate),
                               from.specific_force + s * (to.specific_force - from.specific_force)};
   const kinematics::Reading b{to.angular_rate, to.specific_force};
-  kinematics::integrate(current_, a, b, dt, config_.imu_position);
+  const Eigen::Matrix3d R = current_.pose.linear();
+  const auto [w, f] = kinematics::integrate(current_, a, b, dt, config_.inertial.imu_position);
+  kinematics::propagate_covariance(covariance_, R, w, f, dt, config_.inertial);
   current_.t = to.t;
 }
 
-void ImuExtrapolator::anchor(const InertialState& state) {
+void ImuExtrapolator::anchor(const InertialState& state, const Matrix18d& covariance) {
   anchor_t_ = state.t;
   current_ = state;
+  covariance_ = covariance;
   // Readings already past the horizon (a replayed log read far ahead): none
   // of them, nor any later one, gives a pose from this anchor.
   current_valid_ = count_ == 0 || kept(count_ - 1).t - state.t <= config_.max_horizon_s;
@@ -35,7 +38,7 @@ void ImuExtrapolator::anchor(const InertialState& state) {
     if (to.t <= state.t) continue;
     const ImuSample& from = i > 0 ? kept(i - 1) : to;
     const double gap = i > 0 ? to.t - from.t : to.t - state.t;
-    if (gap > config_.max_sample_gap_s) current_valid_ = false;
+    if (gap > config_.inertial.max_sample_gap_s) current_valid_ = false;
     else step(from, to);
   }
 }
@@ -43,9 +46,9 @@ void ImuExtrapolator::anchor(const InertialState& state) {
 std::optional<InertialState> ImuExtrapolator::add(const ImuSample& reading) {
   if (count_ > 0 && !(reading.t > kept(count_ - 1).t)) return std::nullopt;  // out of order: not kept
   const ImuSample* previous = count_ > 0 ? &kept(count_ - 1) : nullptr;
-  const bool gap = previous == nullptr || reading.t - previous->t > config_.max_sample_gap_s;
+  const bool gap = previous == nullptr || reading.t - previous->t > config_.inertial.max_sample_gap_s;
   if (anchor_t_ && current_valid_) {
-    if (gap && reading.t - current_.t > config_.max_sample_gap_s) current_valid_ = false;
+    if (gap && reading.t - current_.t > config_.inertial.max_sample_gap_s) current_valid_ = false;
     else if (previous != nullptr && !gap) step(*previous, reading);
     else step(reading, reading);  // the anchor's time is within a gap's reach of this first reading
   }
@@ -59,6 +62,10 @@ std::optional<InertialState> ImuExtrapolator::add(const ImuSample& reading) {
   }
   if (!anchor_t_ || !current_valid_ || reading.t - *anchor_t_ > config_.max_horizon_s) return std::nullopt;
   return current_;
+}
+
+Matrix6d ImuExtrapolator::pose_covariance() const {
+  return kinematics::body_pose_covariance(covariance_, current_.pose.linear());
 }
 
 }  // namespace adit::slam

@@ -12,8 +12,12 @@ using kinematics::exp_so3;
 using kinematics::integrate;
 using kinematics::Reading;
 
-// Error-state blocks (see the header).
-constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12, kG = 15;
+using kinematics::kBa;
+using kinematics::kBg;
+using kinematics::kG;
+using kinematics::kP;
+using kinematics::kTheta;
+using kinematics::kV;
 
 // The samples at `tau`: linear between the two around it, the nearest held
 // beyond the ends. `j` walks forward with tau (samples[j].t <= tau).
@@ -73,31 +77,10 @@ void InertialFilter::reset(const InertialState& state, const Matrix6d& pose_cova
 
 bool InertialFilter::propagate(std::span<const ImuSample> samples, double t_end) {
   if (!covers(samples, state_.t, t_end, config_.max_sample_gap_s)) return false;
-  const ImuNoise& n = config_.noise;
-  const double gyro_density2 = n.gyro_noise_density * n.gyro_noise_density +
-                               config_.gyro_model_error_density * config_.gyro_model_error_density;
-  const double accel_density2 = n.accel_noise_density * n.accel_noise_density +
-                                config_.accel_model_error_density * config_.accel_model_error_density;
   for_each_piece(samples, state_.t, t_end, [&](const Reading& a, const Reading& b, double dt) {
     const Eigen::Matrix3d R = state_.pose.linear();
     const auto [w, f] = integrate(state_, a, b, dt, config_.imu_position);
-    // Error dynamics (Solà 2017, eq. 269 with local angular error), first order in dt:
-    // δθ' = exp(−ω dt)·δθ − dt·δb_g, δp' = δp + dt·δv,
-    // δv' = δv − dt·R[f]×·δθ − dt·R·δb_a + dt·δg.
-    Matrix18d F = Matrix18d::Identity();
-    F.block<3, 3>(kTheta, kTheta) = exp_so3(-w * dt);
-    F.block<3, 3>(kTheta, kBg) = -dt * Eigen::Matrix3d::Identity();
-    F.block<3, 3>(kP, kV) = dt * Eigen::Matrix3d::Identity();
-    F.block<3, 3>(kV, kTheta) = -dt * R * skew(f);
-    F.block<3, 3>(kV, kBa) = -dt * R;
-    F.block<3, 3>(kV, kG) = dt * Eigen::Matrix3d::Identity();
-    covariance_ = F * covariance_ * F.transpose();
-    // White noise integrated over dt: density² · dt (isotropic, so R·Q·Rᵀ = Q),
-    // the model error's with the datasheet's.
-    covariance_.block<3, 3>(kTheta, kTheta).diagonal().array() += gyro_density2 * dt;
-    covariance_.block<3, 3>(kV, kV).diagonal().array() += accel_density2 * dt;
-    covariance_.block<3, 3>(kBg, kBg).diagonal().array() += n.gyro_bias_walk * n.gyro_bias_walk * dt;
-    covariance_.block<3, 3>(kBa, kBa).diagonal().array() += n.accel_bias_walk * n.accel_bias_walk * dt;
+    kinematics::propagate_covariance(covariance_, R, w, f, dt, config_);
   });
   state_.t = t_end;  // the pieces' sum, without its rounding
   return true;
@@ -121,9 +104,7 @@ PosePrior InertialFilter::pose_prior() const {
   PosePrior prior;
   prior.mean = state_.pose;
   // Registration's ρ is the body-frame translation: ρ = Rᵀ·δp.
-  Matrix6d M = Matrix6d::Identity();
-  M.topLeftCorner<3, 3>() = state_.pose.linear().transpose();
-  const Matrix6d pose_covariance = M * covariance_.topLeftCorner<6, 6>() * M.transpose();
+  const Matrix6d pose_covariance = kinematics::body_pose_covariance(covariance_, state_.pose.linear());
   prior.information = pose_covariance.ldlt().solve(Matrix6d::Identity());
   if (!prior.information.allFinite()) prior.information.setZero();
   return prior;

@@ -1,8 +1,9 @@
 #pragma once
-// The nominal kinematics of an IMU-driven body, shared by the filter's
-// propagation (inertial_filter.cpp) and the pose extrapolated at the IMU's
-// rate between scans (imu_extrapolator.cpp): one midpoint step of pose and
-// velocity from two readings (Solà 2017, §5.3, the nominal-state kinematics).
+// The kinematics of an IMU-driven body, shared by the filter's propagation
+// (inertial_filter.cpp) and the pose extrapolated at the IMU's rate between
+// scans (imu_extrapolator.cpp): one midpoint step of pose and velocity from
+// two readings (Solà 2017, §5.3, the nominal-state kinematics), and the
+// error state's covariance carried through it (§5.3.3).
 
 #include <utility>
 
@@ -50,6 +51,45 @@ inline std::pair<Eigen::Vector3d, Eigen::Vector3d> integrate(InertialState& s, c
   s.pose.linear() = q.normalized().toRotationMatrix();
   s.t += dt;
   return {w, 0.5 * (fa + fb)};
+}
+
+// Error-state blocks (inertial_filter.hpp): δp, δθ, δv, δb_g, δb_a, δg.
+inline constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12, kG = 15;
+
+// The error state's covariance through one step of `dt` at attitude R (the
+// step's start) with the bias-corrected rate w and specific force f that
+// `integrate` returned. Error dynamics (Solà 2017, eq. 269 with local angular
+// error), first order in dt: δθ' = exp(−ω dt)·δθ − dt·δb_g, δp' = δp + dt·δv,
+// δv' = δv − dt·R[f]×·δθ − dt·R·δb_a + dt·δg; white noise integrated over dt
+// (density² · dt; isotropic, so R·Q·Rᵀ = Q), the model error's with the
+// datasheet's, and the biases' random walks.
+inline void propagate_covariance(Matrix18d& covariance, const Eigen::Matrix3d& R, const Eigen::Vector3d& w,
+                                 const Eigen::Vector3d& f, double dt, const InertialConfig& config) {
+  const ImuNoise& n = config.noise;
+  const double gyro_density2 = n.gyro_noise_density * n.gyro_noise_density +
+                               config.gyro_model_error_density * config.gyro_model_error_density;
+  const double accel_density2 = n.accel_noise_density * n.accel_noise_density +
+                                config.accel_model_error_density * config.accel_model_error_density;
+  Matrix18d F = Matrix18d::Identity();
+  F.block<3, 3>(kTheta, kTheta) = exp_so3(-w * dt);
+  F.block<3, 3>(kTheta, kBg) = -dt * Eigen::Matrix3d::Identity();
+  F.block<3, 3>(kP, kV) = dt * Eigen::Matrix3d::Identity();
+  F.block<3, 3>(kV, kTheta) = -dt * R * skew(f);
+  F.block<3, 3>(kV, kBa) = -dt * R;
+  F.block<3, 3>(kV, kG) = dt * Eigen::Matrix3d::Identity();
+  covariance = F * covariance * F.transpose();
+  covariance.block<3, 3>(kTheta, kTheta).diagonal().array() += gyro_density2 * dt;
+  covariance.block<3, 3>(kV, kV).diagonal().array() += accel_density2 * dt;
+  covariance.block<3, 3>(kBg, kBg).diagonal().array() += n.gyro_bias_walk * n.gyro_bias_walk * dt;
+  covariance.block<3, 3>(kBa, kBa).diagonal().array() += n.accel_bias_walk * n.accel_bias_walk * dt;
+}
+
+// The pose block [δp; δθ] (δp in the world) as registration's and pose_t's
+// body tangent [ρ; δθ], ρ = Rᵀ·δp.
+inline Matrix6d body_pose_covariance(const Matrix18d& covariance, const Eigen::Matrix3d& R) {
+  Matrix6d M = Matrix6d::Identity();
+  M.topLeftCorner<3, 3>() = R.transpose();
+  return M * covariance.topLeftCorner<6, 6>() * M.transpose();
 }
 
 }  // namespace adit::slam::kinematics

@@ -26,7 +26,12 @@ TEST(ImuPoseFeed, AnchoredFromOneThreadItGivesAPosePerReadingOnAnother) {
   const std::vector<slam::ImuSample> imu = slam::test::samples(m, 1.0, 6.0, kRate);
   std::vector<slam::InertialState> given;
   given.reserve(imu.size());
-  ImuPoseFeed feed(slam::ImuExtrapolatorConfig{}, [&](const slam::InertialState& s) { given.push_back(s); });
+  std::vector<double> position_variance;
+  position_variance.reserve(imu.size());
+  ImuPoseFeed feed(slam::ImuExtrapolatorConfig{}, [&](const slam::InertialState& s, const slam::Matrix6d& covariance) {
+    given.push_back(s);
+    position_variance.push_back(covariance(0, 0));
+  });
   std::atomic<std::size_t> read{0};
   // The odometry: a scan every 0.1 s of the readings, its state (the truth
   // here) anchored once the readings have passed the scan's end.
@@ -37,7 +42,7 @@ TEST(ImuPoseFeed, AnchoredFromOneThreadItGivesAPosePerReadingOnAnother) {
         return n == imu.size() || (n > 0 && imu[n - 1].t >= scan + 0.1);
       };
       while (!passed()) std::this_thread::yield();
-      feed.anchor(m.state(scan));
+      feed.anchor(m.state(scan), slam::Matrix18d::Identity() * 1e-6);
     }
   });
   for (const slam::ImuSample& r : imu) {
@@ -54,6 +59,8 @@ TEST(ImuPoseFeed, AnchoredFromOneThreadItGivesAPosePerReadingOnAnother) {
   for (const slam::InertialState& s : given) worst_m = std::max(worst_m, (s.pose.translation() - m.position(s.t)).norm());
   EXPECT_LT(worst_m, 1e-3);
   for (const double ms : feed.latency_ms()) EXPECT_GE(ms, 0.0);
+  // The anchor's covariance reaches each pose, grown by the readings since it.
+  for (const double v : position_variance) EXPECT_GT(v, 1e-6);
 }
 
 }  // namespace

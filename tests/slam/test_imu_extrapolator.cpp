@@ -44,6 +44,40 @@ TEST(ImuExtrapolator, FollowsTheBodyAtTheImuRateFromTheLatestAnchor) {
   EXPECT_LT(worst_rad, 1e-4);
 }
 
+// The pose's covariance is the filter's own, carried by the same error-state
+// propagation (inertial_kinematics.hpp) through the readings since the
+// anchor, in the body tangent of the scan-rate pose; it grows with them.
+TEST(ImuExtrapolator, ThePosesCovarianceIsTheFiltersPropagatedThroughTheReadings) {
+  const Motion m;
+  const std::vector<ImuSample> imu = samples(m, 0.95, 1.4, kRate);
+  InertialFilter filter(InertialConfig{});
+  Matrix6d pose_covariance = Matrix6d::Zero();
+  pose_covariance.diagonal() << 1e-4, 2e-4, 3e-4, 1e-6, 2e-6, 3e-6;
+  filter.reset(m.state(1.0), pose_covariance);
+  ImuExtrapolator x(ImuExtrapolatorConfig{});
+  x.anchor(filter.state(), filter.covariance());
+  double previous_variance = 0.0;
+  std::size_t checked = 0;
+  for (const ImuSample& r : imu) {
+    const std::optional<InertialState> s = x.add(r);
+    if (r.t < 1.0 + 1e-9) continue;
+    ASSERT_TRUE(s.has_value());
+    ASSERT_TRUE(filter.propagate(imu, r.t));
+    Matrix6d M = Matrix6d::Identity();
+    M.topLeftCorner<3, 3>() = filter.state().pose.linear().transpose();
+    const Matrix6d expected = M * filter.covariance().topLeftCorner<6, 6>() * M.transpose();
+    const Matrix6d given = x.pose_covariance();
+    EXPECT_LT((given - expected).norm(), 1e-9 * expected.norm()) << "t " << r.t;
+    const double variance = given.topLeftCorner<3, 3>().trace();
+    EXPECT_GT(variance, previous_variance) << "t " << r.t;
+    previous_variance = variance;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 80U);
+  // 0.4 s past the scan the position is less certain than at it.
+  EXPECT_GT(previous_variance, 6e-4);
+}
+
 TEST(ImuExtrapolator, ALateAnchorIsCarriedThroughTheReadingsSinceIt) {
   const Motion m;
   ImuExtrapolator x(ImuExtrapolatorConfig{});

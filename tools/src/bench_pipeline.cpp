@@ -168,7 +168,7 @@ int bench_pipeline(const BenchPipelineOptions& o) {
   daemon::PipelineSinks sinks;
   if (config.imu.enabled && config.imu.pose_horizon_s > 0.0) {
     imu_poses.emplace(kBenchLcmUrl, "adit-bench");
-    sinks.imu_pose = [&](const slam::InertialState& s) { imu_poses->publish(s); };
+    sinks.imu_pose = [&](const slam::InertialState& s, const slam::Matrix6d& c) { imu_poses->publish(s, c); };
   }
   // The file's pipeline is gone before the loopback run, whose resident size
   // would otherwise hold both (the peak, VmHWM, is the process's and does).

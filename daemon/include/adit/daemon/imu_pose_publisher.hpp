@@ -28,9 +28,9 @@ class ImuPosePublisher {
   ImuPosePublisher(const ImuPosePublisher&) = delete;
   ImuPosePublisher& operator=(const ImuPosePublisher&) = delete;
 
-  // The extrapolated state as pose_t: utime its time, flags VALID, no
-  // covariance (the scan-rate POSE carries it), no session id (POSE does).
-  void publish(const slam::InertialState& state);
+  // The extrapolated state as pose_t: utime its time, flags VALID, the
+  // covariance (body tangent [ρ; δθ], as POSE's), no session id (POSE has it).
+  void publish(const slam::InertialState& state, const slam::Matrix6d& covariance);
   std::uint64_t published() const { return published_.load(std::memory_order_relaxed); }
 
  private:

@@ -55,7 +55,7 @@ struct MapSlot {
 struct PipelineSinks {
   using PoseSink = std::function<void(const slam::OdometryResult&)>;
   using TileSink = std::function<void(const slam::TileCoord&, std::span<const slam::MapSample>)>;
-  using ImuPoseSink = std::function<void(const slam::InertialState&)>;
+  using ImuPoseSink = std::function<void(const slam::InertialState&, const slam::Matrix6d& covariance)>;
   PoseSink pose;  // output thread, once per scan (valid or not)
   // The IMU source's thread, per IMU reading while LiDAR-inertial (imu_pose_feed.hpp): quick, never throws.
   ImuPoseSink imu_pose;

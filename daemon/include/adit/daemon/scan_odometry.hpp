@@ -68,6 +68,7 @@ class ScanOdometry {
   const ImuSource* imu() const { return imu_; }
   // The LiDAR-inertial filter's state after the last scan it corrected (result().inertial).
   const slam::InertialState& inertial_state() const { return odometry_.inertial().state(); }
+  const slam::Matrix18d& inertial_covariance() const { return odometry_.inertial().covariance(); }
 
  private:
   std::optional<slam::MotionPrior> wheel_prior_for(double previous, double t);
