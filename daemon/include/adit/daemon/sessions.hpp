@@ -53,7 +53,7 @@ class Sessions {
   // the finishing thread once a session's files are written.
   struct Outputs {
     std::function<void(const PoseSample&)> pose;
-    std::function<void(const slam::InertialState&, const slam::Matrix6d&)> imu_pose;  // the IMU source's thread (PipelineSinks::imu_pose)
+    PipelineSinks::ImuPoseSink imu_pose;  // the IMU source's thread
     std::function<void(TileUpdate&&)> tile;
     std::function<void(const std::string& session)> ended;
   };
