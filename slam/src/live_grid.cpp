@@ -1,0 +1,196 @@
+// The live 2D occupancy grid: a band around the sensor's height, obstacles
+// per cell, free rays per bearing, log-odds per cell. (live_grid.hpp)
+#include "adit/slam/live_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+namespace adit::slam {
+namespace {
+
+// Log-odds ×1000 (int16): OctoMap's hit 0.7, miss 0.4, clamping 0.12 / 0.97;
+// map_saver's occupied 0.65 and free 0.196 thresholds.
+constexpr std::int16_t kHit = 847;        // ln(0.7 / 0.3)
+constexpr std::int16_t kMiss = -405;      // ln(0.4 / 0.6)
+constexpr std::int16_t kMin = -1992;      // ln(0.12 / 0.88)
+constexpr std::int16_t kMax = 3476;       // ln(0.97 / 0.03)
+constexpr std::int16_t kOccupiedAt = 619;   // ln(0.65 / 0.35)
+constexpr std::int16_t kFreeAt = -1411;     // ln(0.196 / 0.804)
+
+std::int8_t value_of(std::int16_t log_odds) {
+  if (log_odds >= kOccupiedAt) return kGridOccupied;
+  if (log_odds <= kFreeAt) return kGridFree;
+  return kGridUnknown;
+}
+
+std::int64_t floor_div(std::int64_t a, std::int64_t n) { return a >= 0 ? a / n : -((-a + n - 1) / n); }
+
+}  // namespace
+
+LiveGrid::LiveGrid(const LiveGridConfig& config)
+    : config_(config),
+      inv_resolution_(1.0F / config.resolution_m),
+      tilt_tan_(std::tan(config.tilt_tolerance_deg * std::numbers::pi_v<float> / 180.0F)) {
+  if (!(config.resolution_m > 0.0F) || config.patch_cells < 1 || config.bearings < 1 || !(config.max_range_m > 0.0F))
+    throw std::invalid_argument("LiveGrid: resolution, range, bearings and patch size must be positive");
+  rays_.resize(static_cast<std::size_t>(config.bearings));
+}
+
+LiveGrid::Patch& LiveGrid::patch_at(GridPatchCoord c) {
+  if (last_patch_ != nullptr && c == last_coord_) return *last_patch_;
+  auto [it, added] = patches_.try_emplace(key(c));
+  if (added) {
+    const auto cells = static_cast<std::size_t>(config_.patch_cells) * static_cast<std::size_t>(config_.patch_cells);
+    it->second.log_odds.assign(cells, 0);
+    it->second.stamp.assign(cells, 0);
+  }
+  last_patch_ = &it->second;  // unordered_map keeps its elements where they are
+  last_coord_ = c;
+  return it->second;
+}
+
+bool LiveGrid::update(std::int64_t i, std::int64_t j, std::int16_t delta) {
+  const std::int64_t n = config_.patch_cells;
+  const GridPatchCoord c{static_cast<std::int32_t>(floor_div(i, n)), static_cast<std::int32_t>(floor_div(j, n))};
+  Patch& p = patch_at(c);
+  const auto cell = static_cast<std::size_t>((j - c.y * n) * n + (i - c.x * n));
+  if (p.stamp[cell] == scan_stamp_) return false;
+  p.stamp[cell] = scan_stamp_;
+  std::int16_t& l = p.log_odds[cell];
+  const std::int8_t before = value_of(l);
+  l = static_cast<std::int16_t>(std::clamp<int>(l + delta, kMin, kMax));
+  if (value_of(l) != before) p.changed = true;
+  return true;
+}
+
+// The cells from `from` to `to` (map xy) by Amanatides & Woo's traversal
+// (1987), each passed once; cells hit this scan were stamped first and keep
+// their hit.
+void LiveGrid::trace_free(const Eigen::Vector2f& from, const Eigen::Vector2f& to) {
+  const Eigen::Vector2f a = from * inv_resolution_;
+  const Eigen::Vector2f b = to * inv_resolution_;
+  std::int64_t i = static_cast<std::int64_t>(std::floor(a.x()));
+  std::int64_t j = static_cast<std::int64_t>(std::floor(a.y()));
+  const std::int64_t end_i = static_cast<std::int64_t>(std::floor(b.x()));
+  const std::int64_t end_j = static_cast<std::int64_t>(std::floor(b.y()));
+  const Eigen::Vector2f d = b - a;
+  const int step_i = d.x() > 0 ? 1 : -1;
+  const int step_j = d.y() > 0 ? 1 : -1;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const float delta_i = d.x() != 0 ? std::abs(1.0F / d.x()) : kInf;
+  const float delta_j = d.y() != 0 ? std::abs(1.0F / d.y()) : kInf;
+  float t_i = d.x() != 0 ? (step_i > 0 ? static_cast<float>(i + 1) - a.x() : a.x() - static_cast<float>(i)) * delta_i : kInf;
+  float t_j = d.y() != 0 ? (step_j > 0 ? static_cast<float>(j + 1) - a.y() : a.y() - static_cast<float>(j)) * delta_j : kInf;
+  // |end - start| cells in each axis bound the walk (float rounding at a corner).
+  const std::int64_t max_steps = std::abs(end_i - i) + std::abs(end_j - j);
+  for (std::int64_t s = 0;; ++s) {
+    if (update(i, j, kMiss)) ++counts_.miss_updates;
+    if ((i == end_i && j == end_j) || s >= max_steps) break;
+    if (t_i < t_j) {
+      i += step_i;
+      t_i += delta_i;
+    } else {
+      j += step_j;
+      t_j += delta_j;
+    }
+  }
+}
+
+void LiveGrid::insert(const Eigen::Vector3f& origin, std::span<const Eigen::Vector3f> points) {
+  if (++scan_stamp_ == 0) ++scan_stamp_;  // 0 is a new cell's stamp
+  ++counts_.scans;
+  for (Ray& r : rays_) r = Ray{};
+  const float max2 = config_.max_range_m * config_.max_range_m;
+  const float min_range = config_.resolution_m;
+  const float bins_per_rad = static_cast<float>(config_.bearings) / (2.0F * std::numbers::pi_v<float>);
+  const Eigen::Vector2f o = origin.head<2>();
+  // Obstacles first: each cell of the band hit this scan counts once, as hit.
+  for (const Eigen::Vector3f& p : points) {
+    if (!p.allFinite()) continue;
+    const Eigen::Vector2f d = p.head<2>() - o;
+    const float r2 = d.squaredNorm();
+    if (r2 > max2 || r2 < min_range * min_range) continue;
+    const float r = std::sqrt(r2);
+    const float dz = p.z() - origin.z();
+    auto bin = static_cast<int>((std::atan2(d.y(), d.x()) + std::numbers::pi_v<float>) * bins_per_rad);
+    bin = std::clamp(bin, 0, config_.bearings - 1);
+    Ray& ray = rays_[static_cast<std::size_t>(bin)];
+    const float margin = r * tilt_tan_;
+    if (dz >= -config_.band_below_m + margin && dz <= config_.band_above_m - margin) {
+      const auto i = static_cast<std::int64_t>(std::floor(p.x() * inv_resolution_));
+      const auto j = static_cast<std::int64_t>(std::floor(p.y() * inv_resolution_));
+      if (update(i, j, kHit)) ++counts_.hit_updates;
+      if (ray.hit_range == 0.0F || r < ray.hit_range) {
+        ray.hit_range = r;
+        ray.hit_dir = d / r;
+      }
+    } else if (dz < -config_.band_below_m || dz > config_.band_above_m) {
+      // Where the ray from the sensor left the band (its height is linear in r).
+      const float edge = dz > 0 ? config_.band_above_m : config_.band_below_m;
+      const float reach = r * edge / std::abs(dz);
+      if (reach > ray.free_range) {
+        ray.free_range = reach;
+        ray.free_dir = d / r;
+      }
+    }
+  }
+  // Then the free rays: to the nearest obstacle per bearing, or as far as the
+  // band was seen through where there was none.
+  for (const Ray& ray : rays_) {
+    if (ray.hit_range > 0.0F) {
+      trace_free(o, o + ray.hit_dir * ray.hit_range);
+    } else if (ray.free_range > min_range) {
+      trace_free(o, o + ray.free_dir * ray.free_range);
+    }
+  }
+}
+
+std::vector<GridPatchCoord> LiveGrid::take_changed() {
+  std::vector<GridPatchCoord> changed;
+  for (auto& [k, p] : patches_) {
+    if (!p.changed) continue;
+    p.changed = false;
+    ++p.version;
+    changed.push_back({static_cast<std::int32_t>(k >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(k))});
+  }
+  std::sort(changed.begin(), changed.end());
+  return changed;
+}
+
+std::vector<GridPatchCoord> LiveGrid::patch_coords() const {
+  std::vector<GridPatchCoord> coords;
+  coords.reserve(patches_.size());
+  for (const auto& [k, p] : patches_)
+    coords.push_back({static_cast<std::int32_t>(k >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(k))});
+  std::sort(coords.begin(), coords.end());
+  return coords;
+}
+
+void LiveGrid::read(GridPatchCoord patch, std::span<std::int8_t> out) const {
+  const auto cells = static_cast<std::size_t>(config_.patch_cells) * static_cast<std::size_t>(config_.patch_cells);
+  if (out.size() < cells) throw std::invalid_argument("LiveGrid::read: the output holds fewer than a patch's cells");
+  const auto it = patches_.find(key(patch));
+  if (it == patches_.end()) {
+    std::fill_n(out.begin(), cells, kGridUnknown);
+    return;
+  }
+  std::transform(it->second.log_odds.begin(), it->second.log_odds.end(), out.begin(), value_of);
+}
+
+std::int32_t LiveGrid::version(GridPatchCoord patch) const {
+  const auto it = patches_.find(key(patch));
+  return it == patches_.end() ? 0 : it->second.version;
+}
+
+std::size_t LiveGrid::memory_bytes() const {
+  std::size_t bytes = rays_.capacity() * sizeof(Ray);
+  for (const auto& [k, p] : patches_)
+    bytes += sizeof(p) + sizeof(k) + p.log_odds.capacity() * sizeof(std::int16_t) +
+             p.stamp.capacity() * sizeof(std::uint16_t);
+  return bytes;
+}
+
+}  // namespace adit::slam
