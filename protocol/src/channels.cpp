@@ -26,6 +26,7 @@ std::string_view channel_kind(Channel channel) {
     case Channel::file_request: return "FILE_REQUEST";
     case Channel::file: return "FILE";
     case Channel::imu_pose: return "POSE_IMU";
+    case Channel::grid: return "GRID";
   }
   return "UNKNOWN";
 }

@@ -107,6 +107,8 @@ const std::vector<Field>& layout(LcmType type) {
                                           counted(Kind::i64, 6), counted(Kind::i32, 6), counted(Kind::i32, 6)};
   static const std::vector<Field> file_request{I64, I16, I64, STR, STR, STR, I32, I32};
   static const std::vector<Field> file_chunk{I64, I16, I64, STR, STR, STR, STR, I64, I32, I32, I32, counted(Kind::i8, 10)};
+  static const std::vector<Field> grid_patch{I64, I16, STR, STR, F32, I32, I32, I32, I32, I32, I32,
+                                             counted(Kind::i8, 10)};
   switch (type) {
     case LcmType::pose: return pose;
     case LcmType::status: return status;
@@ -117,6 +119,7 @@ const std::vector<Field>& layout(LcmType type) {
     case LcmType::tile_request: return request;
     case LcmType::file_request: return file_request;
     case LcmType::file_chunk: return file_chunk;
+    case LcmType::grid_patch: return grid_patch;
   }
   return pose;
 }

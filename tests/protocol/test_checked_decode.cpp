@@ -97,6 +97,12 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   chunk.size = 3;
   chunk.n_chunks = 1;
   expect_round_trip(chunk);
+
+  grid_patch_t patch{};
+  patch.session_id = "s1";
+  patch.data = {4, 5, 6, 7, 8};
+  patch.size = 5;
+  expect_round_trip(patch);
 }
 
 // Byte offset of n_args in sample_command(): hash, utime, schema, request id,

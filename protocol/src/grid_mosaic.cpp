@@ -1,0 +1,86 @@
+// A client's copy of the live 2D grid. (grid_mosaic.hpp)
+#include "adit/protocol/grid_mosaic.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "adit/grid_patch_t.hpp"
+#include "adit/protocol/grid_codec.hpp"
+
+namespace adit::protocol {
+
+std::string GridMosaic::accept(const grid_patch_t& patch) {
+  if (std::string problem = grid_patch_problem(patch); !problem.empty()) {
+    ++counts_.refused;
+    return problem;
+  }
+  std::vector<std::int8_t> cells(static_cast<std::size_t>(patch.patch_cells) * static_cast<std::size_t>(patch.patch_cells));
+  if (const std::string problem = decode_grid_cells(patch.data, cells); !problem.empty()) {
+    ++counts_.refused;
+    return fmt::format("patch ({}, {}) version {}: {}", patch.patch_x, patch.patch_y, patch.version, problem);
+  }
+  return put(patch.session_id, patch.resolution_m, patch.patch_cells, patch.patch_x, patch.patch_y, patch.version,
+             std::move(cells));
+}
+
+std::string GridMosaic::put(const std::string& session_id, float resolution_m, std::int32_t patch_cells,
+                            std::int32_t x, std::int32_t y, std::int32_t version, std::vector<std::int8_t> cells) {
+  if (session_id != session_id_ || patches_.empty()) {
+    if (session_id != session_id_) patches_.clear();
+    session_id_ = session_id;
+    resolution_m_ = resolution_m;
+    patch_cells_ = patch_cells;
+  }
+  std::string problem;
+  if (resolution_m != resolution_m_ || patch_cells != patch_cells_)
+    problem = fmt::format("a patch of {} cells at {} m in a grid of {} cells at {} m", patch_cells, resolution_m,
+                          patch_cells_, resolution_m_);
+  else if (cells.size() != static_cast<std::size_t>(patch_cells) * static_cast<std::size_t>(patch_cells))
+    problem = fmt::format("patch ({}, {}): {} cells for {} a side", x, y, cells.size(), patch_cells);
+  if (!problem.empty()) {
+    ++counts_.refused;
+    return problem;
+  }
+  Patch& held = patches_[{x, y}];
+  if (version <= held.version) {
+    ++counts_.stale;
+    return {};
+  }
+  held = {version, std::move(cells)};
+  ++counts_.accepted;
+  return {};
+}
+
+GridImage GridMosaic::image() const {
+  GridImage image;
+  if (patches_.empty()) return image;
+  std::int32_t min_x = std::numeric_limits<std::int32_t>::max(), min_y = min_x;
+  std::int32_t max_x = std::numeric_limits<std::int32_t>::min(), max_y = max_x;
+  for (const auto& [coord, patch] : patches_) {
+    min_x = std::min(min_x, coord.first);
+    max_x = std::max(max_x, coord.first);
+    min_y = std::min(min_y, coord.second);
+    max_y = std::max(max_y, coord.second);
+  }
+  const int n = patch_cells_;
+  // The message's float, to the micrometre: 0.05 is written 0.05, not 0.0500000007.
+  image.resolution_m = std::round(static_cast<double>(resolution_m_) * 1e6) / 1e6;
+  image.origin_x = static_cast<double>(min_x) * n * image.resolution_m;
+  image.origin_y = static_cast<double>(min_y) * n * image.resolution_m;
+  image.width = (max_x - min_x + 1) * n;
+  image.height = (max_y - min_y + 1) * n;
+  image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
+  for (const auto& [coord, patch] : patches_) {
+    const int col0 = (coord.first - min_x) * n;
+    const int row0 = (coord.second - min_y) * n;
+    for (int r = 0; r < n; ++r)
+      std::copy_n(patch.cells.begin() + static_cast<std::ptrdiff_t>(r) * n, n,
+                  image.cells.begin() + static_cast<std::ptrdiff_t>(row0 + r) * image.width + col0);
+  }
+  return image;
+}
+
+}  // namespace adit::protocol

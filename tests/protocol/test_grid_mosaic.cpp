@@ -1,0 +1,104 @@
+// The live grid's patches: coded, checked and assembled into one image.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "adit/grid_patch_t.hpp"
+#include "adit/protocol/grid_codec.hpp"
+#include "adit/protocol/grid_mosaic.hpp"
+
+namespace adit::protocol {
+namespace {
+
+constexpr int kCells = 4;
+
+grid_patch_t patch_message(std::string session, int x, int y, int version, std::int8_t fill) {
+  grid_patch_t m;
+  m.utime = 1;
+  m.schema = 1;
+  m.payload_id = "rig1";
+  m.session_id = std::move(session);
+  m.resolution_m = 0.5F;
+  m.patch_cells = kCells;
+  m.patch_x = x;
+  m.patch_y = y;
+  m.version = version;
+  m.n_patches = 1;
+  std::vector<std::int8_t> cells(kCells * kCells, fill);
+  cells[0] = 100;  // the lowest row's first cell
+  const std::vector<std::uint8_t> frame = encode_grid_cells(cells);
+  m.data.assign(frame.begin(), frame.end());
+  m.size = static_cast<std::int32_t>(m.data.size());
+  return m;
+}
+
+TEST(GridCodec, CellsComeBackAsTheyWentAndBadFramesSayWhy) {
+  std::vector<std::int8_t> cells(128 * 128, -1);
+  for (std::size_t i = 0; i < cells.size(); i += 7) cells[i] = (i % 2 == 0) ? 0 : 100;
+  const std::vector<std::uint8_t> frame = encode_grid_cells(cells);
+  EXPECT_LT(frame.size(), cells.size() / 4);
+  std::vector<std::int8_t> back(cells.size());
+  EXPECT_EQ(decode_grid_cells(frame, back), "");
+  EXPECT_EQ(back, cells);
+
+  std::vector<std::int8_t> small(100);
+  EXPECT_NE(decode_grid_cells(frame, small).find("a patch has 100"), std::string::npos);
+  std::vector<std::uint8_t> flipped = frame;
+  flipped[flipped.size() / 2] ^= 0x5A;
+  EXPECT_NE(decode_grid_cells(flipped, back), "");
+  const std::vector<std::int8_t> odd(16, 50);
+  std::vector<std::int8_t> odd_back(16);
+  EXPECT_NE(decode_grid_cells(encode_grid_cells(odd), odd_back).find("not -1, 0 or 100"), std::string::npos);
+  const std::vector<std::uint8_t> junk{1, 2, 3};
+  EXPECT_NE(decode_grid_cells(junk, back), "");
+}
+
+TEST(GridMosaic, KeepsTheNewestVersionOfEachPatchAndDrawsThemInPlace) {
+  GridMosaic mosaic;
+  EXPECT_EQ(mosaic.accept(patch_message("s1", 0, 0, 1, -1)), "");
+  EXPECT_EQ(mosaic.accept(patch_message("s1", -1, 1, 1, 0)), "");
+  EXPECT_EQ(mosaic.accept(patch_message("s1", 0, 0, 2, 0)), "");   // newer
+  EXPECT_EQ(mosaic.accept(patch_message("s1", 0, 0, 1, 100)), "");  // older: ignored
+  EXPECT_EQ(mosaic.counts().accepted, 3U);
+  EXPECT_EQ(mosaic.counts().stale, 1U);
+  const GridImage image = mosaic.image();
+  EXPECT_EQ(image.width, 2 * kCells);
+  EXPECT_EQ(image.height, 2 * kCells);
+  EXPECT_DOUBLE_EQ(image.origin_x, -2.0);
+  EXPECT_DOUBLE_EQ(image.origin_y, 0.0);
+  const auto at = [&](int col, int row) { return image.cells[static_cast<std::size_t>(row * image.width + col)]; };
+  EXPECT_EQ(at(kCells, 0), 100);       // patch (0, 0)'s first cell
+  EXPECT_EQ(at(kCells + 1, 0), 0);     // patch (0, 0) version 2: free
+  EXPECT_EQ(at(0, kCells), 100);       // patch (-1, 1)
+  EXPECT_EQ(at(1, kCells + 1), 0);
+  EXPECT_EQ(at(0, 0), -1);             // patch (-1, 0) never came
+  EXPECT_EQ(at(kCells, kCells), -1);   // nor (0, 1)
+}
+
+TEST(GridMosaic, RefusesMalformedPatchesAndStartsAgainForANewSession) {
+  GridMosaic mosaic;
+  ASSERT_EQ(mosaic.accept(patch_message("s1", 0, 0, 1, 0)), "");
+  grid_patch_t bad = patch_message("s1", 1, 0, 1, 0);
+  bad.resolution_m = 0.25F;
+  EXPECT_NE(mosaic.accept(bad).find("in a grid of 4 cells at 0.5 m"), std::string::npos);
+  bad = patch_message("s1", 1, 0, 1, 0);
+  bad.size = 3;
+  EXPECT_NE(mosaic.accept(bad).find("bytes of data"), std::string::npos);
+  bad = patch_message("s1", 1, 0, 1, 0);
+  bad.data[bad.data.size() / 2] ^= 0x33;
+  EXPECT_NE(mosaic.accept(bad).find("patch (1, 0) version 1"), std::string::npos);
+  bad = patch_message("s1", 1, 0, 1, 0);
+  bad.patch_cells = kMaxGridPatchCells + 1;
+  EXPECT_NE(mosaic.accept(bad), "");
+  EXPECT_EQ(mosaic.counts().refused, 4U);
+  EXPECT_EQ(mosaic.patch_count(), 1U);
+  EXPECT_EQ(mosaic.accept(patch_message("s2", 5, 5, 1, 0)), "");
+  EXPECT_EQ(mosaic.session_id(), "s2");
+  EXPECT_EQ(mosaic.patch_count(), 1U);
+  EXPECT_DOUBLE_EQ(mosaic.image().origin_x, 10.0);
+}
+
+}  // namespace
+}  // namespace adit::protocol
