@@ -26,6 +26,7 @@
 #include "adit/common/clock.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
+#include "adit/grid_patch_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
 
@@ -90,7 +91,7 @@ TilePublisherOptions publisher_options(const EndpointOptions& o,
 
 }  // namespace
 
-struct LcmEndpoint::Impl final : TileSink {
+struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   EndpointOptions options;
   SessionHooks hooks;
   lcm::LCM lcm;
@@ -98,6 +99,7 @@ struct LcmEndpoint::Impl final : TileSink {
   Handoff<PoseSample> poses;
   Handoff<StatusSample> statuses;
   Handoff<TileUpdate> tiles;
+  Handoff<GridPatchUpdate> grids;
   std::mutex events_mutex;  // control events are rare (button, end of flush)
   std::vector<protocol::SessionEvent> events;
   protocol::CommandGate gate;
@@ -105,6 +107,7 @@ struct LcmEndpoint::Impl final : TileSink {
   std::atomic<protocol::SessionState> published_state{protocol::SessionState::idle};
   std::string session_id;
   TilePublisher publisher;
+  GridPublisher grid_publisher;
   std::int64_t pose_seq = 0;
   EndpointCounters counters;
   FileIdentity key_identity;
@@ -124,12 +127,14 @@ struct LcmEndpoint::Impl final : TileSink {
         poses(options.queue_capacity, Overflow::wait, [] { return PoseSample{}; }),
         statuses(options.queue_capacity, Overflow::wait, [] { return StatusSample{}; }),
         tiles(options.queue_capacity, Overflow::wait, [] { return TileUpdate{}; }),
+        grids(options.queue_capacity, Overflow::wait, [] { return GridPatchUpdate{}; }),
         gate(options.payload_id, options.command_window),
         publisher(publisher_options(options,
                                     [this](const std::string& session, TileStore& into) {
                                       return load_stored(session, into);
                                     }),
-                  *this) {
+                  *this),
+        grid_publisher({options.payload_id, options.grid_period_s, options.grid_refresh_s}, *this) {
     if (const std::string problem = protocol::payload_id_problem(options.payload_id); !problem.empty())
       throw InputError("payload id", "payload_id", problem);
     if (const std::string problem = protocol::tile_params_problem(options.tiles); !problem.empty())
@@ -164,6 +169,7 @@ struct LcmEndpoint::Impl final : TileSink {
 
   void send(const tile_segment_t& segment) override { send(Channel::tile, segment); }
   void send(const tile_index_t& index) override { send(Channel::tile_index, index); }
+  void send(const grid_patch_t& patch) override { send(Channel::grid, patch); }
 
   // --- keys ---------------------------------------------------------------
 
@@ -230,6 +236,11 @@ struct LcmEndpoint::Impl final : TileSink {
         std::vector<protocol::MapPoint>().swap(t.points);
       }
       publisher.tick(Clock::now());
+      GridPatchUpdate g;
+      while (take_from(grids, g)) grid_publisher.update(g);
+      grid_publisher.tick(Clock::now());
+      counters.grid_patches_published = grid_publisher.counts().patches_sent;
+      counters.grid_bytes_published = grid_publisher.counts().bytes_sent;
       const TilePublisherCounts& c = publisher.counts();
       counters.chunks_published = c.chunks_published;
       counters.chunks_dropped_by_hook = c.chunks_dropped_by_hook;
@@ -332,6 +343,7 @@ struct LcmEndpoint::Impl final : TileSink {
       std::string started = hooks.start ? hooks.start() : fmt::format("session-{}", realtime_us());
       session_id = std::move(started);
       publisher.reset(session_id, hooks.session_folder ? hooks.session_folder(session_id) : std::filesystem::path{});
+      grid_publisher.reset(session_id);
       pose_seq = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
@@ -448,6 +460,12 @@ bool LcmEndpoint::publish_pose(const PoseSample& pose) {
 bool LcmEndpoint::publish_status(StatusSample&& status) {
   if (hand_over(impl_->statuses, status)) return true;
   ++impl_->counters.status_dropped;
+  return false;
+}
+
+bool LcmEndpoint::publish_grid(GridPatchUpdate&& patch) {
+  if (hand_over(impl_->grids, patch)) return true;
+  ++impl_->counters.grid_patches_dropped;
   return false;
 }
 

@@ -4,9 +4,24 @@
 #include <algorithm>
 #include <cmath>
 
+#include "adit/products/grid_io.hpp"
+#include "adit/protocol/grid_mosaic.hpp"
 #include "adit/protocol/map_export.hpp"
+#include "adit/slam/live_grid.hpp"
 
 namespace adit::daemon {
+
+std::uintmax_t write_live_grid(const std::filesystem::path& stem, const slam::LiveGrid& grid) {
+  const slam::LiveGridConfig& c = grid.config();
+  protocol::GridMosaic mosaic;
+  for (const slam::GridPatchCoord& p : grid.patch_coords()) {
+    std::vector<std::int8_t> cells(static_cast<std::size_t>(c.patch_cells) * static_cast<std::size_t>(c.patch_cells));
+    grid.read(p, cells);
+    mosaic.put("", c.resolution_m, c.patch_cells, p.x, p.y, 1, std::move(cells));
+  }
+  if (mosaic.patch_count() == 0) return 0;
+  return products::write_grid(stem, products::grid_of(mosaic.image()));
+}
 
 std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m) {
   std::array<double, 3> corner{0, 0, 0};

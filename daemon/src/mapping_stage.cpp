@@ -14,6 +14,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/extrinsics.hpp"
 #include "adit/protocol/map_export.hpp"
 
 namespace adit::daemon {
@@ -28,6 +29,17 @@ slam::TiledMapConfig map_config_of(const config::MapSection& m) {
 // No point of a scan lies farther than max_range_m from the body (map_scan
 // filters them), deskewing moves points by at most a sweep's motion, and the
 // sensor's offset from the body is small: the margin covers both.
+slam::LiveGridConfig grid_config_of(const config::GridSection& g) {
+  slam::LiveGridConfig c;
+  c.resolution_m = static_cast<float>(g.resolution_m);
+  c.band_below_m = static_cast<float>(g.band_below_m);
+  c.band_above_m = static_cast<float>(g.band_above_m);
+  c.tilt_tolerance_deg = static_cast<float>(g.tilt_tolerance_deg);
+  c.max_range_m = static_cast<float>(g.max_range_m);
+  c.patch_cells = g.patch_cells;
+  return c;
+}
+
 slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
           static_cast<std::size_t>(m.compact_tile_voxels)};
@@ -39,6 +51,8 @@ MappingStage::MappingStage(const config::Config& config, const slam::OdometryCon
                            std::size_t max_points, PipelineSinks::TileSink sink, PipelineStats& stats,
                            const std::atomic<bool>& stop)
     : config_(config.map),
+      grid_config_(config.grid),
+      sensor_in_body_(isometry_of(config.lidar.extrinsics).translation().cast<float>()),
       min_range_m_(odometry.min_range_m),
       max_range_m_(std::min(odometry.max_range_m, static_cast<float>(config.map.max_range_m))),
       max_scan_gap_s_(odometry.max_scan_gap_s),
@@ -54,6 +68,10 @@ MappingStage::MappingStage(const config::Config& config, const slam::OdometryCon
     slam::MapRefinerConfig refine;
     refine.max_scan_points = max_points;
     refiner_.emplace(refine);
+  }
+  if (config.grid.enabled) {
+    grid_.emplace(grid_config_of(config.grid));
+    grid_cells_.resize(static_cast<std::size_t>(config.grid.patch_cells) * static_cast<std::size_t>(config.grid.patch_cells));
   }
   for (std::vector<Eigen::Vector3f>* v : {&points_, &deskewed_, &keyframe_points_, &pending_.points}) v->reserve(max_points);
   for (std::vector<float>* v : {&times_, &intensities_, &pending_.times_s, &pending_.intensities}) v->reserve(max_points);
@@ -75,11 +93,17 @@ void MappingStage::start() {
 
 void MappingStage::loop() {
   const auto period_ns = static_cast<std::int64_t>(config_.publish_period_s * 1e9);
+  const auto grid_period_ns = static_cast<std::int64_t>(grid_config_.publish_period_s * 1e9);
   std::int64_t last_flush_ns = monotonic_ns();
+  std::int64_t last_grid_ns = last_flush_ns;
   while (!thread_.stopping()) {
     if (monotonic_ns() - last_flush_ns >= period_ns) {
       flush_tiles();
       last_flush_ns = monotonic_ns();
+    }
+    if (monotonic_ns() - last_grid_ns >= grid_period_ns) {
+      flush_grid();
+      last_grid_ns = monotonic_ns();
     }
     // Waits for a scan until the next flush is due.
     MapSlot* slot =
@@ -103,6 +127,7 @@ void MappingStage::loop() {
   if (have_pending_ && !thread_.stopping()) map_scan(pending_, velocity_);  // the last sweep: the last motion known
   have_pending_ = false;
   flush_tiles();
+  flush_grid();
   map_trajectory_.flush();
   stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);
   stats_.dropped_map_scans.store(scans_.dropped());
@@ -141,6 +166,12 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   }
   const Eigen::Isometry3f pose = map_pose.cast<float>();
   for (Eigen::Vector3f& p : deskewed_) p = pose * p;
+  if (grid_) {
+    const std::int64_t grid_start_ns = monotonic_ns();
+    grid_->insert(pose * sensor_in_body_, deskewed_);
+    if (grid_ms_ != nullptr && grid_ms_->size() < kTimingCapacity)
+      grid_ms_->push_back(1e-6 * static_cast<double>(monotonic_ns() - grid_start_ns));
+  }
   if (spill_) restore_tiles(map_.evicted_hit_by(deskewed_));
   map_.add(deskewed_, intensities_, 1e-9 * static_cast<double>(slot.stamp_ns));
   journal_new_points();  // before eviction: an evicted tile's points are all in the journal
@@ -285,6 +316,18 @@ void MappingStage::flush_tiles() {
     } else {
       tile_file_error(problem);
     }
+  }
+}
+
+// The live grid's patches whose cells changed since the last flush.
+void MappingStage::flush_grid() {
+  if (!grid_) return;
+  const std::vector<slam::GridPatchCoord> changed = grid_->take_changed();
+  stats_.grid_patches.store(grid_->patch_count(), std::memory_order_relaxed);
+  if (!grid_sink_) return;
+  for (const slam::GridPatchCoord& c : changed) {
+    grid_->read(c, grid_cells_);
+    grid_sink_(c, grid_->version(c), grid_cells_, grid_->patch_count());
   }
 }
 

@@ -48,8 +48,11 @@ struct Pipeline::Impl {
                  source.max_points_per_scan(), source.overflow(), stats, timings, stop),
         output(c, odometry.poses(), o.sinks.pose, stats, timings, stop),
         empty_map(slam::TiledMapConfig{}) {
-    if (o.mapping)
+    if (o.mapping) {
       mapping.emplace(c, odometry_config, *odometry.map_scans(), source.max_points_per_scan(), o.sinks.tile, stats, stop);
+      mapping->publish_grid_to(o.sinks.grid);
+      mapping->time_grid_into(&timings.grid_ms);
+    }
     if (mapping && c.map.loop_closure) {
       loops.emplace(c, stats, stop);
       mapping->feed_loops(&loops->input());
@@ -193,6 +196,8 @@ std::vector<StageLoad> Pipeline::loads() const {
   if (i.mapping) out.push_back(load(i.mapping->thread(), i.mapping->input()));
   return out;
 }
+
+const slam::LiveGrid* Pipeline::grid() const { return impl_->mapping ? impl_->mapping->grid() : nullptr; }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }
 const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &*impl_->loops : nullptr; }

@@ -55,6 +55,8 @@ EndpointOptions endpoint_options(const config::Config& c) {
   o.payload_id = c.payload.id;
   o.tiles.tile_size_m = c.map.tile_size_m;
   o.tile_period_s = c.map.publish_period_s;
+  o.grid_period_s = c.grid.publish_period_s;
+  o.grid_refresh_s = c.grid.refresh_s;
   return o;
 }
 
@@ -138,8 +140,12 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   outputs.tile = [&endpoint_ptr](TileUpdate&& t) {
     if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_tile(std::move(t));
   };
-  // The tile stream's bandwidth per session, for the crew's link budget.
+  outputs.grid = [&endpoint_ptr](GridPatchUpdate&& g) {
+    if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_grid(std::move(g));
+  };
+  // The tile and grid streams' bandwidth per session, for the crew's link budget.
   std::atomic<std::uint64_t> tile_bytes_at_start{0};
+  std::atomic<std::uint64_t> grid_bytes_at_start{0};
   std::atomic<std::int64_t> session_start_ns{0};
   outputs.ended = [&](const std::string& id) {
     const double seconds = 1e-9 * static_cast<double>(monotonic_ns() - session_start_ns.load());
@@ -147,6 +153,9 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     const double bytes = static_cast<double>(e->counters().chunk_bytes_published.load() - tile_bytes_at_start.load());
     log::info("session {}: tile stream {:.1f} kB/s ({:.1f} MB in {:.0f} s)", id, seconds > 0 ? bytes / seconds / 1e3 : 0.0,
               bytes / 1e6, seconds);
+    const double grid_bytes = static_cast<double>(e->counters().grid_bytes_published.load() - grid_bytes_at_start.load());
+    log::info("session {}: grid stream {:.1f} kB/s ({:.2f} MB)", id, seconds > 0 ? grid_bytes / seconds / 1e3 : 0.0,
+              grid_bytes / 1e6);
     e->session_stopped();
   };
   // The IMU-rate pose goes out on the IMU's thread by an LCM instance of its own (imu_pose_publisher.hpp).
@@ -161,7 +170,10 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   SessionHooks hooks;
   hooks.start = [&] {
     std::string id = sessions.start();
-    if (const LcmEndpoint* e = endpoint_ptr.load()) tile_bytes_at_start = e->counters().chunk_bytes_published.load();
+    if (const LcmEndpoint* e = endpoint_ptr.load()) {
+      tile_bytes_at_start = e->counters().chunk_bytes_published.load();
+      grid_bytes_at_start = e->counters().grid_bytes_published.load();
+    }
     session_start_ns = monotonic_ns();
     return id;
   };

@@ -131,6 +131,15 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
           {"edges", loop_edges}};
 }
 
+// summary.json's "grid_live": the live 2D grid as the tablet had it, written
+// as grid_live.pgm / .yaml (null without grid.enabled).
+nlohmann::json live_grid_summary(const slam::LiveGrid* grid, std::uintmax_t file_bytes, std::vector<double> insert_ms) {
+  if (grid == nullptr) return nullptr;
+  return {{"patches", grid->patch_count()}, {"resolution_m", grid->config().resolution_m},
+          {"scans", grid->counts().scans}, {"memory_bytes", grid->memory_bytes()}, {"file_bytes", file_bytes},
+          {"insert_ms_median", quantile(insert_ms, 0.5)}, {"insert_ms_p99", quantile(insert_ms, 0.99)}};
+}
+
 // summary.json's "journal": what the crash-safety journal wrote (it is
 // removed once the summary is on the disk).
 nlohmann::json journal_summary(const JournalWriter* journal) {
@@ -228,6 +237,13 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
   if (outputs_.tile) {
     options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
       tile(TileUpdate{realtime_us(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
+    };
+  }
+  if (outputs_.grid) {
+    options.sinks.grid = [grid = outputs_.grid, c = config_.grid](slam::GridPatchCoord p, std::int32_t version,
+                                                                   std::span<const std::int8_t> cells, std::size_t n) {
+      grid(GridPatchUpdate{realtime_us(), p.x, p.y, version, static_cast<std::int32_t>(n),
+                           static_cast<float>(c.resolution_m), c.patch_cells, {cells.begin(), cells.end()}});
     };
   }
   return std::make_unique<Pipeline>(config_, options);
@@ -409,6 +425,14 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     }
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
+    std::uintmax_t grid_bytes = 0;
+    if (const slam::LiveGrid* grid = pipeline->grid(); grid != nullptr) {
+      grid_bytes = write_live_grid(dir / "grid_live", *grid);
+      if (grid_bytes > 0) {
+        files.push_back("grid_live.pgm");
+        files.push_back("grid_live.yaml");
+      }
+    }
     if (s.spilled_keyframes.load() > 0) files.push_back("keyframes/");
     const JournalWriter* journal = pipeline->journal();
     if (s.recorded_datagrams > 0) files.push_back("lidar.pcap");
@@ -449,6 +473,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"spilled_keyframes", s.spilled_keyframes.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
+        {"grid_live", live_grid_summary(pipeline->grid(), grid_bytes, t.grid_ms)},
         {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},
                     {"odometry_ms_p99", quantile(t.odometry_ms, 0.99)},
                     {"latency_ms_p99", quantile(t.latency_ms, 0.99)},

@@ -11,6 +11,17 @@
 #include "adit/common/error.hpp"
 
 namespace adit::products {
+
+Grid2d grid_of(const protocol::GridImage& image) {
+  Grid2d grid;
+  grid.resolution_m = image.resolution_m;
+  grid.origin_x = image.origin_x;
+  grid.origin_y = image.origin_y;
+  grid.width = image.width;
+  grid.height = image.height;
+  grid.cells = image.cells;
+  return grid;
+}
 namespace {
 
 constexpr unsigned char kPgmOccupied = 0, kPgmFree = 254, kPgmUnknown = 205;

@@ -26,6 +26,7 @@
 #include "adit/common/clock.hpp"
 #include "adit/common/error.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/products/grid_io.hpp"
 #include "adit/protocol/command_auth.hpp"
 #include "adit/drivers/lidar/scan_files.hpp"
 #include "adit/protocol/channels.hpp"
@@ -93,6 +94,8 @@ struct Harness {
     o.key_file = key_file;
     o.key_check_period_s = 0.1;
     o.command_window = command_window;
+    o.grid_period_s = 0.2;
+    o.grid_refresh_s = 2.0;
     SessionHooks hooks;
     hooks.start = [this] { return fmt::format("s{}", ++starts); };
     // The daemon flushes elsewhere and calls session_stopped() when done
@@ -335,6 +338,44 @@ TEST(LcmEndpoint, ChangedTilesGoOutAtMostOnceASecond) {
   EXPECT_GE(versions.size(), 2u);
   EXPECT_LE(static_cast<double>(versions.size()), std::ceil(seconds) + 1);
   EXPECT_TRUE(versions.count(25)) << "the last version must go out";
+}
+
+// The live grid: patches sent before a client listened reach it by the
+// refresh cycle (grid_refresh_s 2 s here), and `adit grid` writes them as a
+// map_server grid with every patch in its place.
+TEST(LcmEndpoint, ALateClientGetsTheWholeLiveGridWithinARefreshCycle) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  constexpr int kCells = 32;
+  const auto patch = [&](int x, int y) {
+    GridPatchUpdate u{1, x, y, 1, 6, 0.1F, kCells, std::vector<std::int8_t>(kCells * kCells, -1)};
+    for (int i = 0; i < kCells; ++i) u.cells[static_cast<std::size_t>(i * kCells + i)] = 100;  // a diagonal wall
+    u.cells[static_cast<std::size_t>((x + 2) * kCells + (y + 3))] = 0;                          // one free cell each
+    return u;
+  };
+  for (int x = -1; x <= 1; ++x)
+    for (int y = 0; y <= 1; ++y) ASSERT_TRUE(h.endpoint->publish_grid(patch(x, y)));
+  std::this_thread::sleep_for(500ms);  // their first broadcast is over
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / fmt::format("adit-grid-{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  const test::ProgramResult r = h.adit({"grid", "--out", (dir / "live").string(), "--duration", "3"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("6 patches"), std::string::npos) << r.out;
+  const products::Grid2d grid = products::read_grid(dir / "live.yaml");
+  EXPECT_NEAR(grid.resolution_m, 0.1, 1e-9);
+  EXPECT_NEAR(grid.origin_x, -3.2, 1e-6);
+  EXPECT_NEAR(grid.origin_y, 0.0, 1e-9);
+  ASSERT_EQ(grid.width, 3 * kCells);
+  ASSERT_EQ(grid.height, 2 * kCells);
+  for (int x = -1; x <= 1; ++x)
+    for (int y = 0; y <= 1; ++y) {
+      const int col0 = (x + 1) * kCells, row0 = y * kCells;
+      EXPECT_EQ(grid.at(col0 + 5, row0 + 5), products::kOccupied) << x << ", " << y;
+      EXPECT_EQ(grid.at(col0 + 5, row0 + 6), products::kUnknown) << x << ", " << y;
+      EXPECT_EQ(grid.at(col0 + y + 3, row0 + x + 2), products::kFree) << x << ", " << y;
+    }
+  EXPECT_GT(h.endpoint->counters().grid_patches_published.load(), 6U);  // refreshed
+  std::filesystem::remove_all(dir);
 }
 
 TEST(LcmEndpoint, BadCommandsAreRejectedOrIgnoredAndTheStateStays) {

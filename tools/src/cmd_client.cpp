@@ -1,4 +1,4 @@
-// adit status | watch | start | stop | export | sessions | ping: talk to a running aditd
+// adit status | watch | start | stop | export | grid | sessions | ping: talk to a running aditd
 // over LCM (docs/PROTOCOL.md).
 
 #include <chrono>
@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include "adit/common/error.hpp"
+#include "adit/products/grid_io.hpp"
+#include "adit/protocol/grid_mosaic.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "client_options.hpp"
 #include "commands.hpp"
@@ -169,6 +171,51 @@ void register_export(CLI::App& app, int& status) {
   });
 }
 
+// The live 2D grid as the tablet receives it (grid_patch_t on GRID), written
+// as a ROS map_server PGM + YAML. The daemon sends every patch again within
+// grid.refresh_s, so listening that long gets the whole grid.
+void register_grid(CLI::App& app, int& status) {
+  auto options = std::make_shared<ClientOptions>();
+  auto out = std::make_shared<std::string>();
+  auto duration = std::make_shared<double>(12.0);
+  CLI::App* sub = app.add_subcommand("grid", "Receive the live 2D occupancy grid and write it as PGM + YAML");
+  add_client_options(*sub, *options);
+  sub->add_option("--out", *out, "Files STEM.pgm and STEM.yaml (ROS map_server)")->required();
+  sub->add_option("--duration", *duration, "Listen this many seconds (the daemon's grid.refresh_s and more)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub->callback([options, out, duration, &status] {
+    using Clock = std::chrono::steady_clock;
+    LcmClient client(*options);
+    protocol::GridMosaic mosaic;
+    std::size_t messages = 0;
+    std::string first_problem;
+    const auto start = Clock::now();
+    LcmClient::FollowHandlers handlers;
+    handlers.grid_patch = [&](const grid_patch_t& p) {
+      ++messages;
+      if (std::string problem = mosaic.accept(p); !problem.empty() && first_problem.empty())
+        first_problem = std::move(problem);
+    };
+    client.follow(handlers, [&] { return std::chrono::duration<double>(Clock::now() - start).count() >= *duration; });
+    if (!first_problem.empty())
+      fmt::print(stderr, "adit: {} grid messages refused; the first: {}\n", mosaic.counts().refused, first_problem);
+    if (mosaic.patch_count() == 0) {
+      fmt::print(stderr, "adit: error: no grid patch from payload '{}' within {} s on {}\n", options->payload_id,
+                 *duration, options->lcm_url);
+      status = kExitFailure;
+      return;
+    }
+    const products::Grid2d grid = products::grid_of(mosaic.image());
+    const std::uintmax_t bytes = products::write_grid(*out, grid);
+    fmt::print("session {}: {} patches ({} messages), {} x {} cells at {} m: {} occupied, {} free; {}.pgm/.yaml, {} "
+               "bytes\n",
+               mosaic.session_id(), mosaic.patch_count(), messages, grid.width, grid.height, grid.resolution_m,
+               grid.count(products::kOccupied), grid.count(products::kFree), *out, bytes);
+    status = kExitOk;
+  });
+}
+
 }  // namespace
 
 void register_client_commands(CLI::App& app, int& status) {
@@ -177,6 +224,7 @@ void register_client_commands(CLI::App& app, int& status) {
   register_verb(app, status, "start", "START", "Start a mapping session", false);
   register_verb(app, status, "stop", "STOP", "Stop the mapping session (the payload flushes, then goes idle)", false);
   register_export(app, status);
+  register_grid(app, status);
   register_verb(app, status, "sessions", "SESSIONS", "List the sessions stored on the payload", true);
   register_verb(app, status, "ping", "PING", "Check that the payload answers commands", false);
 }

@@ -85,7 +85,8 @@ void LiveFeed::run() {
   client_->follow({.pose = [this](const pose_t& p) { on_pose(p); },
                    .status = [this](const status_t& s) { on_status(s); },
                    .tile_index = [this](const tile_index_t& m) { on_index(m); },
-                   .tile_segment = [this](const tile_segment_t& m) { on_segment(m); }},
+                   .tile_segment = [this](const tile_segment_t& m) { on_segment(m); },
+                   .grid_patch = {}},
                   [this] {
                     tick();
                     return stop_.load();

@@ -134,7 +134,7 @@ std::optional<status_t> LcmClient::wait_status() {
 
 void LcmClient::watch(const std::function<void(const pose_t&)>& on_pose,
                       const std::function<void(const status_t&)>& on_status, const std::function<bool()>& until) {
-  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}}, until);
+  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}, .grid_patch = {}}, until);
 }
 
 void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
@@ -151,6 +151,7 @@ void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool(
   const auto statuses = listen(Channel::status, handlers.status);
   const auto index = listen(Channel::tile_index, handlers.tile_index);
   const auto segments = listen(Channel::tile, handlers.tile_segment);
+  const auto grid = listen(Channel::grid, handlers.grid_patch);
   while (!until()) impl_->handle_for(0.05);
 }
 

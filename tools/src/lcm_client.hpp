@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "adit/command_ack_t.hpp"
+#include "adit/grid_patch_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/tile_assembler.hpp"
 #include "adit/status_t.hpp"
@@ -53,6 +54,7 @@ class LcmClient {
     std::function<void(const status_t&)> status;
     std::function<void(const tile_index_t&)> tile_index;
     std::function<void(const tile_segment_t&)> tile_segment;
+    std::function<void(const grid_patch_t&)> grid_patch;
   };
   // Calls the handlers for every message until `until` returns true (checked
   // at least every 50 ms).

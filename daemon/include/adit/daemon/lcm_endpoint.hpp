@@ -18,6 +18,7 @@
 #include "adit/protocol/map_point.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "adit/protocol/tile_codec.hpp"
+#include "adit/daemon/grid_publisher.hpp"
 #include "adit/daemon/tile_store.hpp"
 
 namespace adit::daemon {
@@ -84,6 +85,8 @@ struct EndpointOptions {
   protocol::TileParams tiles;
   double tile_period_s = 1.0;          // changed tiles go out at most this often
   double chunk_bytes_per_s = 4.0e6;    // pacing of tile chunks (broadcast and answers)
+  double grid_period_s = 1.0;          // changed live-grid patches go out at most this often
+  double grid_refresh_s = 10.0;        // every patch again within this
   std::size_t queue_capacity = 256;    // per hand-off queue
   std::size_t command_window = 1024;   // request ids remembered for replays
   // Command authentication (docs/COMMAND-AUTH.md): a key file readable only by
@@ -109,6 +112,9 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> chunk_bytes_published{0};
   std::atomic<std::uint64_t> index_published{0};
   std::atomic<std::uint64_t> segment_read_errors{0};  // tile segments whose file could not be read
+  std::atomic<std::uint64_t> grid_patches_published{0};  // live-grid patches, changed and refreshed
+  std::atomic<std::uint64_t> grid_bytes_published{0};
+  std::atomic<std::uint64_t> grid_patches_dropped{0};    // hand-off queue full
   std::atomic<std::uint64_t> file_requests{0};  // product files (file_request_t)
   std::atomic<std::uint64_t> file_requests_malformed{0};
   std::atomic<std::uint64_t> file_chunks_published{0};
@@ -144,6 +150,7 @@ class LcmEndpoint {
   bool publish_pose(const PoseSample& pose);
   bool publish_status(StatusSample&& status);
   bool publish_tile(TileUpdate&& tile);
+  bool publish_grid(GridPatchUpdate&& patch);
 
   // The daemon finished flushing the stopping session (STOPPING -> IDLE).
   void session_stopped();

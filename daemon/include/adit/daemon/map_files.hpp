@@ -14,7 +14,17 @@
 #include "adit/protocol/map_point.hpp"
 #include "adit/slam/tiled_map.hpp"
 
+namespace adit::slam {
+class LiveGrid;
+}
+
 namespace adit::daemon {
+
+// Writes the live 2D grid as STEM.pgm and STEM.yaml (ROS map_server), over
+// its patches' bounding box; returns the bytes written, 0 when the grid has
+// no patch (nothing written). Throws adit::InputError naming a file that
+// cannot be written.
+std::uintmax_t write_live_grid(const std::filesystem::path& stem, const slam::LiveGrid& grid);
 
 // A corner at or below every point of the tiles `coords` (tile_size_m each),
 // lowered by `margin_m` (points moved after mapping), floored to whole metres:

@@ -4,7 +4,9 @@
 // In:   each valid scan's body-frame points, times and intensities with its
 //       odometry pose (MapSlot).
 // Out:  the tiled voxel map and keyframes (read after join()); changed tiles
-//       to the tile sink at most once per map.publish_period_s; the map's
+//       to the tile sink at most once per map.publish_period_s; the live
+//       2D grid's changed patches to the grid sink at most once per
+//       grid.publish_period_s; the map's
 //       poses as TUM; tiles the sensor has left, crowded tiles and old
 //       keyframes' scans to the session folder (bounded memory).
 // A scan is mapped one scan late: deskewed with the corrected motion over its
@@ -31,6 +33,7 @@
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/deskew.hpp"
 #include "adit/slam/keyframes.hpp"
+#include "adit/slam/live_grid.hpp"
 #include "adit/slam/lie.hpp"
 #include "adit/slam/map_refiner.hpp"
 #include "adit/slam/tiled_map.hpp"
@@ -56,6 +59,14 @@ class MappingStage {
   // Before start(): each mapped scan's pose, the points each tile confirms and
   // each keyframe also go to the session journal.
   void journal_to(JournalWriter* journal) { journal_ = journal; }
+  // Before start(): the live grid's changed patches go to `sink`.
+  void publish_grid_to(PipelineSinks::GridSink sink) { grid_sink_ = std::move(sink); }
+  // Before start(): each scan's grid insertion time (ms) goes to `ms`, up to
+  // kTimingCapacity scans; read it after join().
+  void time_grid_into(std::vector<double>* ms) {
+    grid_ms_ = ms;
+    if (grid_ms_ != nullptr) grid_ms_->reserve(kTimingCapacity);
+  }
   void start();
   void join() { thread_.join(); }
 
@@ -65,6 +76,8 @@ class MappingStage {
   const slam::TiledVoxelMap& map() const { return map_; }
   const TileSpill* tile_spill() const { return spill_ ? &*spill_ : nullptr; }
   const std::vector<slam::Keyframe>& keyframes() const { return keyframes_; }
+  // The live 2D grid (null when grid.enabled is false). Complete after join().
+  const slam::LiveGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
 
  private:
   void loop();
@@ -74,10 +87,13 @@ class MappingStage {
   void restore_tiles(const std::vector<slam::TileCoord>& coords);
   void evict_tiles(const std::vector<slam::TileCoord>& coords);
   void flush_tiles();
+  void flush_grid();
   void journal_new_points();
   void tile_file_error(const std::string& problem);
 
   const config::MapSection config_;
+  const config::GridSection grid_config_;
+  const Eigen::Vector3f sensor_in_body_;  // the LiDAR's origin: where the grid's rays start
   const float min_range_m_;
   const float max_range_m_;
   const double max_scan_gap_s_;
@@ -99,6 +115,10 @@ class MappingStage {
   slam::VoxelDownsampler keyframe_downsampler_;
   slam::Deskewer deskewer_;
   std::optional<slam::MapRefiner> refiner_;  // with map.refine
+  std::optional<slam::LiveGrid> grid_;       // with grid.enabled
+  PipelineSinks::GridSink grid_sink_;
+  std::vector<double>* grid_ms_ = nullptr;
+  std::vector<std::int8_t> grid_cells_;      // one patch, for the sink
   slam::TumWriter map_trajectory_;
   // Per-scan buffers, reserved for the largest scan.
   std::vector<Eigen::Vector3f> points_;

@@ -102,6 +102,8 @@ class Pipeline {
   const slam::TiledVoxelMap& map() const;
   const TileSpill* tile_spill() const;  // null without SessionFiles::tiles_dir
   const std::vector<slam::Keyframe>& keyframes() const;
+  // The live 2D grid (grid.enabled), complete after join(); null without it.
+  const slam::LiveGrid* grid() const;
   // The loop-closure stage (map.loop_closure), complete after join(); null without it.
   const LoopClosureStage* loop_closure() const;
   // The session journal's writer (SessionFiles::journal_file), closed after join(); null without it.

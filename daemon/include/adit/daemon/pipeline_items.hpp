@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "adit/drivers/lidar/point.hpp"
+#include "adit/slam/live_grid.hpp"
 #include "adit/slam/odometry.hpp"
 #include "adit/slam/tiled_map.hpp"
 
@@ -56,10 +57,15 @@ struct PipelineSinks {
   using PoseSink = std::function<void(const slam::OdometryResult&)>;
   using TileSink = std::function<void(const slam::TileCoord&, std::span<const slam::MapSample>)>;
   using ImuPoseSink = std::function<void(const slam::InertialState&, const slam::Matrix6d& covariance)>;
+  // A live-grid patch whose cells changed: its coordinate, version, cells
+  // (slam::LiveGrid::read) and the grid's patch count.
+  using GridSink = std::function<void(slam::GridPatchCoord, std::int32_t version, std::span<const std::int8_t> cells,
+                                      std::size_t patches)>;
   PoseSink pose;  // output thread, once per scan (valid or not)
   // The IMU source's thread, per IMU reading while LiDAR-inertial (imu_pose_feed.hpp): quick, never throws.
   ImuPoseSink imu_pose;
   TileSink tile;  // mapping thread: the whole current content of a tile that changed
+  GridSink grid;  // mapping thread, at most once per grid.publish_period_s per patch
 };
 
 }  // namespace adit::daemon

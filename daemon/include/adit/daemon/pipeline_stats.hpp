@@ -78,6 +78,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> map_bytes{0};            // resident tiles' vectors and indices
   std::atomic<std::uint64_t> keyframe_bytes{0};       // keyframes' downsampled scans
   std::atomic<std::uint64_t> resident_tiles{0};
+  std::atomic<std::uint64_t> grid_patches{0};         // the live 2D grid's patches
   std::atomic<std::uint64_t> evicted_tiles{0};        // evictions (a tile evicted twice counts twice)
   std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
   std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
@@ -115,6 +116,7 @@ inline constexpr std::size_t kTimingCapacity = std::size_t{1} << 20;
 struct PipelineTimings {
   std::vector<double> odometry_ms;   // Odometry::process per scan
   std::vector<double> latency_ms;    // last packet of a scan received → its pose handed on
+  std::vector<double> grid_ms;       // slam::LiveGrid::insert per mapped scan (mapping thread)
   double duration_s = 0.0;           // wall time from start to the source's end and the queues drained
   double sensor_span_s = 0.0;        // first to last scan stamp
 };

@@ -203,6 +203,22 @@ struct MapSection {
   bool loops_tilt_walk = true;
 };
 
+// The live 2D occupancy grid (slam::LiveGrid, docs/PRODUCTS.md "The live
+// grid"): a slice of the world at the sensor's height, by ray casting each
+// mapped scan; its changed patches go to the tablet on GRID, and the session
+// folder gets it as grid_live.pgm / .yaml at the end.
+struct GridSection {
+  bool enabled = true;
+  double resolution_m = 0.05;
+  double band_below_m = 0.5;      // the slice, relative to the sensor's height
+  double band_above_m = 0.5;
+  double tilt_tolerance_deg = 1.0;  // the band narrows with range by this much attitude error
+  double max_range_m = 40.0;      // horizontal reach of the rays
+  int patch_cells = 128;          // cells per side of a patch (one message)
+  double publish_period_s = 1.0;  // changed patches go out at most this often
+  double refresh_s = 10.0;        // every patch goes out again within this (late or lossy clients)
+};
+
 // Sessions: what is kept in the session folder and how a session begins.
 struct SessionSection {
   bool autostart = false;                // start mapping at launch (payloads without a tablet)
@@ -271,6 +287,7 @@ struct Config {
   ImuSection imu;
   GpioSection gpio;
   MapSection map;
+  GridSection grid;
   SessionSection session;
   PriorMapSection prior_map;
   LcmSection lcm;

@@ -211,6 +211,19 @@ void describe(V& v, MapSection& s) {
 }
 
 template <typename V>
+void describe(V& v, GridSection& s) {
+  v.optional("enabled", s.enabled);
+  v.optional("resolution_m", s.resolution_m, Range<double>{0.02, 1.0});
+  v.optional("band_below_m", s.band_below_m, Range<double>{0.0, 10.0});
+  v.optional("band_above_m", s.band_above_m, Range<double>{0.0, 10.0});
+  v.optional("tilt_tolerance_deg", s.tilt_tolerance_deg, Range<double>{0.0, 10.0});
+  v.optional("max_range_m", s.max_range_m, Range<double>{1.0, 200.0});
+  v.optional("patch_cells", s.patch_cells, Range<int>{16, 200});  // 200² cells fit one message
+  v.optional("publish_period_s", s.publish_period_s, Range<double>{0.1, 60.0});
+  v.optional("refresh_s", s.refresh_s, Range<double>{1.0, 600.0});
+}
+
+template <typename V>
 void describe(V& v, PriorMapSection& s) {
   v.optional("dir", s.dir);
 }
@@ -262,6 +275,7 @@ void describe(V& v, Config& c) {
   v.section("imu", c.imu);
   v.section("gpio", c.gpio);
   v.section("map", c.map);
+  v.section("grid", c.grid);
   v.section("session", c.session);
   v.section("prior_map", c.prior_map);
   v.section("lcm", c.lcm);

@@ -12,12 +12,16 @@
 #include <string_view>
 
 #include "adit/products/grid_2d.hpp"
+#include "adit/protocol/grid_mosaic.hpp"
 
 namespace adit::products {
 
 // Writes STEM.pgm and STEM.yaml; returns the bytes written (both files).
 // Throws adit::InputError naming the file when it cannot be written.
 std::uintmax_t write_grid(const std::filesystem::path& stem, const Grid2d& grid);
+
+// The live grid's image (protocol::GridMosaic) as a grid: the same cells.
+Grid2d grid_of(const protocol::GridImage& image);
 
 // Reads a map_server YAML and the image it names (P5 PGM only; trinary,
 // negate 0). Bad files throw adit::InputError naming the file, line and key.
