@@ -110,6 +110,20 @@ TEST(LiveGrid, APersonWhoWalksAwayIsClearedAndAWallSeenThroughAPersonStays) {
   EXPECT_EQ(value_at(grid, 3.02F, 0.02F), kGridFree);
 }
 
+TEST(LiveGrid, AnOccupiedCellPassedOnceStaysOccupiedButClearsWhenPassedOften) {
+  LiveGrid grid(LiveGridConfig{});
+  const Eigen::Vector3f sensor(0.0F, 0.0F, 1.0F);
+  const Eigen::Vector3f wall(4.025F, 1.025F, 1.0F);
+  grid.insert(sensor, std::vector<Eigen::Vector3f>{wall});
+  EXPECT_EQ(value_at(grid, 4.025F, 1.025F), kGridOccupied);
+  // A ray to a point beyond, on the same line, passes the cell: a grazing ray's miss.
+  const std::vector<Eigen::Vector3f> beyond{sensor + 2.0F * (wall - sensor)};
+  grid.insert(sensor, beyond);
+  EXPECT_EQ(value_at(grid, 4.025F, 1.025F), kGridOccupied);  // a whole miss would leave it unknown
+  for (int k = 0; k < 6; ++k) grid.insert(sensor, beyond);
+  EXPECT_EQ(value_at(grid, 4.025F, 1.025F), kGridFree);
+}
+
 TEST(LiveGrid, PatchesOnEverySideOfTheOriginHoldTheirCells) {
   LiveGridConfig config;
   config.patch_cells = 16;  // 0.8 m patches: the drift spans many, negative ones too

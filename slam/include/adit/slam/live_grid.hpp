@@ -10,7 +10,8 @@
 // left it. Cells hold log-odds (Thrun, Burgard, Fox, Probabilistic Robotics,
 // §9.2, eq. 9.7), updated once per scan per cell with OctoMap's hit / miss
 // probabilities 0.7 / 0.4 and clamping 0.12 / 0.97 (Hornung et al. 2013, §3);
-// a cell hit and passed in one scan counts as hit (OctoMap does the same).
+// a cell hit and passed in one scan counts as hit (OctoMap does the same), and
+// a pass through a cell that reads occupied counts half (rays graze walls).
 // Far away a small attitude error moves the floor and ceiling into the band,
 // so the band narrows with range by a tilt tolerance.
 // The value a cell reads as is ROS map_saver's: occupied at P >= 0.65, free
@@ -40,7 +41,7 @@ struct LiveGridConfig {
   // the ceiling); points in that margin are neither obstacle nor free.
   float tilt_tolerance_deg = 1.0F;
   float max_range_m = 40.0F;   // horizontal; farther points are left out
-  int bearings = 1440;         // free rays per scan: the nearest obstacle per 0.25°
+  int bearings = 1440;         // free rays per scan: the nearest obstacle per 0.25° (0.16-0.32°)
   int patch_cells = 128;       // a patch is patch_cells × patch_cells cells
 };
 
@@ -103,8 +104,9 @@ class LiveGrid {
     return (static_cast<std::int64_t>(c.x) << 32) ^ static_cast<std::uint32_t>(c.y);
   }
   Patch& patch_at(GridPatchCoord c);
-  // Updates cell (i, j) once this scan; false when it was updated already.
-  bool update(std::int64_t i, std::int64_t j, std::int16_t delta);
+  // Updates a cell of `p` once this scan; false when it was updated already.
+  bool update(Patch& p, std::size_t cell, std::int16_t delta);
+  static float pseudo_angle(float x, float y);
   void trace_free(const Eigen::Vector2f& from, const Eigen::Vector2f& to);
 
   LiveGridConfig config_;
