@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/pose_t.hpp"
+#include "adit/products/grid_io.hpp"
 #include "adit/protocol/channels.hpp"
 #include "adit/protocol/checked_decode.hpp"
 #include "daemon_process.hpp"
@@ -81,6 +82,13 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   EXPECT_GE(rate, 8.0);
   EXPECT_LE(rate, 12.0);
   EXPECT_EQ(poses.valid(), poses.count());
+  // The live 2D grid, as a tablet receives it while mapping: walls and free floor.
+  const CommandRun grid = run_adit(fmt::format("grid {} --out {} --duration 2.5", client, (work / "live").string()));
+  ASSERT_EQ(grid.status, 0) << grid.output;
+  EXPECT_NE(grid.output.find("session " + id), std::string::npos) << grid.output;
+  const products::Grid2d live = products::read_grid(work / "live.yaml");
+  EXPECT_GT(live.count(products::kOccupied), 100U);
+  EXPECT_GT(live.count(products::kFree), 1000U);
 
   const CommandRun stop = run_adit("stop " + client);
   ASSERT_EQ(stop.status, 0) << stop.output;
@@ -96,6 +104,9 @@ TEST(AditdEndToEnd, StartWatchStopDownloadOverLcmAndTheMapLiesOnTheTrueSurfaces)
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(folder / "summary.json"));
   const std::size_t map_points = summary["map"]["points"];
   ASSERT_GT(map_points, 10'000U);
+  // The live grid at the end, as the tablet had it, beside the session's files.
+  EXPECT_GT(summary["grid_live"]["patches"].get<int>(), 0) << summary["grid_live"].dump();
+  EXPECT_GE(products::read_grid(folder / "grid_live.yaml").count(products::kOccupied), live.count(products::kOccupied) / 2);
   // The poses the map was built at, beside the odometry's.
   std::ifstream map_trajectory(folder / "map_trajectory.tum");
   std::size_t map_poses = 0;
