@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
+#include <span>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -35,10 +38,25 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   PipelineOptions options;
   options.trajectory_file = out / "trajectory.tum";
   options.map_trajectory_file = out / "map_trajectory.tum";
+  // The live grid's changed patches, handed over on the mapping thread (read after join()).
+  std::map<std::pair<int, int>, std::int32_t> grid_versions;
+  std::size_t grid_cells = 0;
+  options.sinks.grid = [&](slam::GridPatchCoord c, std::int32_t version, std::span<const std::int8_t> cells,
+                           std::size_t) {
+    std::int32_t& held = grid_versions[{c.x, c.y}];
+    EXPECT_GT(version, held);
+    held = version;
+    grid_cells = cells.size();
+  };
   Pipeline pipeline(hdl32e_replay(dir, out), options);
   pipeline.start();
   pipeline.join();
   ASSERT_TRUE(pipeline.drained());
+  ASSERT_NE(pipeline.grid(), nullptr);
+  EXPECT_FALSE(grid_versions.empty());
+  EXPECT_LE(grid_versions.size(), pipeline.grid()->patch_count());
+  EXPECT_EQ(grid_cells, 128U * 128U);
+  for (const auto& [c, version] : grid_versions) EXPECT_EQ(version, pipeline.grid()->version({c.first, c.second}));
   const PipelineStats& s = pipeline.stats();
   EXPECT_GE(s.scans.load(), 5U);  // 876 packets of an 11.7 Hz sensor: about 5 scans
   // Every scan is a pose but an incomplete first one.
@@ -49,6 +67,7 @@ TEST(Pipeline, ReplaysARealCaptureIntoOnePosePerScan) {
   EXPECT_EQ(s.datagrams.load(), 976U);          // 876 data + 100 position packets
   EXPECT_EQ(s.foreign_datagrams.load(), 100U);  // the position packets, on port 8308
   EXPECT_EQ(pipeline.timings().odometry_ms.size(), s.poses.load());
+  EXPECT_EQ(pipeline.timings().grid_ms.size(), s.mapped_scans.load());
 
   std::ifstream trajectory(options.trajectory_file);
   std::size_t lines = 0;
