@@ -135,7 +135,8 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
 // as grid_live.pgm / .yaml (null without grid.enabled).
 nlohmann::json live_grid_summary(const slam::LiveGrid* grid, std::uintmax_t file_bytes, std::vector<double> insert_ms) {
   if (grid == nullptr) return nullptr;
-  return {{"patches", grid->patch_count()}, {"resolution_m", grid->config().resolution_m},
+  const double resolution_m = std::round(static_cast<double>(grid->config().resolution_m) * 1e6) / 1e6;  // a float
+  return {{"patches", grid->patch_count()}, {"resolution_m", resolution_m},
           {"scans", grid->counts().scans}, {"memory_bytes", grid->memory_bytes()}, {"file_bytes", file_bytes},
           {"insert_ms_median", quantile(insert_ms, 0.5)}, {"insert_ms_p99", quantile(insert_ms, 0.99)}};
 }
