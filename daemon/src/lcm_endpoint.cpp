@@ -24,9 +24,9 @@
 #include "adit/protocol/command_auth.hpp"
 #include "adit/protocol/command_gate.hpp"
 #include "adit/common/clock.hpp"
+#include "adit/grid_patch_t.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
-#include "adit/grid_patch_t.hpp"
 #include "adit/tile_index_t.hpp"
 #include "adit/tile_request_t.hpp"
 

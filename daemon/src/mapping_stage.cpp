@@ -26,9 +26,6 @@ slam::TiledMapConfig map_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.tile_size_m), static_cast<float>(m.voxel_m), static_cast<std::uint8_t>(m.min_hits)};
 }
 
-// No point of a scan lies farther than max_range_m from the body (map_scan
-// filters them), deskewing moves points by at most a sweep's motion, and the
-// sensor's offset from the body is small: the margin covers both.
 slam::LiveGridConfig grid_config_of(const config::GridSection& g) {
   slam::LiveGridConfig c;
   c.resolution_m = static_cast<float>(g.resolution_m);
@@ -40,6 +37,9 @@ slam::LiveGridConfig grid_config_of(const config::GridSection& g) {
   return c;
 }
 
+// No point of a scan lies farther than max_range_m from the body (map_scan
+// filters them), deskewing moves points by at most a sweep's motion, and the
+// sensor's offset from the body is small: the margin covers both.
 slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
           static_cast<std::size_t>(m.compact_tile_voxels)};
@@ -105,9 +105,11 @@ void MappingStage::loop() {
       flush_grid();
       last_grid_ns = monotonic_ns();
     }
-    // Waits for a scan until the next flush is due.
-    MapSlot* slot =
-        scans_.take_or_wait([&] { return thread_.idle() && monotonic_ns() - last_flush_ns < period_ns; });
+    // Waits for a scan until the next flush (tiles or grid) is due.
+    MapSlot* slot = scans_.take_or_wait([&] {
+      const std::int64_t now = monotonic_ns();
+      return thread_.idle() && now - last_flush_ns < period_ns && now - last_grid_ns < grid_period_ns;
+    });
     if (slot == nullptr) {
       if (scans_.drained()) break;
       continue;
