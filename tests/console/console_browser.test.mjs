@@ -4,6 +4,9 @@
 //   - a START without the passphrase is refused with a visible message and changes nothing;
 //   - unlocked, START and STOP by clicking work; two browsers watch at once;
 //   - the map renders (non-background pixels of the map canvas);
+//   - the payload's live 2D grid reaches the page cell for cell (the PNG of
+//     /api/grid decoded here and in the page) and shows in the top view; its
+//     button hides it;
 //   - the console restarting (a browser losing its link) shows a message, and the
 //     page resumes without reloading the map (only changed tiles are fetched);
 //   - a payload that stops answering (SIGSTOP) shows a message, which clears on SIGCONT;
@@ -15,8 +18,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import assert from 'node:assert/strict';
 import { setTimeout as sleep } from 'node:timers/promises';
-import { adit, launchBrowser, mapCoverage, processUsage, quantile, requireBrowser, simulatedSession, startConsole,
-         startPayload, waitFor } from './harness.mjs';
+import { adit, launchBrowser, mapCoverage, processUsage, quantile, requireBrowser, servedGrid, simulatedSession,
+         startConsole, startPayload, waitFor } from './harness.mjs';
 
 const build = path.resolve(process.argv[2] || 'build');
 const shotsAt = process.argv.indexOf('--screenshots');
@@ -183,6 +186,55 @@ try {
   figures.latency_ms_p50 = quantile(lat, 0.5);
   figures.latency_ms_p95 = quantile(lat, 0.95);
   figures.latency_samples = lat.length;
+
+  step('The 2D grid');
+  // The session's grid, as the console serves it (decoded here) and as the
+  // page holds it (decoded there), once the page has the version served.
+  const grids = await waitFor('the page to hold the grid the console serves', async () => {
+    const served = await servedGrid(base);
+    const held = await page.evaluate(() => window.adit.view.grid.summary());
+    return served && held && held.v === served.v ? { served, held } : null;
+  }, 30000, 500);
+  const { served, held } = grids;
+  const { bytes: _, ...servedSummary } = served;
+  assert.deepEqual(held, servedSummary, 'the page holds the served grid cell for cell');
+  figures.grid_cells = `${served.width} x ${served.height}`;
+  figures.grid_occupied = served.occupied;
+  figures.grid_free = served.free;
+  figures.grid_png_bytes = served.bytes;
+  figures.grid_fetches = (await metrics(page)).gridFetches;
+  assert.equal(served.session, id, 'the grid is the session\'s');
+  assert.ok(served.occupied > 1000 && served.free > 10000, `a mine drive's grid: ${JSON.stringify(served)}`);
+  assert.equal(await text(page, '#grid-text'), ` · grid ${(served.width * served.resolution).toFixed(0)} × ${
+    (served.height * served.resolution).toFixed(0)} m`);
+  // In the top view the grid is drawn over the points (pixels of exactly the
+  // free cells' colour); its button hides it.
+  const freeShare = () => page.evaluate(() => {
+    const src = document.getElementById('map');
+    const c = document.createElement('canvas');
+    c.width = src.width;
+    c.height = src.height;
+    const g = c.getContext('2d');
+    g.drawImage(src, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    const free = window.adit.view.grid.freeColour;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4)
+      if (Math.abs(d[i] - free[0]) + Math.abs(d[i + 1] - free[1]) + Math.abs(d[i + 2] - free[2]) <= 6) ++n;
+    return n / (c.width * c.height);
+  });
+  await page.click('#camera-modes button[data-mode="top"]');
+  await sleep(1000);
+  figures.grid_free_share_top = await freeShare();
+  await page.click('#grid-toggle');
+  await sleep(1000);
+  const hidden = await freeShare();
+  assert.equal(await page.$eval('#grid-toggle', (b) => b.getAttribute('aria-pressed')), 'false');
+  assert.ok(figures.grid_free_share_top > 0.01 && hidden < figures.grid_free_share_top / 10,
+            `the grid's free cells show in the top view (${(100 * figures.grid_free_share_top).toFixed(2)} % of the ` +
+            `pixels), and not once hidden (${(100 * hidden).toFixed(2)} %)`);
+  await page.click('#grid-toggle');
+  await page.click('#camera-modes button[data-mode="follow"]');
 
   step('The payload stops answering');
   // The payload stops answering: a visible message; it clears when it answers again.

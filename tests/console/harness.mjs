@@ -5,6 +5,7 @@
 import { spawn, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
+import zlib from 'node:zlib';
 import { setTimeout as sleep } from 'node:timers/promises';
 
 export const CHROMIUM = process.env.ADIT_CHROMIUM || '/usr/bin/chromium';
@@ -150,4 +151,74 @@ export async function mapCoverage(page) {
       if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 30) ++n;
     return n / (c.width * c.height);
   });
+}
+
+// GET /api/grid read here, apart from the page's decoder: the PNG's chunks,
+// node's zlib and the PNG row filters (https://www.w3.org/TR/png/#9Filters),
+// then the cells and summary the page's gridSummary (grid_layer.js) gives.
+// null when the console holds no grid.
+export async function servedGrid(base) {
+  const r = await fetch(`${base}/api/grid`);
+  if (r.status !== 200) return null;
+  const png = Buffer.from(await r.arrayBuffer());
+  const { width, height, pixels } = decodeGreyAlphaPng(png);
+  let occupied = 0, free = 0, unknown = 0, hash = 0x811c9dc5;
+  for (let row = 0; row < height; ++row) {
+    const from = (height - 1 - row) * width * 2;  // the image's top row is the grid's last (highest y)
+    for (let col = 0; col < width; ++col) {
+      const grey = pixels[from + 2 * col], alpha = pixels[from + 2 * col + 1];
+      const c = alpha < 128 ? -1 : Math.round((255 - grey) / 2.55);
+      if (c < 0) unknown += 1; else if (c >= 65) occupied += 1; else free += 1;
+      hash = Math.imul(hash ^ (c & 0xff), 0x01000193) >>> 0;
+    }
+  }
+  const h = (name) => r.headers.get(name);
+  return { session: h('X-Grid-Session'), v: Number(h('X-Grid-Version')), width, height,
+           resolution: Number(h('X-Grid-Resolution')), originX: Number(h('X-Grid-Origin-X')),
+           originY: Number(h('X-Grid-Origin-Y')), occupied, free, unknown, hash, bytes: png.length };
+}
+
+function decodeGreyAlphaPng(png) {
+  if (png.toString('latin1', 1, 4) !== 'PNG') throw new Error('/api/grid is not a PNG');
+  const idat = [];
+  let width = 0, height = 0, format = '';
+  for (let at = 8; at < png.length;) {
+    const length = png.readUInt32BE(at);
+    const type = png.toString('latin1', at + 4, at + 8);
+    const data = png.subarray(at + 8, at + 8 + length);
+    if (type === 'IHDR') {
+      width = data.readUInt32BE(0);
+      height = data.readUInt32BE(4);
+      format = `depth ${data[8]} colour ${data[9]} interlace ${data[12]}`;
+    } else if (type === 'IDAT') {
+      idat.push(data);
+    }
+    at += 12 + length;
+  }
+  if (format !== 'depth 8 colour 4 interlace 0') throw new Error(`/api/grid: ${format}, not 8-bit grey + alpha`);
+  const raw = zlib.inflateSync(Buffer.concat(idat));
+  const stride = width * 2;
+  const pixels = new Uint8Array(height * stride);
+  for (let y = 0; y < height; ++y) {
+    const filter = raw[y * (stride + 1)];
+    for (let x = 0; x < stride; ++x) {
+      const left = x >= 2 ? pixels[y * stride + x - 2] : 0;
+      const up = y > 0 ? pixels[(y - 1) * stride + x] : 0;
+      const corner = x >= 2 && y > 0 ? pixels[(y - 1) * stride + x - 2] : 0;
+      let predictor;
+      if (filter === 0) predictor = 0;
+      else if (filter === 1) predictor = left;
+      else if (filter === 2) predictor = up;
+      else if (filter === 3) predictor = (left + up) >> 1;
+      else if (filter === 4) predictor = paeth(left, up, corner);
+      else throw new Error(`/api/grid: PNG filter ${filter}`);
+      pixels[y * stride + x] = (raw[y * (stride + 1) + 1 + x] + predictor) & 0xff;
+    }
+  }
+  return { width, height, pixels };
+}
+
+function paeth(a, b, c) {
+  const p = a + b - c, pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
+  return pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
 }

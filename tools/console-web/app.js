@@ -1,10 +1,12 @@
 // adit console: the page. One event stream (/api/events) brings the
-// snapshot (`hello`), poses, status, tile changes, link and download news;
-// tiles are fetched as binary, only the segments changed since the version
-// held, decimated to a point budget so the view stays smooth on a tablet.
+// snapshot (`hello`), poses, status, tile and grid changes, link and download
+// news; tiles are fetched as binary, only the segments changed since the
+// version held, decimated to a point budget so the view stays smooth on a
+// tablet; the live 2D grid as one PNG when its version moves.
 // A reconnecting stream starts with a snapshot and the page fetches only the
 // tiles whose version moved: the map is not loaded again.
 import { MapView } from './map_view.js';
+import { fetchGrid } from './grid_layer.js';
 import { HealthPanel } from './health.js';
 import { SessionsPanel } from './sessions.js';
 
@@ -15,7 +17,7 @@ const pointBudget = Number(params.get('budget')) || 300000;
 
 // What the browser tests read (tests/console): latencies, poses, frames.
 const metrics = { latencies: [], poses: 0, lastSeq: -1, frames: 0, frameTimes: [], tileFetches: 0, tileBytes: 0,
-                  hellos: 0, errors: [] };
+                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0 };
 window.adit = { metrics };
 
 const view = new MapView(el('map'));
@@ -102,6 +104,52 @@ async function fetchTile(id) {
   el('map-text').textContent = `${drawn.toLocaleString()} of ${Math.max(mapPoints, drawn).toLocaleString()} points drawn`;
 }
 
+// ---- the live 2D grid: one fetch at a time, again if its version moved meanwhile.
+// Its version (the sum of its patches' versions) only grows within a session,
+// and is the same for the same grid in any console: a restarted console that
+// holds less of it so far is not fetched from until it has caught up.
+let gridWanted = 0;  // the newest version announced and not fetched since
+let gridFetching = false;
+function wantGrid(g) {
+  if (!g || g.v <= view.gridVersion()) return;
+  gridWanted = g.v;
+  pumpGrid();
+}
+async function pumpGrid() {
+  if (gridFetching || gridWanted === 0) return;
+  const wanted = gridWanted;
+  gridFetching = true;
+  try {
+    const grid = await fetchGrid();  // null: not held (a new session without a patch yet)
+    if (grid && grid.v > view.gridVersion() && (!mapSession || grid.session === mapSession)) showGrid(grid);
+  } catch (e) {
+    metrics.errors.push(String(e));
+  }
+  if (gridWanted === wanted) gridWanted = 0;  // the answer is at least as new as what was announced
+  gridFetching = false;
+  pumpGrid();
+}
+function showGrid(grid) {
+  metrics.gridFetches += 1;
+  metrics.gridBytes += grid.bytes;
+  view.setGrid(grid);
+  el('grid-toggle').hidden = false;
+  const m = (n) => (n * grid.resolution).toFixed(0);
+  el('grid-text').textContent = ` · grid ${m(grid.width)} × ${m(grid.height)} m`;
+  el('grid-text').hidden = false;
+}
+function clearGrid() {
+  gridWanted = 0;
+  el('grid-toggle').hidden = true;
+  el('grid-text').hidden = true;
+}
+el('grid-toggle').addEventListener('click', () => {
+  const on = !el('grid-toggle').classList.contains('on');
+  el('grid-toggle').classList.toggle('on', on);
+  el('grid-toggle').setAttribute('aria-pressed', String(on));
+  view.showGrid(on);
+});
+
 // ---- the event stream
 function applySnapshot(s) {
   metrics.hellos += 1;
@@ -114,10 +162,11 @@ function applySnapshot(s) {
   // Tiles only grow within a session: a console that is still catching up
   // (restarted) lists fewer, and the ones held stay. A console that has not
   // heard the payload yet knows no session (""): that is no new session.
-  if (s.session && s.session !== mapSession) { view.clear(); queue.clear(); mapSession = s.session; }
+  if (s.session && s.session !== mapSession) { view.clear(); queue.clear(); clearGrid(); mapSession = s.session; }
   if (s.path.length >= view.pathCount) view.setPath(s.path);  // a restarted console knows less of it
   mapPoints = Math.max(mapPoints, s.map_points);
   for (const t of s.tiles) wantTile(t.id, t.v);
+  wantGrid(s.grid);
   showBanner();
 }
 
@@ -150,11 +199,13 @@ function connect() {
   events.addEventListener('tiles', (e) => {
     for (const t of JSON.parse(e.data).tiles) wantTile(t.id, t.v);
   });
+  events.addEventListener('grid', (e) => wantGrid(JSON.parse(e.data)));
   events.addEventListener('session', (e) => {
     const session = JSON.parse(e.data).session;
     if (session === mapSession) return;
     view.clear();
     queue.clear();
+    clearGrid();
     mapPoints = 0;
     mapSession = session;
   });

@@ -1,9 +1,11 @@
 // adit console: the live 3D view. Tiles from the console become one
 // THREE.Points each, coloured by height in the shader (so every tile shares
 // one colour scale that follows the map's extent without recolouring); the
-// path is a line, the current pose a cone; cameras: follow, top, free (orbit
-// with a finger or the mouse, pinch or wheel to zoom).
+// path is a line, the current pose a cone; the live 2D grid a textured plane
+// under the points (grid_layer.js); cameras: follow, top, free (orbit with a
+// finger or the mouse, pinch or wheel to zoom).
 import * as THREE from '/vendor/three/three.module.js';
+import { GridLayer } from './grid_layer.js';
 
 const heightShader = {
   vertex: `
@@ -54,6 +56,7 @@ export class MapView {
     this.marker = new THREE.Mesh(cone, new THREE.MeshBasicMaterial({ color: 0xff2bd6 }));
     this.marker.visible = false;
     this.scene.add(this.marker);
+    this.grid = new GridLayer(this.scene);
     this.mode = 'follow';
     this.orbit = { target: new THREE.Vector3(), distance: 40, azimuth: -Math.PI / 2, elevation: 0.9 };
     this.poseDirty = false;
@@ -74,6 +77,7 @@ export class MapView {
   setTheme(sun) {
     this.renderer.setClearColor(sun ? 0xffffff : 0x0a0d10);
     this.path.material.color.set(sun ? 0x000000 : 0xffffff);
+    if (this.grid) this.grid.setTheme(sun);
     this.dirty = true;
   }
 
@@ -92,6 +96,18 @@ export class MapView {
     this.pathCount = 0;
     this.pathGeometry.setDrawRange(0, 0);
     this.marker.visible = false;
+    this.grid.clear();
+    this.dirty = true;
+  }
+
+  // The live 2D grid (grid_layer.js fetchGrid's answer), and whether it shows.
+  setGrid(grid) {
+    this.grid.set(grid);
+    this.dirty = true;
+  }
+  gridVersion() { return this.grid.version(); }
+  showGrid(on) {
+    this.grid.setVisible(on);
     this.dirty = true;
   }
 
@@ -217,6 +233,14 @@ export class MapView {
     if (this.zRange) {
       this.material.uniforms.zmin.value = this.zRange[0];
       this.material.uniforms.zmax.value = this.zRange[1];
+    }
+    this.grid.setFloor(this.zRange ? this.zRange[0] : 0);
+    // From above, the grid (and the path and pose on it) over the points: the roof would hide them.
+    const overlay = this.mode === 'top' && this.grid.visible && this.grid.version() > 0;
+    this.grid.setOnTop(overlay);
+    for (const o of [this.path, this.marker]) {
+      o.material.depthTest = !overlay;
+      o.renderOrder = overlay ? 2 : 0;
     }
     this.placeCamera();
     this.renderer.render(this.scene, this.camera);

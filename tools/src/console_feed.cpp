@@ -4,6 +4,8 @@
 #include <cstring>
 
 #include "adit/common/clock.hpp"
+#include "adit/common/log.hpp"
+#include "adit/grid_patch_t.hpp"
 #include "adit/protocol/session_state.hpp"
 
 namespace adit::tools::console {
@@ -14,6 +16,7 @@ constexpr std::int64_t kQuietBeforeAskMs = 300;  // as `adit download`: ask once
 constexpr std::int64_t kAskEveryMs = 500;
 constexpr std::int64_t kAskIndexEveryMs = 2000;  // until the full index comes (a payload down at first)
 constexpr std::int64_t kTilesEventEveryMs = 250;
+constexpr std::int64_t kGridEventEveryMs = 500;  // the payload sends changed patches at most once a second
 constexpr double kPathStepM = 0.05;       // the path keeps a point per 5 cm travelled
 constexpr std::size_t kPathMax = 20000;   // then every other one is dropped
 constexpr std::size_t kChangesKept = 32;  // completions remembered per tile
@@ -86,7 +89,7 @@ void LiveFeed::run() {
                    .status = [this](const status_t& s) { on_status(s); },
                    .tile_index = [this](const tile_index_t& m) { on_index(m); },
                    .tile_segment = [this](const tile_segment_t& m) { on_segment(m); },
-                   .grid_patch = {}},
+                   .grid_patch = [this](const grid_patch_t& m) { on_grid(m); }},
                   [this] {
                     tick();
                     return stop_.load();
@@ -101,6 +104,11 @@ void LiveFeed::switch_session(const std::string& session) {
   pending_event_.clear();
   path_.clear();
   index_received_ = false;
+  grid_ = {};
+  grid_version_ = 0;
+  grid_patch_versions_.clear();
+  grid_changed_ = false;
+  grid_png_.reset();
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
 }
 
@@ -170,10 +178,28 @@ void LiveFeed::on_segment(const tile_segment_t& m) {
   pending_event_[m.tile_id] = held->version;
 }
 
+void LiveFeed::on_grid(const grid_patch_t& m) {
+  if (m.payload_id != options_.payload_id) return;
+  const std::lock_guard lock(mutex_);
+  if (session_.empty()) switch_session(m.session_id);
+  if (m.session_id != session_) return;
+  const std::uint64_t accepted = grid_.counts().accepted;
+  if (const std::string problem = grid_.accept(m); !problem.empty()) {
+    if (grid_.counts().refused == 1) log::warn("adit console: a grid patch refused (more are not logged): {}", problem);
+    return;
+  }
+  if (grid_.counts().accepted == accepted) return;  // a refresh of a version held
+  std::int32_t& held = grid_patch_versions_[{m.patch_x, m.patch_y}];
+  grid_version_ += m.version - held;
+  held = m.version;
+  grid_changed_ = true;
+}
+
 void LiveFeed::tick() {
   const std::int64_t now = now_ms();
   bool link_lost = false;
   std::string tiles_event;
+  std::string grid_event;
   {
     const std::lock_guard lock(mutex_);
     if (link_up_ && now - last_status_ms_ > kLinkSilentMs) {
@@ -201,10 +227,16 @@ void LiveFeed::tick() {
       last_tiles_event_ms_ = now;
       tiles_event = nlohmann::json{{"session", session_}, {"tiles", list}}.dump();
     }
+    if (grid_changed_ && now - last_grid_event_ms_ >= kGridEventEveryMs) {
+      grid_changed_ = false;
+      last_grid_event_ms_ = now;
+      grid_event = nlohmann::json{{"session", session_}, {"v", grid_version_}, {"patches", grid_.patch_count()}}.dump();
+    }
   }
   if (link_lost)
     hub_.publish("link", nlohmann::json{{"up", false}, {"silent_ms", now - last_status_ms_}}.dump());
   if (!tiles_event.empty()) hub_.publish("tiles", std::move(tiles_event));
+  if (!grid_event.empty()) hub_.publish("grid", std::move(grid_event));
 }
 
 nlohmann::json LiveFeed::snapshot() const {
@@ -228,7 +260,10 @@ nlohmann::json LiveFeed::snapshot() const {
           {"pose", pose_ ? *pose_ : nlohmann::json()},
           {"path", path},
           {"tiles", tiles},
-          {"map_points", points}};
+          {"map_points", points},
+          {"grid", grid_.patch_count() == 0
+                       ? nlohmann::json()
+                       : nlohmann::json{{"v", grid_version_}, {"patches", grid_.patch_count()}}}};
 }
 
 std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_version, int every) const {
@@ -272,6 +307,31 @@ std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_versi
     index += segment.size();
   }
   return out;
+}
+
+std::shared_ptr<const GridBytes> LiveFeed::grid() const {
+  protocol::GridImage image;
+  GridBytes out;
+  {
+    const std::lock_guard lock(mutex_);
+    if (grid_.patch_count() == 0) return nullptr;
+    if (grid_png_ && grid_png_->session == session_ && grid_png_->version == grid_version_) return grid_png_;
+    image = grid_.image();
+    out.session = session_;
+    out.version = grid_version_;
+    out.patches = grid_.patch_count();
+  }
+  // Encoded without the lock: the feed's thread goes on receiving meanwhile.
+  out.resolution_m = image.resolution_m;
+  out.origin_x = image.origin_x;
+  out.origin_y = image.origin_y;
+  out.width = image.width;
+  out.height = image.height;
+  out.png = grid_png(image);
+  auto encoded = std::make_shared<const GridBytes>(std::move(out));
+  const std::lock_guard lock(mutex_);
+  if (encoded->session == session_ && (!grid_png_ || grid_png_->version < encoded->version)) grid_png_ = encoded;
+  return encoded;
 }
 
 }  // namespace adit::tools::console

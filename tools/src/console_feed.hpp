@@ -3,16 +3,19 @@
 // as the tablet would (tools/src/lcm_client.cpp): poses, status, the tile
 // index and the tile segments of the current session, asking for what it
 // lacks like `adit download` does. It keeps the latest status, the path and
-// the map (protocol::TileAssembler), and publishes what changed as events:
+// the map (protocol::TileAssembler), the live 2D grid (protocol::GridMosaic),
+// and publishes what changed as events:
 //   pose     every pose, with the console's receive time (for the latency)
 //   status   every status (2 Hz)
 //   tiles    the tiles completed at a new version, at most every 250 ms
+//   grid     the grid changed (its version), at most every 500 ms
 //   session  the payload's session changed (the browser clears its map)
 //   link     the payload stopped answering (no status for 2 s) or came back
 
 #include <atomic>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -21,8 +24,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "adit/protocol/grid_mosaic.hpp"
 #include "adit/protocol/tile_assembler.hpp"
 #include "console_events.hpp"
+#include "console_grid.hpp"
 #include "lcm_client.hpp"
 
 namespace adit::tools::console {
@@ -53,6 +58,9 @@ class LiveFeed {
   // Tile `id` for a browser that holds it at `held_version` (0 = nothing):
   // only the segments changed since when the console knows them.
   std::optional<TileBytes> tile(std::int64_t id, std::int32_t held_version, int every) const;
+  // The current session's grid as a PNG (encoded once per version, when a
+  // browser asks), or null when no patch is held.
+  std::shared_ptr<const GridBytes> grid() const;
 
  private:
   void run();
@@ -60,7 +68,8 @@ class LiveFeed {
   void on_status(const status_t& s);
   void on_index(const tile_index_t& m);
   void on_segment(const tile_segment_t& m);
-  void tick();  // requests, throttled tile events, the link watch
+  void on_grid(const grid_patch_t& m);
+  void tick();  // requests, throttled tile and grid events, the link watch
   void switch_session(const std::string& session);  // under mutex_
 
   ClientOptions options_;
@@ -85,6 +94,18 @@ class LiveFeed {
   std::int64_t last_tiles_event_ms_ = 0;
   bool index_received_ = false;  // the full index of session_ came (else asked for again every 2 s)
   bool link_up_ = false;
+
+  protocol::GridMosaic grid_;
+  // The grid's version: the sum of its patches' versions. Patch versions only
+  // grow within a session, so this grows with every change, and any console
+  // holding the same patches gives the same number (a browser that reconnects
+  // to a restarted console, which holds fewer patches at first, fetches the
+  // grid again only once this number passes the one it holds).
+  std::int64_t grid_version_ = 0;
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> grid_patch_versions_;
+  bool grid_changed_ = false;  // not yet announced
+  std::int64_t last_grid_event_ms_ = 0;
+  mutable std::shared_ptr<const GridBytes> grid_png_;  // the last one encoded
 
   std::unique_ptr<LcmClient> client_;  // used by the feed's thread only (request_tiles)
   std::thread thread_;

@@ -16,6 +16,7 @@
 #include "console_downloads.hpp"
 #include "console_events.hpp"
 #include "console_feed.hpp"
+#include "console_grid.hpp"
 #include "console_sessions.hpp"
 
 namespace adit::tools::console {
@@ -211,6 +212,32 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
     res.set_header("X-Tile-Points", std::to_string(tile->n_points));
     res.set_header("Cache-Control", "no-store");
     res.set_content(tile->body, "application/octet-stream");
+  });
+
+  // The live 2D grid as one PNG (console_grid.hpp) and where it lies: the
+  // page fetches it when a `grid` event or the snapshot names another version.
+  server.Get("/api/grid", [&](const httplib::Request&, httplib::Response& res) {
+    std::shared_ptr<const GridBytes> grid;
+    try {
+      grid = feed.grid();
+    } catch (const std::runtime_error& e) {
+      reply_error(res, 500, e.what());
+      return;
+    }
+    if (!grid) {
+      reply_error(res, 404, "no grid held: the payload has sent no grid patch for this session");
+      return;
+    }
+    res.set_header("X-Grid-Session", grid->session);
+    res.set_header("X-Grid-Version", std::to_string(grid->version));
+    res.set_header("X-Grid-Patches", std::to_string(grid->patches));
+    res.set_header("X-Grid-Resolution", fmt::format("{}", grid->resolution_m));
+    res.set_header("X-Grid-Origin-X", fmt::format("{}", grid->origin_x));
+    res.set_header("X-Grid-Origin-Y", fmt::format("{}", grid->origin_y));
+    res.set_header("X-Grid-Width", std::to_string(grid->width));
+    res.set_header("X-Grid-Height", std::to_string(grid->height));
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(grid->png, "image/png");
   });
 
   server.Post("/api/unlock", [&](const httplib::Request& req, httplib::Response& res) {

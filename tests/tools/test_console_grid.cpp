@@ -1,0 +1,273 @@
+// adit console's live 2D grid end to end: the daemon's LCM endpoint sends
+// grid patches (as aditd's mapping thread does) over real LCM on loopback,
+// `adit console` runs as a child process, and the test reads what a browser
+// reads: GET /api/grid (a PNG and where it lies), the snapshot and the event
+// stream. The PNG is decoded here with libpng's own reader, independently of
+// the console's encoder, and compared cell for cell with what was sent.
+#include <gtest/gtest.h>
+
+#include <httplib.h>
+#include <png.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "adit/daemon/lcm_endpoint.hpp"
+#include "daemon_process.hpp"
+#include "run_program.hpp"
+#include "shared_data.hpp"
+#include "temp_file.hpp"
+
+namespace adit {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr int kCells = 32;  // cells per patch side
+constexpr float kResolution = 0.1F;
+
+// A patch with a diagonal wall, free cells below it, one free cell that tells
+// the patches (and the grid's rows and columns) apart, and unknown elsewhere
+// (the protocol's values: -1, 0 and 100 only).
+std::vector<std::int8_t> patch_cells(int x, int y) {
+  std::vector<std::int8_t> cells(kCells * kCells, -1);
+  for (int row = 0; row < kCells; ++row)
+    for (int col = 0; col < kCells; ++col) {
+      if (col == row) cells[static_cast<std::size_t>(row * kCells + col)] = 100;
+      if (col < row && col > row - 6) cells[static_cast<std::size_t>(row * kCells + col)] = 0;
+    }
+  cells[static_cast<std::size_t>((x + 4) * kCells + (y + 20))] = 0;  // row x + 4, column y + 20 (unknown else): a mark
+  return cells;
+}
+
+// A payload's LCM endpoint and `adit console` following it.
+struct Harness {
+  std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 17) % 30000);
+  std::string payload = fmt::format("console-grid-{}", ::getpid());
+  int port = 30000 + ::getpid() % 10000;
+  test::TempFolder folder;
+  std::unique_ptr<daemon::LcmEndpoint> endpoint;
+  std::unique_ptr<test::Daemon> console;
+  int sessions = 0;
+
+  Harness() {
+    daemon::EndpointOptions o;
+    o.lcm_url = url;
+    o.payload_id = payload;
+    o.grid_period_s = 0.2;
+    o.grid_refresh_s = 2.0;
+    daemon::SessionHooks hooks;
+    hooks.start = [this] { return fmt::format("s{}", ++sessions); };
+    hooks.stop = [] {};
+    endpoint = std::make_unique<daemon::LcmEndpoint>(o, hooks);
+    std::filesystem::create_directories(folder.path() / "web");
+    const auto adit = (test::binary_dir() / "bin" / "adit").string();
+    console = std::make_unique<test::Daemon>(
+        std::vector<std::string>{adit, "console", "--payload", payload, "--lcm-url", url, "--listen",
+                                 fmt::format("127.0.0.1:{}", port), "--data-dir", (folder.path() / "data").string(),
+                                 "--web-dir", (folder.path() / "web").string(), "--three-dir",
+                                 (folder.path() / "web").string()},
+        folder.path() / "console.log");
+  }
+
+  httplib::Client http() const {
+    httplib::Client c("127.0.0.1", port);
+    c.set_read_timeout(5, 0);
+    return c;
+  }
+
+  bool console_listens() const {
+    for (int i = 0; i < 100; ++i) {
+      if (auto r = http().Get("/api/config"); r && r->status == 200) return true;
+      std::this_thread::sleep_for(100ms);
+    }
+    return false;
+  }
+
+  test::ProgramResult adit(const std::string& verb) const {
+    return test::run_program({(test::binary_dir() / "bin" / "adit").string(), verb, "--payload", payload,
+                              "--lcm-url", url, "--timeout", "5"});
+  }
+
+  void publish(int x, int y, int version, std::vector<std::int8_t> cells) const {
+    ASSERT_TRUE(endpoint->publish_grid(
+        daemon::GridPatchUpdate{1, x, y, version, 6, kResolution, kCells, std::move(cells)}));
+  }
+
+  // GET /api/grid once it answers with `patches` patches at `version` or more.
+  httplib::Result grid_when(std::size_t patches, std::int64_t version) const {
+    for (int i = 0; i < 100; ++i) {
+      auto r = http().Get("/api/grid");
+      if (r && r->status == 200 && std::stoul(r->get_header_value("X-Grid-Patches")) == patches &&
+          std::stoll(r->get_header_value("X-Grid-Version")) >= version)
+        return r;
+      std::this_thread::sleep_for(100ms);
+    }
+    return http().Get("/api/grid");
+  }
+
+  nlohmann::json state() const {
+    const auto r = http().Get("/api/state");
+    return r && r->status == 200 ? nlohmann::json::parse(r->body) : nlohmann::json();
+  }
+};
+
+// libpng's reader on the console's PNG: the cells in grid order (row 0 the
+// lowest y, as grid_patch_t), by the mapping docs/CONSOLE.md gives.
+struct Decoded {
+  int width = 0, height = 0;
+  std::vector<std::int8_t> cells;
+  std::string error;
+  std::int8_t at(int col, int row) const { return cells[static_cast<std::size_t>(row * width + col)]; }
+};
+
+Decoded decode(const std::string& png) {
+  Decoded out;
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_memory(&image, png.data(), png.size()) == 0) {
+    out.error = image.message;
+    return out;
+  }
+  image.format = PNG_FORMAT_GA;
+  std::vector<std::uint8_t> pixels(PNG_IMAGE_SIZE(image));
+  if (png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr) == 0) {
+    out.error = image.message;
+    return out;
+  }
+  out.width = static_cast<int>(image.width);
+  out.height = static_cast<int>(image.height);
+  out.cells.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height));
+  for (int row = 0; row < out.height; ++row)
+    for (int col = 0; col < out.width; ++col) {
+      // The image's top row is the grid's last (the highest y).
+      const std::size_t p = 2 * (static_cast<std::size_t>(out.height - 1 - row) * out.width + col);
+      out.cells[static_cast<std::size_t>(row * out.width + col)] =
+          pixels[p + 1] == 0 ? std::int8_t{-1} : static_cast<std::int8_t>(std::lround((255 - pixels[p]) / 2.55));
+    }
+  return out;
+}
+
+// The patches (x -1..1, y 0..1) as the grid's cells, for the comparison.
+void expect_cells(const Decoded& grid, int x, int y, const std::vector<std::int8_t>& cells) {
+  const int col0 = (x + 1) * kCells, row0 = y * kCells;
+  int wrong = 0;
+  for (int row = 0; row < kCells; ++row)
+    for (int col = 0; col < kCells; ++col) {
+      const int served = grid.at(col0 + col, row0 + row);
+      const int sent = cells[static_cast<std::size_t>(row * kCells + col)];
+      if (served != sent && ++wrong <= 3)
+        ADD_FAILURE() << fmt::format("patch ({}, {}) cell (col {}, row {}): {} served, {} sent", x, y, col, row, served,
+                                     sent);
+    }
+  EXPECT_EQ(wrong, 0) << "patch (" << x << ", " << y << ")";
+}
+
+// A browser's event stream until an event named `name` whose data holds `text` (or 8 s).
+std::string wait_for_event(const Harness& h, const std::string& name, const std::string& text) {
+  std::string seen;
+  const auto start = std::chrono::steady_clock::now();
+  h.http().Get("/api/events", [&](const char* data, std::size_t length) {
+    seen.append(data, length);
+    for (std::size_t at = seen.find("event: " + name + "\n"); at != std::string::npos;
+         at = seen.find("event: " + name + "\n", at + 1)) {
+      const std::size_t end = seen.find("\n\n", at);
+      if (end != std::string::npos && seen.substr(at, end - at).find(text) != std::string::npos) return false;
+    }
+    return std::chrono::steady_clock::now() - start < 8s;
+  });
+  return seen;
+}
+
+TEST(ConsoleGrid, ThePayloadsGridIsServedAtApiGridCellForCellAndEachChangeIsAnnounced) {
+  Harness h;
+  ASSERT_TRUE(h.console_listens()) << "adit console did not listen on " << h.port;
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  {
+    const auto none = h.http().Get("/api/grid");
+    ASSERT_TRUE(none);
+    EXPECT_EQ(none->status, 404) << "no patch yet: no grid";
+  }
+  for (int x = -1; x <= 1; ++x)
+    for (int y = 0; y <= 1; ++y) h.publish(x, y, 1, patch_cells(x, y));
+
+  const auto r = h.grid_when(6, 6);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+  EXPECT_EQ(r->get_header_value("X-Grid-Session"), "s1");
+  EXPECT_EQ(r->get_header_value("X-Grid-Patches"), "6");
+  EXPECT_EQ(r->get_header_value("X-Grid-Version"), "6") << "the sum of the patches' versions";
+  EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Resolution")), 0.1, 1e-9);
+  EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-X")), -3.2, 1e-6);  // patch x -1: -1 · 32 · 0.1 m
+  EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-Y")), 0.0, 1e-9);
+  EXPECT_EQ(r->get_header_value("X-Grid-Width"), "96");
+  EXPECT_EQ(r->get_header_value("X-Grid-Height"), "64");
+  const Decoded grid = decode(r->body);
+  ASSERT_EQ(grid.error, "");
+  ASSERT_EQ(grid.width, 3 * kCells);
+  ASSERT_EQ(grid.height, 2 * kCells);
+  for (int x = -1; x <= 1; ++x)
+    for (int y = 0; y <= 1; ++y) expect_cells(grid, x, y, patch_cells(x, y));
+  EXPECT_LT(r->body.size(), 2000U) << "compressed: " << 96 * 64 << " cells";
+
+  // The snapshot names the grid's version; a patch that changes is announced
+  // on the event stream and served at the new version.
+  EXPECT_EQ(h.state()["grid"], (nlohmann::json{{"v", 6}, {"patches", 6}}));
+  std::vector<std::int8_t> changed = patch_cells(0, 1);
+  for (int col = 0; col < kCells; ++col) changed[static_cast<std::size_t>(10 * kCells + col)] = 100;  // a wall across
+  std::thread later([&] {
+    std::this_thread::sleep_for(300ms);  // once the stream below is open
+    h.publish(0, 1, 3, changed);
+  });
+  const std::string events = wait_for_event(h, "grid", R"("v":8)");
+  later.join();
+  EXPECT_NE(events.find(R"("session":"s1","v":8)"), std::string::npos) << events;
+  const auto r2 = h.grid_when(6, 8);
+  ASSERT_TRUE(r2);
+  EXPECT_EQ(r2->get_header_value("X-Grid-Version"), "8");
+  const Decoded grid2 = decode(r2->body);
+  ASSERT_EQ(grid2.width, 3 * kCells);
+  expect_cells(grid2, 0, 1, changed);
+  expect_cells(grid2, 1, 1, patch_cells(1, 1));
+  EXPECT_EQ(h.console->stop(), 0);
+}
+
+TEST(ConsoleGrid, ANewSessionStartsAnEmptyGrid) {
+  Harness h;
+  ASSERT_TRUE(h.console_listens()) << "adit console did not listen on " << h.port;
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.publish(0, 0, 1, patch_cells(0, 0));
+  const auto first = h.grid_when(1, 1);
+  ASSERT_TRUE(first);
+  ASSERT_EQ(first->status, 200);
+  EXPECT_EQ(first->get_header_value("X-Grid-Session"), "s1");
+
+  ASSERT_EQ(h.adit("stop").exit_status, 0);
+  h.endpoint->session_stopped();
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.endpoint->publish_status(daemon::StatusSample{});  // the payload's status names session s2
+  for (int i = 0; i < 50 && h.state()["session"] != "s2"; ++i) std::this_thread::sleep_for(100ms);
+  ASSERT_EQ(h.state()["session"], "s2");
+  EXPECT_TRUE(h.state()["grid"].is_null()) << "s1's grid is not shown for s2";
+  const auto none = h.http().Get("/api/grid");
+  ASSERT_TRUE(none);
+  EXPECT_EQ(none->status, 404);
+
+  h.publish(2, -1, 4, patch_cells(2, -1));
+  const auto r = h.grid_when(1, 4);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200);
+  EXPECT_EQ(r->get_header_value("X-Grid-Session"), "s2");
+  EXPECT_EQ(r->get_header_value("X-Grid-Version"), "4");
+  EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-X")), 6.4, 1e-6);
+  EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-Y")), -3.2, 1e-6);
+  EXPECT_EQ(decode(r->body).width, kCells);
+}
+
+}  // namespace
+}  // namespace adit
