@@ -18,7 +18,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import assert from 'node:assert/strict';
 import { setTimeout as sleep } from 'node:timers/promises';
-import { adit, launchBrowser, mapCoverage, processUsage, quantile, requireBrowser, servedGrid, simulatedSession,
+import { adit, launchBrowser, mapCoverage, mapPixelShare, processUsage, quantile, requireBrowser, servedGrid, simulatedSession,
          startConsole, startPayload, waitFor } from './harness.mjs';
 
 const build = path.resolve(process.argv[2] || 'build');
@@ -209,20 +209,7 @@ try {
     (served.height * served.resolution).toFixed(0)} m`);
   // In the top view the grid is drawn over the points (pixels of exactly the
   // free cells' colour); its button hides it.
-  const freeShare = () => page.evaluate(() => {
-    const src = document.getElementById('map');
-    const c = document.createElement('canvas');
-    c.width = src.width;
-    c.height = src.height;
-    const g = c.getContext('2d');
-    g.drawImage(src, 0, 0);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    const free = window.adit.view.grid.freeColour;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4)
-      if (Math.abs(d[i] - free[0]) + Math.abs(d[i + 1] - free[1]) + Math.abs(d[i + 2] - free[2]) <= 6) ++n;
-    return n / (c.width * c.height);
-  });
+  const freeShare = async () => mapPixelShare(page, await page.evaluate(() => window.adit.view.grid.freeColour));
   await page.click('#camera-modes button[data-mode="top"]');
   await sleep(1000);
   figures.grid_free_share_top = await freeShare();

@@ -134,10 +134,12 @@ export function processUsage(pid) {
   return { cpu_s: ticks / 100, rss_kb: kb('VmRSS'), hwm_kb: kb('VmHWM') };
 }
 
-// Share of the map canvas's pixels that differ from the background colour
-// (read in the page: the WebGL canvas keeps its drawing buffer).
-export async function mapCoverage(page) {
-  return page.evaluate(() => {
+// Share of the map canvas's pixels (read in the page: the WebGL canvas keeps
+// its drawing buffer) within `within` (sum of |r|, |g|, |b| differences) of
+// `colour`, or with `colour` null, farther than 30 from the background (a
+// corner: the clear colour).
+export async function mapPixelShare(page, colour = null, within = 6) {
+  return page.evaluate(([colour, within]) => {
     const src = document.getElementById('map');
     const c = document.createElement('canvas');
     c.width = src.width;
@@ -145,12 +147,19 @@ export async function mapCoverage(page) {
     const g = c.getContext('2d');
     g.drawImage(src, 0, 0);
     const d = g.getImageData(0, 0, c.width, c.height).data;
-    const bg = [d[0], d[1], d[2]];  // a corner: the clear colour
+    const ref = colour ?? [d[0], d[1], d[2]];
     let n = 0;
-    for (let i = 0; i < d.length; i += 4)
-      if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 30) ++n;
+    for (let i = 0; i < d.length; i += 4) {
+      const diff = Math.abs(d[i] - ref[0]) + Math.abs(d[i + 1] - ref[1]) + Math.abs(d[i + 2] - ref[2]);
+      if (colour ? diff <= within : diff > 30) ++n;
+    }
     return n / (c.width * c.height);
-  });
+  }, [colour, within]);
+}
+
+// Share of the map canvas's pixels that differ from the background colour.
+export async function mapCoverage(page) {
+  return mapPixelShare(page);
 }
 
 // GET /api/grid read here, apart from the page's decoder: the PNG's chunks,
