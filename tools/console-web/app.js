@@ -108,17 +108,28 @@ async function fetchTile(id) {
 // Its version (the sum of its patches' versions) only grows within a session,
 // and is the same for the same grid in any console: a restarted console that
 // holds less of it so far is not fetched from until it has caught up.
+// At most one fetch per kGridIntervalMs: each new grid is a texture upload,
+// which in software rendering delays the frame it lands in (docs/CONSOLE.md).
+const kGridIntervalMs = 3000;
 let gridWanted = 0;  // the newest version announced and not fetched since
 let gridFetching = false;
+let gridLastFetch = -Infinity;  // performance.now() of the last fetch
+let gridTimer = null;
 function wantGrid(g) {
   if (!g || g.v <= view.gridVersion()) return;
   gridWanted = g.v;
   pumpGrid();
 }
 async function pumpGrid() {
-  if (gridFetching || gridWanted === 0) return;
+  if (gridFetching || gridWanted === 0 || gridTimer !== null) return;
+  const wait = gridLastFetch + kGridIntervalMs - performance.now();
+  if (wait > 0) {
+    gridTimer = setTimeout(() => { gridTimer = null; pumpGrid(); }, wait);
+    return;
+  }
   const wanted = gridWanted;
   gridFetching = true;
+  gridLastFetch = performance.now();
   try {
     const grid = await fetchGrid();  // null: not held (a new session without a patch yet)
     if (grid && grid.v > view.gridVersion() && (!mapSession || grid.session === mapSession)) showGrid(grid);
@@ -140,6 +151,7 @@ function showGrid(grid) {
 }
 function clearGrid() {
   gridWanted = 0;
+  gridLastFetch = -Infinity;  // a new session's first grid at once
   el('grid-toggle').hidden = true;
   el('grid-text').hidden = true;
 }
