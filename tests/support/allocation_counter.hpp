@@ -6,17 +6,10 @@
 
 #include <cstdint>
 
+#include "sanitizers.hpp"
+
 // Sanitizers bring their own operator new; counting is done in plain builds only.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define ADIT_COUNTING_ALLOCATIONS 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define ADIT_COUNTING_ALLOCATIONS 0
-#endif
-#endif
-#ifndef ADIT_COUNTING_ALLOCATIONS
-#define ADIT_COUNTING_ALLOCATIONS 1
-#endif
+#define ADIT_COUNTING_ALLOCATIONS (!ADIT_SANITIZED)
 
 namespace adit::test {
 

@@ -15,6 +15,7 @@
 
 #include "daemon_process.hpp"
 #include "run_program.hpp"
+#include "sanitizers.hpp"
 #include "shared_data.hpp"
 
 namespace {
@@ -142,7 +143,11 @@ TEST_F(Replay, AMissingOrCorruptCaptureIsNamedWithStatus2) {
 }
 
 TEST_F(Replay, BenchPipelineReceivesTheWholeCaptureOverLoopback) {
-  const CommandRun run = adit("bench pipeline" + config() + " --speed 4 --json");
+  // 4x the sensor's rate; 1x in a sanitizer build, whose pipeline cannot keep
+  // 4x on two cores (CI under ASan: 25 of 109 scans dropped, 0.34x reached, and
+  // once a datagram lost on loopback with none overflowing the socket).
+  const std::string speed = adit::test::kSanitized ? "1" : "4";
+  const CommandRun run = adit("bench pipeline" + config() + " --speed " + speed + " --json");
   ASSERT_EQ(run.status, 0) << run.output;
   const nlohmann::json j = json_of(run);
   ASSERT_TRUE(j.is_object()) << run.output;
