@@ -133,9 +133,9 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
 
 // summary.json's "grid_live": the live 2D grid as the tablet had it, written
 // as grid_live.pgm / .yaml (null without grid.enabled).
-nlohmann::json live_grid_summary(const slam::LiveGrid* grid, std::uintmax_t file_bytes, std::vector<double> insert_ms) {
+nlohmann::json live_grid_summary(const slam::LiveGrid* grid, double resolution_m, std::uintmax_t file_bytes,
+                                 const std::vector<double>& insert_ms) {
   if (grid == nullptr) return nullptr;
-  const double resolution_m = std::round(static_cast<double>(grid->config().resolution_m) * 1e6) / 1e6;  // a float
   return {{"patches", grid->patch_count()}, {"resolution_m", resolution_m},
           {"scans", grid->counts().scans}, {"memory_bytes", grid->memory_bytes()}, {"file_bytes", file_bytes},
           {"insert_ms_median", quantile(insert_ms, 0.5)}, {"insert_ms_p99", quantile(insert_ms, 0.99)}};
@@ -474,7 +474,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"spilled_keyframes", s.spilled_keyframes.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
-        {"grid_live", live_grid_summary(pipeline->grid(), grid_bytes, t.grid_ms)},
+        {"grid_live", live_grid_summary(pipeline->grid(), config_.grid.resolution_m, grid_bytes, t.grid_ms)},
         {"timing", {{"odometry_ms_median", quantile(t.odometry_ms, 0.5)},
                     {"odometry_ms_p99", quantile(t.odometry_ms, 0.99)},
                     {"latency_ms_p99", quantile(t.latency_ms, 0.99)},

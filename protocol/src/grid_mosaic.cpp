@@ -17,6 +17,14 @@ std::string GridMosaic::accept(const grid_patch_t& patch) {
     ++counts_.refused;
     return problem;
   }
+  // A refresh of a version held: nothing to decode.
+  if (patch.session_id == session_id_) {
+    const auto held = patches_.find({patch.patch_x, patch.patch_y});
+    if (held != patches_.end() && patch.version <= held->second.version) {
+      ++counts_.stale;
+      return {};
+    }
+  }
   std::vector<std::int8_t> cells(static_cast<std::size_t>(patch.patch_cells) * static_cast<std::size_t>(patch.patch_cells));
   if (const std::string problem = decode_grid_cells(patch.data, cells); !problem.empty()) {
     ++counts_.refused;
@@ -29,7 +37,10 @@ std::string GridMosaic::accept(const grid_patch_t& patch) {
 std::string GridMosaic::put(const std::string& session_id, float resolution_m, std::int32_t patch_cells,
                             std::int32_t x, std::int32_t y, std::int32_t version, std::vector<std::int8_t> cells) {
   if (session_id != session_id_ || patches_.empty()) {
-    if (session_id != session_id_) patches_.clear();
+    if (session_id != session_id_) {
+      patches_.clear();
+      version_sum_ = 0;
+    }
     session_id_ = session_id;
     resolution_m_ = resolution_m;
     patch_cells_ = patch_cells;
@@ -49,6 +60,7 @@ std::string GridMosaic::put(const std::string& session_id, float resolution_m, s
     ++counts_.stale;
     return {};
   }
+  version_sum_ += version - held.version;
   held = {version, std::move(cells)};
   ++counts_.accepted;
   return {};

@@ -179,7 +179,7 @@ std::vector<GridPatchCoord> LiveGrid::take_changed() {
     if (!p.changed) continue;
     p.changed = false;
     ++p.version;
-    changed.push_back({static_cast<std::int32_t>(k >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(k))});
+    changed.push_back(coord_of(k));
   }
   std::sort(changed.begin(), changed.end());
   return changed;
@@ -188,8 +188,7 @@ std::vector<GridPatchCoord> LiveGrid::take_changed() {
 std::vector<GridPatchCoord> LiveGrid::patch_coords() const {
   std::vector<GridPatchCoord> coords;
   coords.reserve(patches_.size());
-  for (const auto& [k, p] : patches_)
-    coords.push_back({static_cast<std::int32_t>(k >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(k))});
+  for (const auto& [k, p] : patches_) coords.push_back(coord_of(k));
   std::sort(coords.begin(), coords.end());
   return coords;
 }

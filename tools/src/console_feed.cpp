@@ -105,8 +105,6 @@ void LiveFeed::switch_session(const std::string& session) {
   path_.clear();
   index_received_ = false;
   grid_ = {};
-  grid_version_ = 0;
-  grid_patch_versions_.clear();
   grid_changed_ = false;
   grid_png_.reset();
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
@@ -189,9 +187,6 @@ void LiveFeed::on_grid(const grid_patch_t& m) {
     return;
   }
   if (grid_.counts().accepted == accepted) return;  // a refresh of a version held
-  std::int32_t& held = grid_patch_versions_[{m.patch_x, m.patch_y}];
-  grid_version_ += m.version - held;
-  held = m.version;
   grid_changed_ = true;
 }
 
@@ -230,7 +225,7 @@ void LiveFeed::tick() {
     if (grid_changed_ && now - last_grid_event_ms_ >= kGridEventEveryMs) {
       grid_changed_ = false;
       last_grid_event_ms_ = now;
-      grid_event = nlohmann::json{{"session", session_}, {"v", grid_version_}, {"patches", grid_.patch_count()}}.dump();
+      grid_event = nlohmann::json{{"session", session_}, {"v", grid_.version_sum()}, {"patches", grid_.patch_count()}}.dump();
     }
   }
   if (link_lost)
@@ -263,7 +258,7 @@ nlohmann::json LiveFeed::snapshot() const {
           {"map_points", points},
           {"grid", grid_.patch_count() == 0
                        ? nlohmann::json()
-                       : nlohmann::json{{"v", grid_version_}, {"patches", grid_.patch_count()}}}};
+                       : nlohmann::json{{"v", grid_.version_sum()}, {"patches", grid_.patch_count()}}}};
 }
 
 std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_version, int every) const {
@@ -315,10 +310,10 @@ std::shared_ptr<const GridBytes> LiveFeed::grid() const {
   {
     const std::lock_guard lock(mutex_);
     if (grid_.patch_count() == 0) return nullptr;
-    if (grid_png_ && grid_png_->session == session_ && grid_png_->version == grid_version_) return grid_png_;
+    if (grid_png_ && grid_png_->session == session_ && grid_png_->version == grid_.version_sum()) return grid_png_;
     image = grid_.image();
     out.session = session_;
-    out.version = grid_version_;
+    out.version = grid_.version_sum();
     out.patches = grid_.patch_count();
   }
   // Encoded without the lock: the feed's thread goes on receiving meanwhile.

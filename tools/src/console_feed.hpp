@@ -96,13 +96,9 @@ class LiveFeed {
   bool link_up_ = false;
 
   protocol::GridMosaic grid_;
-  // The grid's version: the sum of its patches' versions. Patch versions only
-  // grow within a session, so this grows with every change, and any console
-  // holding the same patches gives the same number (a browser that reconnects
-  // to a restarted console, which holds fewer patches at first, fetches the
-  // grid again only once this number passes the one it holds).
-  std::int64_t grid_version_ = 0;
-  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> grid_patch_versions_;
+  // The grid's version is grid_.version_sum(): a browser that reconnects to
+  // a restarted console, which holds fewer patches at first, fetches the grid
+  // again only once that number passes the one it holds.
   bool grid_changed_ = false;  // not yet announced
   std::int64_t last_grid_event_ms_ = 0;
   mutable std::shared_ptr<const GridBytes> grid_png_;  // the last one encoded

@@ -43,6 +43,9 @@ class GridMosaic {
   GridImage image() const;
   const std::string& session_id() const { return session_id_; }
   std::size_t patch_count() const { return patches_.size(); }
+  // The sum of the patches' versions: it grows with every change within a
+  // session, and any copy holding the same patches gives the same number.
+  std::int64_t version_sum() const { return version_sum_; }
   const GridMosaicCounts& counts() const { return counts_; }
 
  private:
@@ -54,6 +57,7 @@ class GridMosaic {
   float resolution_m_ = 0.0F;
   std::int32_t patch_cells_ = 0;
   std::map<std::pair<std::int32_t, std::int32_t>, Patch> patches_;
+  std::int64_t version_sum_ = 0;
   GridMosaicCounts counts_;
 };
 

@@ -103,6 +103,9 @@ class LiveGrid {
   static std::int64_t key(GridPatchCoord c) {
     return (static_cast<std::int64_t>(c.x) << 32) ^ static_cast<std::uint32_t>(c.y);
   }
+  static GridPatchCoord coord_of(std::int64_t key) {
+    return {static_cast<std::int32_t>(key >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(key))};
+  }
   Patch& patch_at(GridPatchCoord c);
   // Updates a cell of `p` once this scan; false when it was updated already.
   bool update(Patch& p, std::size_t cell, std::int16_t delta);
