@@ -116,7 +116,12 @@ let gridFetching = false;
 let gridLastFetch = -Infinity;  // performance.now() of the last fetch
 let gridTimer = null;
 function wantGrid(g) {
-  if (!g || g.v <= view.gridVersion()) return;
+  // None held, or none newer than the page's (a restarted console catching
+  // up): a fetch still waiting out the interval is dropped, not sent to a 404.
+  if (!g || g.v <= view.gridVersion()) {
+    gridWanted = 0;
+    return;
+  }
   gridWanted = g.v;
   pumpGrid();
 }
