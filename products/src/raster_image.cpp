@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <memory>
+#include <fstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
-#include <png.h>
 
 #include "adit/common/error.hpp"
+#include "adit/products/png_encoder.hpp"
 
 namespace adit::products {
 namespace {
@@ -84,32 +84,20 @@ int RasterImage::text(int x, int y, std::string_view s, Rgb c, int scale) {
 }
 
 std::uintmax_t RasterImage::write_png(const std::filesystem::path& file) const {
-  struct Closer {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
-  std::unique_ptr<std::FILE, Closer> out(std::fopen(file.c_str(), "wb"));
+  std::string bytes;
+  try {
+    bytes = encode_png({width_, height_, PngPixels::rgb}, [this](int y, std::span<std::uint8_t> row) {
+      std::copy_n(rgb_.data() + static_cast<std::size_t>(y) * row.size(), row.size(), row.data());
+    });
+  } catch (const std::runtime_error& e) {
+    throw InputError(file.string(), "", e.what());
+  }
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(file.string(), "", "cannot open for writing");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  if (png == nullptr || info == nullptr) {
-    png_destroy_write_struct(&png, &info);
-    throw InputError(file.string(), "", "libpng could not start");
-  }
-  // libpng reports errors by longjmp: nothing with a destructor lives between here and the end.
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    throw InputError(file.string(), "", "write failed");
-  }
-  png_init_io(png, out.get());
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width_), static_cast<png_uint_32>(height_), 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < height_; ++y)
-    png_write_row(png, const_cast<png_bytep>(rgb_.data() + static_cast<std::size_t>(y) * width_ * 3));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  out.reset();
-  return std::filesystem::file_size(file);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) throw InputError(file.string(), "", "write failed");
+  return bytes.size();
 }
 
 Rgb viridis(double t) {
