@@ -15,6 +15,15 @@ constexpr float kTwoPi = 6.283185307179586F;
 // atan2 within 1e-5 rad (a minimax polynomial for atan on [-1, 1], octants
 // by symmetry): the columns are 3e-3 rad wide, and libm's atan2 would be most
 // of the time of a pass that projects every map point into every scan.
+// A cell's index along one axis, and its key: 21 bits an axis (±2,097 km at
+// 2 m), x most significant, so the cells of one (x, y) column are contiguous
+// in key order, lowest z first.
+std::int64_t cell_index(float v) { return static_cast<std::int64_t>(std::floor(v / SeeThroughCounter::kCell)); }
+std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
+  const auto c = [](std::int64_t i) { return static_cast<std::uint64_t>(i + (1 << 20)) & 0x1FFFFF; };
+  return (c(x) << 42) | (c(y) << 21) | c(z);
+}
+
 inline __attribute__((always_inline)) float fast_atan2(float y, float x) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float big = std::max(ax, ay);
@@ -123,13 +132,8 @@ SeeThroughCounter::SeeThroughCounter(std::span<const Eigen::Vector3f> map_points
   if (!candidate.empty() && candidate.size() != map_points.size())
     throw InputError("see-through", "", "the candidate flags do not match the map points");
   // The candidates grouped by cell (sorted by the cell's key), so that a scan
-  // skips whole cells out of its range and walks memory in order.
-  const auto key = [](const Eigen::Vector3f& p) {
-    const auto c = [](float v) {
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / kCell)) + (1 << 20)) & 0x1FFFFF;
-    };
-    return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
-  };
+  // visits only the cells within its range and walks memory in order.
+  const auto key = [](const Eigen::Vector3f& p) { return cell_key(cell_index(p.x()), cell_index(p.y()), cell_index(p.z())); };
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   keyed.reserve(map_points.size());
   for (std::size_t i = 0; i < map_points.size(); ++i)
@@ -141,6 +145,7 @@ SeeThroughCounter::SeeThroughCounter(std::span<const Eigen::Vector3f> map_points
     const Eigen::Vector3f& p = map_points[keyed[k].second];
     if (k == 0 || keyed[k].first != keyed[k - 1].first) {
       cells_.push_back({p, p, static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k)});
+      cell_keys_.push_back(keyed[k].first);
     }
     Cell& c = cells_.back();
     c.low = c.low.cwiseMin(p);
@@ -166,7 +171,20 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
   const auto tolerance = static_cast<float>(options_.seen_tolerance_m);
   const int last_pose = static_cast<int>(poses.map_to_sensor.size()) - 1;
   const float inverse_step = poses.step_s > 0.0F ? 1.0F / poses.step_s : 0.0F;
-  for (const Cell& cell : cells_) {
+  // The cells within the range's box: per (x, y) column, the span of keys
+  // from its lowest z to its highest (a cell outside the box is out of range).
+  const float reach = static_cast<float>(options_.max_range_m);
+  const std::int64_t z_low = cell_index(centre.z() - reach), z_high = cell_index(centre.z() + reach);
+  in_range_.clear();
+  for (std::int64_t x = cell_index(centre.x() - reach); x <= cell_index(centre.x() + reach); ++x)
+    for (std::int64_t y = cell_index(centre.y() - reach); y <= cell_index(centre.y() + reach); ++y) {
+      const std::uint64_t last = cell_key(x, y, z_high);
+      for (auto it = std::lower_bound(cell_keys_.begin(), cell_keys_.end(), cell_key(x, y, z_low));
+           it != cell_keys_.end() && *it <= last; ++it)
+        in_range_.push_back(static_cast<std::uint32_t>(it - cell_keys_.begin()));
+    }
+  for (const std::uint32_t c : in_range_) {
+    const Cell& cell = cells_[c];
     // The nearest and farthest distances of the cell's box from the sensor.
     const Eigen::Vector3f near = centre.cwiseMax(cell.low).cwiseMin(cell.high) - centre;
     const Eigen::Vector3f far = (centre - cell.low).cwiseAbs().cwiseMax((cell.high - centre).cwiseAbs());

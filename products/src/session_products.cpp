@@ -22,6 +22,8 @@ namespace {
 double thread_cpu_s() { return 1e-9 * static_cast<double>(thread_cpu_ns()); }
 
 nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
+  nlohmann::json cpu_by_step = nlohmann::json::object();
+  for (const auto& [step, s] : r.cpu_by_step) cpu_by_step[step] = s;
   nlohmann::json files = nlohmann::json::array();
   if (!r.map_static_file.empty()) files.insert(files.end(), {r.map_static_file, "moving_points.ply"});
   files.push_back("occupancy.bt");
@@ -47,7 +49,8 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
                         {"width_at_m", o.sections.width_at_m}}},
           {"targets", {{"found", r.targets}, {"note", r.targets_note}}},
           {"files", files},
-          {"cpu_s", r.cpu_s}};
+          {"cpu_s", r.cpu_s},
+          {"cpu_by_step_s", cpu_by_step}};
 }
 
 // summary.json gains "products"; written beside and renamed, so a reader
@@ -103,12 +106,20 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   };
   const double cpu0 = thread_cpu_s();
   ProductsReport r;
+  // Each step's CPU time, from the end of the one before.
+  double lap0 = cpu0;
+  const auto lap = [&r, &lap0](const char* step) {
+    const double now = thread_cpu_s();
+    r.cpu_by_step.emplace_back(step, now - lap0);
+    lap0 = now;
+  };
   r.out_dir = out_dir.empty() ? session_dir / "products" : out_dir;
   SessionInputs inputs = read_session_inputs(session_dir);
   const std::filesystem::path map_file = map_file_of(session_dir);
   r.points_file = map_file.filename().string();
   r.points_bytes = std::filesystem::file_size(map_file);
   std::filesystem::create_directories(r.out_dir);
+  lap("read_map");
   check_cancel();
   {
     const double moving0 = thread_cpu_s();
@@ -127,19 +138,23 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
       protocol::write_map(r.out_dir / "moving_points.ply", protocol::MapFormat::ply, moving.removed_points);
     }
   }
+  lap("moving_objects");
   const SessionMap map = rays_from(inputs.points, inputs.body_poses, inputs.body_to_sensor, options.rays);
   r.without_ray = map.without_ray;
   r.points = map.points.size();
+  lap("rays_to_path");
   check_cancel();
 
   const GroundSegmentation ground = segment_ground(map.points, options.ground);
   r.ground_points = ground.ground_points;
+  lap("ground");
   check_cancel();
   std::vector<std::uint8_t> non_ground(map.points.size());
   for (std::size_t i = 0; i < non_ground.size(); ++i) non_ground[i] = ground.is_ground[i] ? 0 : 1;
   const std::vector<std::uint8_t> kept = statistical_inliers(map.points, non_ground, options.outliers);
   r.outliers_removed = static_cast<std::size_t>(std::count(non_ground.begin(), non_ground.end(), 1) -
                                                 std::count(kept.begin(), kept.end(), 1));
+  lap("outliers");
 
   // Rays in batches of one viewpoint (OctoMap counts a voxel once per batch).
   std::vector<std::size_t> order;
@@ -164,10 +179,13 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
     occupancy.insert(map.viewpoints[static_cast<std::size_t>(map.origin[order[begin]])], hits, passes);
     begin = end;
   }
+  lap("octree");
   Grid2d grid = project_to_grid(occupancy, map.points, kept, ground.is_ground, ground.model,
                                 {options.grid_resolution_m, options.band_low_m, options.band_high_m});
+  lap("grid");
   if (options.line_of_sight_fill)
     r.grid_filled = fill_line_of_sight(grid, map.viewpoints, options.fill_range_m, options.fill_step_m);
+  lap("grid_fill");
   check_cancel();
   r.grid_occupied = grid.count(kOccupied);
   r.grid_free = grid.count(kFree);
@@ -177,6 +195,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   if (options.write_ot) r.ot_bytes = occupancy.write_ot(r.out_dir / "occupancy.ot");
   r.bt_bytes = occupancy.write_bt(r.out_dir / "occupancy.bt");
   r.leaves = occupancy.leaf_count();
+  lap("write_grid_and_octree");
   // Targets by intensity (target_finder.hpp); a map without intensities has none to find.
   std::vector<Eigen::Vector3d> target_centres;
   if (std::any_of(map.intensities.begin(), map.intensities.end(), [](float i) { return i > 0.0F; })) {
@@ -187,9 +206,11 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   } else {
     r.targets_note = "the map has no intensities: targets cannot be found";
   }
+  lap("targets");
   r.top_view_bytes = write_top_view(r.out_dir / "top_view.png", map.points, ground.model, map.sensor_path, target_centres,
                                     options.top_view)
                          .bytes;
+  lap("top_view");
   const std::vector<CrossSection> sections = cut_sections(map.points, map.sensor_path, options.sections);
   std::filesystem::create_directories(r.out_dir / "sections");
   for (const CrossSection& c : sections) {
@@ -198,6 +219,7 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   }
   r.sections = sections.size();
   write_sections_csv(r.out_dir / "sections" / "sections.csv", sections);
+  lap("sections");
   r.cpu_s = thread_cpu_s() - cpu0;
   const nlohmann::json json = report_json(r, options);
   {

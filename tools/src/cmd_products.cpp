@@ -40,6 +40,7 @@ void run_products(const ProductsCommand& c) {
   fmt::print("pictures          top_view.png ({}), {} cross-sections ({} measured) every {} m in sections/\n",
              kib(r.top_view_bytes), r.sections, r.sections_measured, c.options.sections.interval_m);
   fmt::print("cpu               {:.2f} s\n", r.cpu_s);
+  for (const auto& [step, s] : r.cpu_by_step) fmt::print("  {:<24}{:.2f} s\n", step, s);
 }
 
 }  // namespace

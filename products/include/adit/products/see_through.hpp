@@ -126,6 +126,8 @@ class SeeThroughCounter {
   std::vector<Eigen::Vector3f> sorted_;  // the candidates, cell by cell (scans visit the cells in range)
   std::vector<std::uint32_t> index_;     // each sorted point's index in the map
   std::vector<Cell> cells_;
+  std::vector<std::uint64_t> cell_keys_;  // each cell's key, ascending: a scan looks up only the cells in its range
+  std::vector<std::uint32_t> in_range_;   // add_scan's: the cells within its range
   SeeThroughOptions options_;
   std::vector<std::uint16_t> through_;
   std::vector<std::uint16_t> seen_;

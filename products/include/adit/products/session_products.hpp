@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "adit/products/cross_sections.hpp"
 #include "adit/products/ground.hpp"
@@ -75,6 +77,7 @@ struct ProductsReport {
   std::size_t targets = 0;          // found by intensity (targets.csv)
   std::string targets_note;         // why none were looked for ("" when they were)
   double cpu_s = 0.0;               // this thread's CPU time for all of it
+  std::vector<std::pair<std::string, double>> cpu_by_step;  // of cpu_s, each step's, in order (s)
   std::filesystem::path out_dir;
 };
 
