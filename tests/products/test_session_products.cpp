@@ -73,6 +73,19 @@ TEST(SessionProducts, CorridorGridHasWallsFreeFloorAndUnknownBeyond) {
   EXPECT_EQ(s["products"]["bytes"]["octree_bt"], r.bt_bytes);
   EXPECT_EQ(s["products"]["bytes"]["grid"], r.grid_bytes);
   EXPECT_EQ(r.bt_bytes, std::filesystem::file_size(dir / "products" / "occupancy.bt"));
+  // Each step's CPU time, in order, adding up to the whole (less what runs after the last lap).
+  const nlohmann::json& steps = s["products"]["cpu_by_step_s"];
+  ASSERT_EQ(steps.size(), r.cpu_by_step.size());
+  double sum = 0.0;
+  for (const auto& [step, seconds] : r.cpu_by_step) {
+    EXPECT_GE(seconds, 0.0) << step;
+    EXPECT_EQ(steps[step], seconds) << step;
+    sum += seconds;
+  }
+  for (const char* step : {"read_map", "moving_objects", "rays_to_path", "octree", "grid", "top_view", "sections"})
+    EXPECT_TRUE(steps.contains(step)) << step;
+  EXPECT_LE(sum, r.cpu_s + 1e-9);
+  EXPECT_GE(sum, 0.5 * r.cpu_s);
 }
 
 TEST(SessionProducts, FinerGridAndOtherFolder) {
