@@ -18,20 +18,20 @@ MovingObjectsReport remove_moving_objects(const std::filesystem::path& session_d
   std::vector<std::uint8_t> candidate(points.size(), 1);
   for (std::size_t i = 0; i < keep.size() && i < candidate.size(); ++i) candidate[i] = keep[i] ? 0 : 1;
   for (const std::uint8_t c : candidate) r.candidates += c;
-  const auto pass = [&](const std::vector<std::uint8_t>& tested, int scan_step, SessionScanStats& stats) {
-    SeeThroughCounter counter(points, tested, options);
+  const auto pass = [&](const std::vector<std::uint8_t>& tested, int scan_step, bool retire, SessionScanStats& stats) {
+    SeeThroughCounter counter(points, tested, options, retire);
     stats = for_each_session_scan(session_dir, inputs.body_poses, inputs.body_to_sensor, scan_step,
                                   [&](const RangeImage& image, const ScanPoses& poses) { counter.add_scan(image, poses); });
     return counter;
   };
   SessionScanStats stats;
   if (options.coarse_step > 0) {
-    const SeeThroughCounter coarse = pass(candidate, options.coarse_step, stats);
+    const SeeThroughCounter coarse = pass(candidate, options.coarse_step, true, stats);
     for (std::size_t i = 0; i < candidate.size(); ++i) candidate[i] = coarse.through(i) > 0 ? 1 : 0;
     for (const std::uint8_t c : candidate) r.suspects += c;
   }
   const std::vector<std::uint8_t> dynamic =
-      stats.skipped_because.empty() ? pass(candidate, options.scan_step, stats).dynamic() : std::vector<std::uint8_t>{};
+      stats.skipped_because.empty() ? pass(candidate, options.scan_step, false, stats).dynamic() : std::vector<std::uint8_t>{};
   r.scans = stats.scans;
   r.scans_used = stats.used;
   if (!stats.skipped_because.empty() || stats.used == 0) {

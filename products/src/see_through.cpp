@@ -127,8 +127,14 @@ int RangeImage::row_below(float e) const {
 }
 
 SeeThroughCounter::SeeThroughCounter(std::span<const Eigen::Vector3f> map_points, std::span<const std::uint8_t> candidate,
-                                     const SeeThroughOptions& options)
-    : size_(map_points.size()), options_(options), through_(map_points.size(), 0), seen_(map_points.size(), 0) {
+                                     const SeeThroughOptions& options, bool retire)
+    : size_(map_points.size()),
+      options_(options),
+      retire_after_seen_(retire ? static_cast<std::uint16_t>(std::clamp(options.coarse_retire_after_seen, 0, 65535)) : 0),
+      retire_after_scans_(static_cast<std::size_t>(std::max(options.coarse_retire_after_scans, 0))),
+      through_(map_points.size(), 0),
+      seen_(map_points.size(), 0) {
+  if (retire_after_seen_ > 0) first_seen_.assign(map_points.size(), 0);
   if (!candidate.empty() && candidate.size() != map_points.size())
     throw InputError("see-through", "", "the candidate flags do not match the map points");
   // The candidates grouped by cell (sorted by the cell's key), so that a scan
@@ -192,6 +198,9 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
     for (std::uint32_t s = cell.begin; s < cell.end; ++s) {
     const Eigen::Vector3f& p = sorted_[s];
     const std::size_t i = index_[s];
+    if (retire_after_seen_ > 0 && through_[i] == 0 && seen_[i] >= retire_after_seen_ &&
+        scans_ - first_seen_[i] >= retire_after_scans_)
+      continue;
     const float d2 = (p - centre).squaredNorm();
     if (d2 < min2 || d2 > max2) continue;
     // The sensor's pose when this azimuth was fired.
@@ -237,6 +246,7 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
     if (!known) continue;  // a bin without a return says nothing
     if (seen) {
       if (seen_[i] < std::numeric_limits<std::uint16_t>::max()) ++seen_[i];
+      if (!first_seen_.empty() && first_seen_[i] == 0) first_seen_[i] = static_cast<std::uint32_t>(scans_);
     } else if (nearest > range + std::max(margin, fraction * range)) {
       if (through_[i] < std::numeric_limits<std::uint16_t>::max()) ++through_[i];
     }

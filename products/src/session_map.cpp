@@ -28,6 +28,9 @@ std::int64_t floor_index(float v) {
   return static_cast<std::int64_t>(std::clamp(std::floor(static_cast<double>(v)), -4e18, 4e18));
 }
 
+constexpr int kFixedBits = 16;  // the line-of-sight walk's fixed point: 1/65536 of a voxel
+constexpr double kFixedOne = 1 << kFixedBits;
+
 VoxelIndex voxel_of(const Eigen::Vector3f& p, float inv_voxel) {
   return {floor_index(p.x() * inv_voxel), floor_index(p.y() * inv_voxel), floor_index(p.z() * inv_voxel)};
 }
@@ -62,14 +65,24 @@ SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::
   const float inv_voxel = static_cast<float>(1.0 / o.voxel_m);
   VoxelBrickSet occupied(m.points.size());
   for (const Eigen::Vector3f& p : m.points) occupied.insert(voxel_of(p, inv_voxel));
+  // Samples every half voxel from `from` towards `to`, up to end_clearance_m
+  // short of it, walked in fixed point (voxels × 2^16): each sample adds one
+  // step and its voxel is a shift, floor for negative values too.
+  const double to_fixed = kFixedOne / o.voxel_m;
   const auto visible = [&](const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
-    const Eigen::Vector3f d = to - from;
-    const float length = d.norm();
-    const float step = static_cast<float>(o.voxel_m) / 2;
-    const float stop = length - static_cast<float>(o.end_clearance_m);
+    const Eigen::Vector3d d = (to - from).cast<double>();
+    const double length = d.norm();
+    const double step = o.voxel_m / 2;
+    const double stop = length - o.end_clearance_m;
+    if (!(stop > step)) return true;
+    const Eigen::Vector3d first = (from.cast<double>() + d * (step / length)) * to_fixed;
+    const Eigen::Vector3d delta = d * (step / length * to_fixed);
+    std::int64_t x = std::llround(first.x()), y = std::llround(first.y()), z = std::llround(first.z());
+    const std::int64_t dx = std::llround(delta.x()), dy = std::llround(delta.y()), dz = std::llround(delta.z());
+    const auto samples = static_cast<std::int64_t>(std::ceil((stop - step) / step));
     VoxelBrickSet::BrickReader reader(occupied);
-    for (float t = step; t < stop; t += step)
-      if (reader.contains(voxel_of(from + d * (t / length), inv_voxel))) return false;
+    for (std::int64_t k = 0; k < samples; ++k, x += dx, y += dy, z += dz)
+      if (reader.contains({x >> kFixedBits, y >> kFixedBits, z >> kFixedBits})) return false;
     return true;
   };
 

@@ -26,6 +26,47 @@ std::filesystem::path calibration_of(const std::filesystem::path& session_dir, c
   return p;  // the decoder names it in its error
 }
 
+// Every step-th scan without decoding the others. Once the scan period P is
+// known (the median gap between the capture times at which the first
+// complete scans came out), decoding starts again 0.3 P before the next
+// wanted scan's start: the partial scan before it is incomplete and skipped,
+// the wanted one is whole, and when it comes out the datagrams are skipped
+// again up to the next window. Each whole scan re-anchors the next window, so
+// a motor's slow drift in speed does not carry the windows off the scans; a
+// gap in the recording only means decoding on until a whole scan comes out.
+// step 1: everything.
+class ScanWindows {
+ public:
+  explicit ScanWindows(std::size_t step) : step_(static_cast<std::int64_t>(step)) {}
+  bool period_known() const { return period_ns_ > 0; }
+
+  void scan_completed(std::int64_t capture_ns) {
+    if (step_ <= 1) return;
+    if (period_ns_ == 0) {
+      if (last_ns_ > 0 && capture_ns > last_ns_) gaps_.push_back(capture_ns - last_ns_);
+      if (gaps_.size() == kCalibrationScans) {
+        std::nth_element(gaps_.begin(), gaps_.begin() + kCalibrationScans / 2, gaps_.end());
+        period_ns_ = gaps_[kCalibrationScans / 2];
+      }
+    }
+    last_ns_ = capture_ns;  // the first datagram after this scan's end: the next scan's start
+  }
+
+  bool wanted(std::int64_t capture_ns) const {
+    if (period_ns_ == 0) return true;
+    const std::int64_t start = last_ns_ + (step_ - 1) * period_ns_;  // the wanted scan's start
+    const std::int64_t margin = 3 * period_ns_ / 10;
+    return capture_ns >= start - margin;
+  }
+
+ private:
+  static constexpr std::size_t kCalibrationScans = 5;
+  std::int64_t step_;
+  std::int64_t period_ns_ = 0;
+  std::int64_t last_ns_ = 0;
+  std::vector<std::int64_t> gaps_;
+};
+
 }  // namespace
 
 SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir, const slam::Trajectory& body_poses,
@@ -59,9 +100,16 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
   std::optional<RangeImage> image;  // sized by the first complete scan
   ScanPoses poses;
   poses.map_to_sensor.resize(kPosesPerScan);
+  const auto step = static_cast<std::size_t>(std::max(scan_step, 1));
+  ScanWindows windows(step);
+  std::int64_t now_ns = 0;  // the capture time of the datagram being decoded
   drivers::DecodeStream stream(*decoder, assembler, [&](drivers::LidarScan& scan) {
     if (!scan.stats.complete || scan.points.empty()) return;
     const std::size_t index = stats.scans++;
+    // Counted by scan until the windows know the period, by window after.
+    const bool counted = windows.period_known();
+    windows.scan_completed(now_ns);
+    if (!counted && index % step != 0) return;
     if (!image) {
       // Rings from the data; columns: a little coarser than the firings of a
       // ring, so that each bin holds a return (an empty bin blocks the test).
@@ -74,7 +122,6 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
       const auto per_ring = static_cast<int>(scan.points.size() / static_cast<std::size_t>(rings));
       image.emplace(rings, std::clamp(per_ring * 2 / 3, 64, 8192));
     }
-    if (index % static_cast<std::size_t>(std::max(scan_step, 1)) != 0) return;
     std::uint32_t span_ns = 0;
     for (const drivers::LidarPoint& p : scan.points) span_ns = std::max(span_ns, p.time_offset_ns);
     const double t0 = 1e-9 * static_cast<double>(scan.start_time_ns);
@@ -94,8 +141,20 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
   });
   drivers::PcapReader reader(pcap);
   drivers::UdpDatagram d;
-  while (reader.next(d) && stats.skipped_because.empty())
-    if (d.dst_port == port) stream.push(d.payload, d.capture_time_ns);
+  bool decoding = true;
+  while (reader.next(d) && stats.skipped_because.empty()) {
+    if (d.dst_port != port) continue;
+    if (!windows.wanted(d.capture_time_ns)) {
+      // The scan begun after the wanted one is cut off: emitted now as
+      // incomplete, so that it does not join the next window's datagrams.
+      if (decoding) stream.finish();
+      decoding = false;
+      continue;
+    }
+    decoding = true;
+    now_ns = d.capture_time_ns;
+    stream.push(d.payload, d.capture_time_ns);
+  }
   stream.finish();
   return stats;
 }

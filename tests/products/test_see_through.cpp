@@ -180,6 +180,38 @@ TEST(SeeThrough, PersonWhoStaysIsKept) {
       << o.person_removed << " of " << o.person;
 }
 
+TEST(SeeThrough, ARetiringCounterStopsTestingWhatItSawStillFindsWhoLeft) {
+  // The coarse pass's counter: a point seen 8 times, first 40 scans ago or
+  // more, and never seen through is tested no more. The person of
+  // PersonWhoLeftIsRemoved stood for 10 scans: seen more than 8 times, but
+  // over too short a span to retire before leaving and being seen through.
+  const Drive d = drive(60, Person{{12.0, 0.5}, 1.0}, 0.02);
+  SeeThroughOptions options;
+  options.coarse_retire_after_seen = 8;
+  options.coarse_retire_after_scans = 40;
+  SeeThroughCounter all(d.map, {}, options);
+  SeeThroughCounter retiring(d.map, {}, options, true);
+  for (const auto& [image, poses] : d.scans) {
+    all.add_scan(image, poses);
+    retiring.add_scan(image, poses);
+  }
+  std::size_t person = 0, person_through = 0, retired = 0, through_differs = 0;
+  for (std::size_t i = 0; i < d.map.size(); ++i) {
+    EXPECT_LE(retiring.seen(i), all.seen(i)) << i;
+    if (retiring.seen(i) < all.seen(i)) ++retired;
+    if (d.on_person[i]) {
+      ++person;
+      person_through += retiring.through(i) > 0;
+    }
+    through_differs += (all.through(i) > 0) != (retiring.through(i) > 0);
+  }
+  ASSERT_GT(person, 100u);
+  EXPECT_GE(static_cast<double>(person_through), 0.95 * static_cast<double>(person)) << person_through << " of " << person;
+  EXPECT_GT(retired, d.map.size() / 4);  // most of the corridor is seen often: retired
+  // Whether a point was seen through at all (what makes a suspect) hardly changes.
+  EXPECT_LT(static_cast<double>(through_differs), 0.01 * static_cast<double>(d.map.size())) << through_differs;
+}
+
 TEST(SeeThrough, ExcludedPointsAreNeverRemoved) {
   const Drive d = drive(40, Person{{6.0, 0.0}, 1.0}, 0.0);
   std::vector<std::uint8_t> candidate(d.map.size(), 0);  // none may go

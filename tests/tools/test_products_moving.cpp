@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +14,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/products/session_map.hpp"
+#include "adit/products/session_scans.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
@@ -74,6 +77,28 @@ TEST(ProductsMovingObjects, PeopleWhoWalkedPastLeaveTheMap) {
   // The points removed are the map's: kept + removed = the session's map.
   EXPECT_EQ(s["people_points"].get<std::size_t>() + s["static_points"].get<std::size_t>(),
             json_file(session / "summary.json")["map"]["points"].get<std::size_t>());
+
+  // The coarse pass's every 16th scan, decoded in windows: each one a scan of
+  // the full decode (the same sensor pose at its start, to the bit), about a
+  // sixteenth of them, and far fewer scans decoded.
+  {
+    const adit::products::SessionInputs inputs = adit::products::read_session_inputs(session);
+    std::vector<Eigen::Matrix4f> every;
+    const auto all = adit::products::for_each_session_scan(
+        session, inputs.body_poses, inputs.body_to_sensor, 1,
+        [&](const adit::products::RangeImage&, const adit::products::ScanPoses& p) { every.push_back(p.map_to_sensor[0].matrix()); });
+    std::size_t matched = 0;
+    const auto some = adit::products::for_each_session_scan(
+        session, inputs.body_poses, inputs.body_to_sensor, 16,
+        [&](const adit::products::RangeImage&, const adit::products::ScanPoses& p) {
+          matched += std::count(every.begin(), every.end(), p.map_to_sensor[0].matrix()) == 1;
+        });
+    ASSERT_GT(all.used, 64u);
+    EXPECT_EQ(matched, some.used);
+    EXPECT_GE(some.used, all.used / 16 - 1);
+    EXPECT_LE(some.used, all.used / 16 + 2);
+    EXPECT_LT(some.scans, all.scans / 4);  // complete scans decoded: the wanted ones, the five that find the period
+  }
 
   // Turned off: nothing removed, said so; without a recording: said so, the rest still made.
   const CommandRun kept = adit("products " + session.string() + " --keep-moving --out " + (work / "k").string());
