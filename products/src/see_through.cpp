@@ -12,9 +12,6 @@ namespace {
 
 constexpr float kTwoPi = 6.283185307179586F;
 
-// atan2 within 1e-5 rad (a minimax polynomial for atan on [-1, 1], octants
-// by symmetry): the columns are 3e-3 rad wide, and libm's atan2 would be most
-// of the time of a pass that projects every map point into every scan.
 // A cell's index along one axis, and its key: 21 bits an axis (±2,097 km at
 // 2 m), x most significant, so the cells of one (x, y) column are contiguous
 // in key order, lowest z first.
@@ -24,6 +21,9 @@ std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
   return (c(x) << 42) | (c(y) << 21) | c(z);
 }
 
+// atan2 within 1e-5 rad (a minimax polynomial for atan on [-1, 1], octants
+// by symmetry): the columns are 3e-3 rad wide, and libm's atan2 would be most
+// of the time of a pass that projects every map point into every scan.
 inline __attribute__((always_inline)) float fast_atan2(float y, float x) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float big = std::max(ax, ay);

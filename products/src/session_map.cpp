@@ -18,20 +18,11 @@
 namespace adit::products {
 namespace {
 
-// floor(v): for |v| < 2^20 (±105 km at 0.1 m) a truncation of v + 2^20 in
-// double, exact (a float has 24 significant bits, the sum keeps them all in
-// 53) and a third of the time of std::floor, which an x86-64 build without
-// SSE4.1 emulates; beyond, std::floor, clamped where an int64 would overflow.
-std::int64_t floor_index(float v) {
-  constexpr float kFast = 1 << 20;
-  if (v > -kFast && v < kFast) return static_cast<std::int64_t>(static_cast<double>(v) + kFast) - (1 << 20);
-  return static_cast<std::int64_t>(std::clamp(std::floor(static_cast<double>(v)), -4e18, 4e18));
-}
-
 constexpr int kFixedBits = 16;  // the line-of-sight walk's fixed point: 1/65536 of a voxel
 constexpr double kFixedOne = 1 << kFixedBits;
 
 VoxelIndex voxel_of(const Eigen::Vector3f& p, float inv_voxel) {
+  const auto floor_index = [](float v) { return static_cast<std::int64_t>(std::floor(v)); };
   return {floor_index(p.x() * inv_voxel), floor_index(p.y() * inv_voxel), floor_index(p.z() * inv_voxel)};
 }
 

@@ -38,11 +38,14 @@ std::filesystem::path calibration_of(const std::filesystem::path& session_dir, c
 class ScanWindows {
  public:
   explicit ScanWindows(std::size_t step) : step_(static_cast<std::int64_t>(step)) {}
-  bool period_known() const { return period_ns_ > 0; }
 
-  void scan_completed(std::int64_t capture_ns) {
-    if (step_ <= 1) return;
-    if (period_ns_ == 0) {
+  // A complete scan came out at `capture_ns`: whether it is one of the
+  // wanted (every step-th by count until the period is known, then the one
+  // each window holds).
+  bool take(std::int64_t capture_ns) {
+    const bool wanted = period_ns_ > 0 || complete_ % step_ == 0;
+    ++complete_;
+    if (period_ns_ == 0 && step_ > 1) {
       if (last_ns_ > 0 && capture_ns > last_ns_) gaps_.push_back(capture_ns - last_ns_);
       if (gaps_.size() == kCalibrationScans) {
         std::nth_element(gaps_.begin(), gaps_.begin() + kCalibrationScans / 2, gaps_.end());
@@ -50,9 +53,11 @@ class ScanWindows {
       }
     }
     last_ns_ = capture_ns;  // the first datagram after this scan's end: the next scan's start
+    return wanted;
   }
 
-  bool wanted(std::int64_t capture_ns) const {
+  // Whether a datagram captured at `capture_ns` is decoded.
+  bool decode(std::int64_t capture_ns) const {
     if (period_ns_ == 0) return true;
     const std::int64_t start = last_ns_ + (step_ - 1) * period_ns_;  // the wanted scan's start
     const std::int64_t margin = 3 * period_ns_ / 10;
@@ -62,6 +67,7 @@ class ScanWindows {
  private:
   static constexpr std::size_t kCalibrationScans = 5;
   std::int64_t step_;
+  std::int64_t complete_ = 0;
   std::int64_t period_ns_ = 0;
   std::int64_t last_ns_ = 0;
   std::vector<std::int64_t> gaps_;
@@ -100,16 +106,12 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
   std::optional<RangeImage> image;  // sized by the first complete scan
   ScanPoses poses;
   poses.map_to_sensor.resize(kPosesPerScan);
-  const auto step = static_cast<std::size_t>(std::max(scan_step, 1));
-  ScanWindows windows(step);
+  ScanWindows windows(static_cast<std::size_t>(std::max(scan_step, 1)));
   std::int64_t now_ns = 0;  // the capture time of the datagram being decoded
   drivers::DecodeStream stream(*decoder, assembler, [&](drivers::LidarScan& scan) {
     if (!scan.stats.complete || scan.points.empty()) return;
-    const std::size_t index = stats.scans++;
-    // Counted by scan until the windows know the period, by window after.
-    const bool counted = windows.period_known();
-    windows.scan_completed(now_ns);
-    if (!counted && index % step != 0) return;
+    ++stats.scans;
+    if (!windows.take(now_ns)) return;
     if (!image) {
       // Rings from the data; columns: a little coarser than the firings of a
       // ring, so that each bin holds a return (an empty bin blocks the test).
@@ -144,7 +146,7 @@ SessionScanStats for_each_session_scan(const std::filesystem::path& session_dir,
   bool decoding = true;
   while (reader.next(d) && stats.skipped_because.empty()) {
     if (d.dst_port != port) continue;
-    if (!windows.wanted(d.capture_time_ns)) {
+    if (!windows.decode(d.capture_time_ns)) {
       // The scan begun after the wanted one is cut off: emitted now as
       // incomplete, so that it does not join the next window's datagrams.
       if (decoding) stream.finish();
