@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "adit/common/log.hpp"
+#include "adit/products/session_join_files.hpp"
 #include "adit/products/session_products.hpp"
 
 namespace adit::daemon {
@@ -26,7 +27,7 @@ void lower_priority() {
 
 }  // namespace
 
-ProductsWorker::ProductsWorker() : thread_([this] { run(); }) {}
+ProductsWorker::ProductsWorker(AfterSessionSteps steps) : steps_(steps), thread_([this] { run(); }) {}
 
 ProductsWorker::~ProductsWorker() { stop(); }
 
@@ -75,6 +76,11 @@ std::size_t ProductsWorker::cancelled() const {
   return cancelled_;
 }
 
+std::size_t ProductsWorker::joined() const {
+  const std::lock_guard lock(mutex_);
+  return joined_;
+}
+
 std::size_t ProductsWorker::failed() const {
   const std::lock_guard lock(mutex_);
   return failed_;
@@ -93,35 +99,60 @@ void ProductsWorker::run() {
       queue_.pop_front();
       busy_ = true;
     }
-    enum class Outcome { made, failed, cancelled } outcome = Outcome::failed;
-    const std::filesystem::path partial = dir / "products.partial";
-    const std::filesystem::path done = dir / "products";
-    try {
-      std::filesystem::remove_all(partial);  // a run cut short before
-      products::ProductsOptions options;
-      options.cancel = &cancel_;
-      const products::ProductsReport r = products::write_session_products(dir, options, partial);
-      std::filesystem::remove_all(done);
-      std::filesystem::rename(partial, done);
-      log::info("session {}: products in {} ({:.1f} s of CPU; {} targets{})", dir.filename().string(), done.string(),
-                r.cpu_s, r.targets, r.targets_note.empty() ? "" : "; " + r.targets_note);
-      outcome = Outcome::made;
-    } catch (const products::Cancelled&) {
-      log::warn("session {}: products cancelled at shutdown (`adit products` makes them)", dir.filename().string());
-      outcome = Outcome::cancelled;
-      std::error_code ec;
-      std::filesystem::remove_all(partial, ec);
-    } catch (const std::exception& e) {
-      log::error("session {}: products failed: {}", dir.filename().string(), e.what());
-      std::error_code ec;
-      std::filesystem::remove_all(partial, ec);
-    }
+    if (steps_.products) make_products(dir);
+    if (steps_.join_previous && !cancel_) join_previous(dir);
     {
       const std::lock_guard lock(mutex_);
-      (outcome == Outcome::made ? made_ : outcome == Outcome::failed ? failed_ : cancelled_) += 1;
       busy_ = false;
     }
     changed_.notify_all();
+  }
+}
+
+void ProductsWorker::make_products(const std::filesystem::path& dir) {
+  enum class Outcome { made, failed, cancelled } outcome = Outcome::failed;
+  const std::filesystem::path partial = dir / "products.partial";
+  const std::filesystem::path done = dir / "products";
+  try {
+    std::filesystem::remove_all(partial);  // a run cut short before
+    products::ProductsOptions options;
+    options.cancel = &cancel_;
+    const products::ProductsReport r = products::write_session_products(dir, options, partial);
+    std::filesystem::remove_all(done);
+    std::filesystem::rename(partial, done);
+    log::info("session {}: products in {} ({:.1f} s of CPU; {} targets{})", dir.filename().string(), done.string(),
+              r.cpu_s, r.targets, r.targets_note.empty() ? "" : "; " + r.targets_note);
+    outcome = Outcome::made;
+  } catch (const products::Cancelled&) {
+    log::warn("session {}: products cancelled at shutdown (`adit products` makes them)", dir.filename().string());
+    outcome = Outcome::cancelled;
+    std::error_code ec;
+    std::filesystem::remove_all(partial, ec);
+  } catch (const std::exception& e) {
+    log::error("session {}: products failed: {}", dir.filename().string(), e.what());
+    std::error_code ec;
+    std::filesystem::remove_all(partial, ec);
+  }
+  const std::lock_guard lock(mutex_);
+  (outcome == Outcome::made ? made_ : outcome == Outcome::failed ? failed_ : cancelled_) += 1;
+}
+
+void ProductsWorker::join_previous(const std::filesystem::path& dir) {
+  const std::string name = dir.filename().string();
+  products::JoinFilesOptions options;
+  options.config = steps_.join;
+  options.cancel = &cancel_;
+  const std::vector<products::JoinFilesReport> reports = products::join_previous_session(dir, 3, options);
+  if (reports.empty()) log::info("session {}: no earlier session with a map to join to", name);
+  for (const products::JoinFilesReport& r : reports) {
+    if (r.result.success) {
+      log::info("session {}: joined to {} ({} of {} places agree, overlap {:.2f}; {})", name, r.stored_name,
+                r.result.places_agreeing, r.result.places_tried, r.result.overlap, products::kJoinedFile);
+      const std::lock_guard lock(mutex_);
+      ++joined_;
+    } else {
+      log::info("session {}: not joined to {}: {}", name, r.stored_name, r.result.failure);
+    }
   }
 }
 

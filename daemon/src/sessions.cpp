@@ -207,7 +207,8 @@ PoseSample pose_sample_of(const slam::OdometryResult& r) {
 Sessions::Sessions(const config::Config& config, Outputs outputs)
     : config_(config), outputs_(std::move(outputs)), root_(std::filesystem::path(config.payload.state_dir) / "sessions") {
   standby_ = build_pipeline();
-  if (config_.session.products) products_ = std::make_unique<ProductsWorker>();
+  if (config_.session.products || config_.session.join_previous)
+    products_ = std::make_unique<ProductsWorker>(AfterSessionSteps{config_.session.products, config_.session.join_previous, {}});
   if (!interrupted_sessions(root_).empty()) recoverer_ = std::thread([this] { recover_interrupted(); });
 }
 
@@ -519,18 +520,28 @@ bool Sessions::running() const {
   return pipeline_ != nullptr || finishing_;
 }
 
+std::string session_notes(const std::filesystem::path& dir) {
+  std::string notes;
+  if (std::ifstream summary(dir / "summary.json"); summary) {
+    const nlohmann::json j = nlohmann::json::parse(summary, nullptr, false);
+    if (j.is_object() && j.contains("recovered")) notes += " recovered";
+  }
+  // `adit join` placed it into another session's map (docs/SESSIONS.md, Joining sessions).
+  if (std::ifstream joined(dir / "joined.json"); joined) {
+    const nlohmann::json j = nlohmann::json::parse(joined, nullptr, false);
+    if (j.is_object() && j.value("success", false) && j.contains("joined_to") && j["joined_to"].is_string())
+      notes += " joined to " + j["joined_to"].get<std::string>();
+  }
+  return notes;
+}
+
 std::vector<std::string> Sessions::list() const {
   std::vector<std::string> out;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(root_, ec))
     if (entry.is_directory()) out.push_back(entry.path().filename().string());
   std::sort(out.begin(), out.end());
-  for (std::string& id : out) {
-    std::ifstream summary(root_ / id / "summary.json");
-    if (!summary) continue;
-    const nlohmann::json j = nlohmann::json::parse(summary, nullptr, false);
-    if (j.is_object() && j.contains("recovered")) id += " recovered";
-  }
+  for (std::string& id : out) id += session_notes(root_ / id);
   return out;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Running the built `adit eval` binary from a test and capturing its output.
+// Running the built `adit` binary from a test and capturing its output.
 
 #include <sys/wait.h>
 
@@ -18,11 +18,12 @@ struct EvalRun {
   std::string output;  // stdout and stderr together
 };
 
-inline EvalRun adit_eval(const std::string& args) {
+// `adit ARGS` (ARGS quoted for the shell by the caller).
+inline EvalRun adit_command(const std::string& args) {
   // Built by appending: g++ 12 -Wrestrict misfires on chains of operator+ here.
   std::string command = "'";
   command += (binary_dir() / "bin" / "adit").string();
-  command += "' eval ";
+  command += "' ";
   command += args;
   command += " 2>&1";
   EvalRun run;
@@ -35,6 +36,8 @@ inline EvalRun adit_eval(const std::string& args) {
   run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return run;
 }
+
+inline EvalRun adit_eval(const std::string& args) { return adit_command("eval " + args); }
 
 // A file path quoted for the shell.
 inline std::string q(const TempFile& f) { return "'"s + f.path().string() + "'"; }

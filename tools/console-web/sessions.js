@@ -62,6 +62,7 @@ export class SessionsPanel {
       if (s.points !== undefined) facts.push(`${s.points.toLocaleString()} points`);
       if (s.bytes !== undefined) facts.push(bytes(s.bytes));
       if (s.loops !== undefined) facts.push(`${s.loops} loops`);
+      if (s.notes) facts.push(s.notes);
       title.lastChild.textContent = facts.join(' · ');
       const actions = document.createElement('div');
       actions.className = 'actions';

@@ -32,5 +32,7 @@ void register_targets_commands(CLI::App& app, int& status);
 // georef: a session in site coordinates from total-station control points
 void register_georef_commands(CLI::App& app, int& status);
 void register_prior_map_commands(CLI::App& app, int& status);
+// join: a session placed into a stored session's map (cmd_join.cpp)
+void register_join_commands(CLI::App& app, int& status);
 
 }  // namespace adit::tools

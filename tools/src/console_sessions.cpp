@@ -44,8 +44,13 @@ std::string scan_name_problem(const std::string& name) {
 nlohmann::json describe_sessions(const std::vector<std::string>& ids, const ScanNames& names,
                                  const std::filesystem::path& sessions_dir) {
   nlohmann::json out = nlohmann::json::array();
-  for (const std::string& id : ids) {
+  for (const std::string& line : ids) {
+    // aditd's listing: "<id>", then what it knows of it ("recovered", "joined to <id>").
+    const std::size_t space = line.find(' ');
+    const std::string id = line.substr(0, space);
+    const std::string notes = space == std::string::npos ? std::string() : line.substr(space + 1);
     nlohmann::json entry = {{"id", id}, {"name", names.get(id)}};
+    if (!notes.empty()) entry["notes"] = notes;
     if (!sessions_dir.empty()) {
       const std::filesystem::path dir = sessions_dir / id;
       std::error_code ec;

@@ -29,7 +29,8 @@ class ScanNames {
 // An operator's scan name: 1..64 printable characters, or why not.
 std::string scan_name_problem(const std::string& name);
 
-// One entry per id: id, name, and what the session's folder tells when
+// One entry per line of aditd's listing ("<id>" and its notes: "recovered",
+// "joined to <id>"): id, name, notes, and what the session's folder tells when
 // `sessions_dir` is set (points, duration_s, bytes, files, poses, loops).
 nlohmann::json describe_sessions(const std::vector<std::string>& ids, const ScanNames& names,
                                  const std::filesystem::path& sessions_dir);

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
     adit::tools::register_targets_commands(app, status);
     adit::tools::register_georef_commands(app, status);
     adit::tools::register_prior_map_commands(app, status);
+    adit::tools::register_join_commands(app, status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {

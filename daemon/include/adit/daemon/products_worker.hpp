@@ -19,6 +19,11 @@
 // the thread back to SCHED_OTHER first, when the kernel allows, so that a busy
 // machine does not keep an idle-priority thread from reaching its check.
 // Measured: 2.7-5.8 s of CPU for a 60-90 s drive (docs/PRODUCTS.md).
+//
+// With join_previous (session.join_previous), each session is then joined to
+// the newest earlier session whose map it overlaps
+// (products::join_previous_session: <session>/joined.json; cancelled between
+// places by stop()), logged either way.
 
 #include <atomic>
 #include <condition_variable>
@@ -28,12 +33,21 @@
 #include <mutex>
 #include <thread>
 
+#include "adit/slam/session_join.hpp"
+
 namespace adit::daemon {
+
+// What is made of each session queued.
+struct AfterSessionSteps {
+  bool products = true;        // products::write_session_products (session.products)
+  bool join_previous = false;  // products::join_previous_session (session.join_previous)
+  slam::SessionJoinConfig join;  // its places and checks (the defaults in aditd)
+};
 
 class ProductsWorker {
  public:
   // Products with the library's defaults (ProductsOptions{}: 5 cm grid, 10 cm octree).
-  ProductsWorker();
+  explicit ProductsWorker(AfterSessionSteps steps = {});
   ~ProductsWorker();
   ProductsWorker(const ProductsWorker&) = delete;
   ProductsWorker& operator=(const ProductsWorker&) = delete;
@@ -48,16 +62,20 @@ class ProductsWorker {
   std::size_t made() const;    // sessions whose products were written
   std::size_t failed() const;  // sessions whose products failed (logged)
   std::size_t cancelled() const;  // begun and cancelled by stop()
+  std::size_t joined() const;     // sessions joined to an earlier one
 
  private:
   void run();
+  void make_products(const std::filesystem::path& dir);
+  void join_previous(const std::filesystem::path& dir);
 
+  const AfterSessionSteps steps_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<std::filesystem::path> queue_;
   bool busy_ = false;
   bool stopping_ = false;
-  std::size_t made_ = 0, failed_ = 0, cancelled_ = 0;
+  std::size_t made_ = 0, failed_ = 0, cancelled_ = 0, joined_ = 0;
   std::atomic<bool> cancel_{false};
   std::thread thread_;  // last: started once the rest exists
 };

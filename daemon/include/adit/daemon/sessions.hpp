@@ -47,6 +47,12 @@ PoseSample pose_sample_of(const slam::OdometryResult& result);
 
 class ProductsWorker;
 
+// What the listing says of a stored session beside its id: "" or, each with
+// a leading space, "recovered" (rebuilt from its journal after a crash) and
+// "joined to <id>" (its joined.json: `adit join` placed it into that
+// session's map).
+std::string session_notes(const std::filesystem::path& dir);
+
 class Sessions {
  public:
   // `publish_pose`/`publish_tile` may be empty (no endpoint); `ended` runs on
@@ -81,8 +87,7 @@ class Sessions {
   void stop_and_wait();
 
   bool running() const;  // a pipeline exists (mapping or being finished)
-  // Sessions on disk, oldest first: "<id>", or "<id> recovered" for one
-  // rebuilt from its journal after a crash.
+  // Sessions on disk, oldest first: "<id>" and its session_notes().
   std::vector<std::string> list() const;
   std::filesystem::path folder(const std::string& id) const;
   // Fills `into` with a stored session's tiles (tiles/*.adt); "" or why not.

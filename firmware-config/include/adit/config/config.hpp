@@ -245,6 +245,11 @@ struct SessionSection {
   // 2D grid, top view, cross-sections, targets.csv) on a SCHED_IDLE thread
   // (daemon/products_worker.hpp, docs/PRODUCTS.md "In aditd").
   bool products = true;
+  // After a stop, place the session's map into the newest earlier session's
+  // map it overlaps (of the last three with a map.ply): <session>/joined.json,
+  // and `adit sessions` says "joined to <id>" (products/session_join_files.hpp,
+  // docs/LOOPS.md "Joining sessions"). About 30 s of SCHED_IDLE CPU a try.
+  bool join_previous = false;
 };
 
 // A prior map (BIM export, design model, earlier survey) prepared by

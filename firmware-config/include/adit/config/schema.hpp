@@ -240,6 +240,7 @@ void describe(V& v, SessionSection& s) {
   v.optional("journal_sync_s", s.journal_sync_s, Range<double>{0.05, 10.0});
   v.optional("keep_journal", s.keep_journal);
   v.optional("products", s.products);
+  v.optional("join_previous", s.join_previous);
 }
 
 template <typename V>
