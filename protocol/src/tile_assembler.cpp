@@ -74,17 +74,16 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
   const auto index = static_cast<std::size_t>(m.segment);
   if (tile.have[index]) return count(finish_if_complete(tile) == SegmentOutcome::completed ? SegmentOutcome::completed
                                                                                           : SegmentOutcome::duplicate);
-  std::vector<MapPoint> points;
-  if (const std::string error =
-          decode_segment(m.data, tile_key(m.tile_id), m.tile_size_m, m.quantum_m, points);
+  scratch_.clear();
+  if (const std::string error = decode_segment(m.data, tile_key(m.tile_id), m.tile_size_m, m.quantum_m, scratch_);
       !error.empty()) {
     // Not kept: it is asked for again (a datagram damaged on the way is
     // likely; a daemon serving bad bytes shows as this error repeating).
     last_error_ = fmt::format("tile {} version {} segment {}: {}", m.tile_id, m.version, m.segment, error);
     return count(SegmentOutcome::corrupt);
   }
-  for (MapPoint& p : points) p.time = static_cast<double>(m.utime) * 1e-6;
-  tile.parts[index] = std::move(points);
+  tile.parts[index] = HeldSegment{std::vector<std::uint8_t>(m.data.begin(), m.data.end()),
+                                  static_cast<std::uint32_t>(scratch_.size()), m.tile_id, m.tile_size_m, m.quantum_m, m.utime};
   tile.have[index] = true;
   return count(finish_if_complete(tile));
 }
@@ -157,10 +156,30 @@ std::optional<TileAssembler::HeldTile> TileAssembler::held(std::int64_t id) cons
 }
 
 std::vector<MapPoint> TileAssembler::points() const {
-  std::vector<MapPoint> out;
+  std::size_t n = 0;
   for (const auto& [id, tile] : tiles_)
-    for (const auto& segment : tile.segments) out.insert(out.end(), segment.begin(), segment.end());
+    for (const auto& segment : tile.segments) n += segment.points;
+  std::vector<MapPoint> out;
+  out.reserve(n);
+  for (const auto& [id, tile] : tiles_)
+    for (const auto& segment : tile.segments) segment.decode_into(out);
   return out;
+}
+
+std::size_t TileAssembler::HeldTile::points() const {
+  std::size_t n = 0;
+  for (const HeldSegment& s : segments) n += s.points;
+  return n;
+}
+
+void HeldSegment::decode_into(std::vector<MapPoint>& out) const {
+  const std::size_t first = out.size();
+  // Decoded once already, on arrival: an error here is not expected (the frame is unchanged since).
+  if (frame.empty() || !decode_segment(frame, tile_key(tile_id), tile_size_m, quantum_m, out).empty()) {
+    out.resize(first);
+    return;
+  }
+  for (std::size_t i = first; i < out.size(); ++i) out[i].time = static_cast<double>(utime) * 1e-6;
 }
 
 }  // namespace adit::protocol

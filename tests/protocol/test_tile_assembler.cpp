@@ -126,7 +126,11 @@ TEST(TileAssembler, AHeldVersionIsBroughtUpToDateByTheNewSegmentsOnly) {
   EXPECT_EQ(now->version, tile.version);
   EXPECT_EQ(now->replaced_from, 2);
   ASSERT_EQ(now->segments.size(), 5u);
-  EXPECT_EQ(now->segments[4].size(), 4500u - 4 * 1024u);
+  EXPECT_EQ(now->segments[4].points, 4500u - 4 * 1024u);
+  std::vector<MapPoint> last;
+  now->segments[4].decode_into(last);
+  EXPECT_EQ(last.size(), 4500u - 4 * 1024u);
+  EXPECT_EQ(now->points(), 4500u);
   EXPECT_FALSE(a.held(tile_id({9, 9, 9})).has_value());
 
   // A delta from a base newer than the version held cannot complete it: the

@@ -214,8 +214,7 @@ void LiveFeed::tick() {
       for (const auto& [id, version] : pending_event_) {
         const auto held = tiles_.held(id);
         std::size_t n = 0;
-        if (held)
-          for (const auto& s : held->segments) n += s.size();
+        if (held) n = held->points();
         list.push_back({{"id", std::to_string(id)}, {"v", version}, {"n", n}});
       }
       pending_event_.clear();
@@ -243,8 +242,7 @@ nlohmann::json LiveFeed::snapshot() const {
   for (const auto& [id, changes] : changes_) {
     const auto held = tiles_.held(id);
     if (!held) continue;
-    std::size_t n = 0;
-    for (const auto& s : held->segments) n += s.size();
+    const std::size_t n = held->points();
     points += n;
     tiles.push_back({{"id", std::to_string(id)}, {"v", held->version}, {"n", n}});
   }
@@ -262,35 +260,46 @@ nlohmann::json LiveFeed::snapshot() const {
 }
 
 std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_version, int every) const {
-  const std::lock_guard lock(mutex_);
-  const auto held = tiles_.held(id);
-  if (!held) return std::nullopt;
   TileBytes out;
-  out.version = held->version;
-  out.n_segments = static_cast<std::int32_t>(held->segments.size());
-  // The first segment changed after the version the browser holds, when the
-  // completions since are all known; otherwise the whole tile.
-  if (held_version > 0 && held_version <= held->version) {
-    const auto it = changes_.find(id);
-    std::int32_t from = out.n_segments;
-    std::int32_t reached = held->version;
-    if (it != changes_.end())
-      for (auto c = it->second.rbegin(); c != it->second.rend() && c->version > held_version; ++c) {
-        from = std::min(from, c->from);
-        reached = c->before;
-      }
-    out.from = reached <= held_version ? from : 0;
-    if (held_version == held->version) out.from = out.n_segments;
+  std::vector<std::uint32_t> counts;          // every segment's points
+  std::vector<protocol::HeldSegment> wanted;  // the segments from out.from on, copied (about 6 bytes a point)
+  {
+    const std::lock_guard lock(mutex_);
+    const auto held = tiles_.held(id);
+    if (!held) return std::nullopt;
+    out.version = held->version;
+    out.n_segments = static_cast<std::int32_t>(held->segments.size());
+    // The first segment changed after the version the browser holds, when the
+    // completions since are all known; otherwise the whole tile.
+    if (held_version > 0 && held_version <= held->version) {
+      const auto it = changes_.find(id);
+      std::int32_t from = out.n_segments;
+      std::int32_t reached = held->version;
+      if (it != changes_.end())
+        for (auto c = it->second.rbegin(); c != it->second.rend() && c->version > held_version; ++c) {
+          from = std::min(from, c->from);
+          reached = c->before;
+        }
+      out.from = reached <= held_version ? from : 0;
+      if (held_version == held->version) out.from = out.n_segments;
+    }
+    for (std::size_t s = 0; s < held->segments.size(); ++s) {
+      counts.push_back(held->segments[s].points);
+      if (static_cast<std::int32_t>(s) >= out.from) wanted.push_back(held->segments[s]);
+    }
   }
+  // Decoded without the lock: the feed's thread goes on with poses meanwhile.
   const auto step = static_cast<std::size_t>(std::max(1, every));
   std::size_t index = 0;  // the point's place in the tile, for an even stride across segments
-  for (std::size_t s = 0; s < held->segments.size(); ++s) {
-    const auto& segment = held->segments[s];
-    out.n_points += static_cast<std::int64_t>(segment.size());
+  std::vector<protocol::MapPoint> segment;
+  for (std::size_t s = 0; s < counts.size(); ++s) {
+    out.n_points += static_cast<std::int64_t>(counts[s]);
     if (static_cast<std::int32_t>(s) < out.from) {
-      index += segment.size();
+      index += counts[s];
       continue;
     }
+    segment.clear();
+    wanted[s - static_cast<std::size_t>(out.from)].decode_into(segment);
     const std::size_t first = (step - index % step) % step;
     const std::size_t count = first < segment.size() ? (segment.size() - first + step - 1) / step : 0;
     append_u32(out.body, static_cast<std::uint32_t>(count));
@@ -299,7 +308,7 @@ std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_versi
       append_f32(out.body, static_cast<float>(segment[i].y));
       append_f32(out.body, static_cast<float>(segment[i].z));
     }
-    index += segment.size();
+    index += counts[s];
   }
   return out;
 }
