@@ -16,11 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/common/error.hpp"
-#include "adit/eval/align.hpp"
-#include "adit/eval/associate.hpp"
-#include "adit/eval/trajectory_io.hpp"
 #include "adit/products/session_join_files.hpp"
 #include "commands.hpp"
+#include "eval_commands.hpp"
 
 namespace adit::tools {
 namespace {
@@ -35,17 +33,6 @@ struct JoinOptions {
   float radius_m = 20.0F;
   bool json = false;
 };
-
-// The world's frame from a simulated session's map frame: its trajectory fitted to its truth.
-Eigen::Isometry3d world_from_map(const slam::Trajectory& est, const std::string& truth_file) {
-  const eval::Associated a = eval::associate(eval::read_tum(truth_file), est, 0.02);
-  const auto fit = eval::align_trajectory(a.ref, a.est, eval::Alignment::se3);
-  if (!fit) throw InputError(truth_file, "", "cannot be aligned with the session's trajectory");
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = fit->rotation;
-  t.translation() = fit->translation;
-  return t;
-}
 
 int join(const JoinOptions& o) {
   const std::filesystem::path stored_dir(o.to), new_dir(o.session);
@@ -62,8 +49,10 @@ int join(const JoinOptions& o) {
   nlohmann::json j = nlohmann::json::parse(report.json);
   if (o.truth.size() == 2) {
     // Simulated sessions: the join's error against the truth of both.
-    const Eigen::Isometry3d truth = world_from_map(eval::read_tum(stored_dir / "trajectory.tum"), o.truth[0]).inverse() *
-                                    world_from_map(eval::read_tum(new_dir / "trajectory.tum"), o.truth[1]);
+    std::size_t matched = 0;
+    const Eigen::Isometry3d truth =
+        world_from_map_fitted(o.truth[0], (stored_dir / "trajectory.tum").string(), matched).inverse() *
+        world_from_map_fitted(o.truth[1], (new_dir / "trajectory.tum").string(), matched);
     const Eigen::Isometry3d e = r.stored_from_new.inverse() * truth;
     j["error"] = {{"translation_m", e.translation().norm()},
                   {"rotation_deg", Eigen::AngleAxisd(e.linear()).angle() * 180.0 / M_PI}};

@@ -109,6 +109,9 @@ std::vector<eval::Triangle> scene_triangles(const std::string& file);
 slam::Trajectory timed_trajectory(const std::string& file);
 // Where the map frame lies in the world: ref(t0) · est(t0)⁻¹ at the estimate's first stamp t0.
 Eigen::Isometry3d world_from_map(const std::string& ref_file, const std::string& est_file);
+// Where the map frame lies in the world by a rigid fit of the estimate's
+// positions to the reference's (Umeyama); `poses`: how many were matched.
+Eigen::Isometry3d world_from_map_fitted(const std::string& ref_file, const std::string& est_file, std::size_t& poses);
 nlohmann::json stats_json(const eval::Stats& stats);
 std::string stats_row(const std::string& name, const eval::Stats& stats);
 std::string stats_header();

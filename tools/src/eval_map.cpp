@@ -57,17 +57,6 @@ Eigen::Isometry3d world_from_map(const std::string& ref_file, const std::string&
   return *ref_t0 * est.poses.front().inverse();
 }
 
-namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-struct Placement {
-  Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
-  double t0 = 0.0;  // s; the estimate's first stamp when placed by its origin
-  bool by_trajectories = false;
-  std::size_t fitted_poses = 0;  // poses of the fit when placed by a rigid fit (se3)
-};
-
 // The rigid transform that best lays the estimate's positions onto the
 // reference's (Umeyama, align.hpp), as a surveyor fits a map to control
 // points: a tilt or heading error the whole map shares does not count.
@@ -85,6 +74,17 @@ Eigen::Isometry3d world_from_map_fitted(const std::string& ref_file, const std::
   t.translation() = fit->translation;
   return t;
 }
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+struct Placement {
+  Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
+  double t0 = 0.0;  // s; the estimate's first stamp when placed by its origin
+  bool by_trajectories = false;
+  std::size_t fitted_poses = 0;  // poses of the fit when placed by a rigid fit (se3)
+};
 
 Placement placement(const MapEvalOptions& o) {
   Placement p;
