@@ -195,7 +195,8 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   }
   sweep.deskewed = std::span(source_deskewed_).first(source_.size());
   const auto register_from = [&](const PosePrior& start, const SweepMotion& motion) {
-    return register_scan(source_, map_, start, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, motion);
+    return register_scan(source_, map_, start, 3.0 * sigma, sigma / 3.0, config_.registration, planes_, motion,
+                         prior_term(config_.registration.point_sigma_m));
   };
   // An alternative start replaces the registration only when it explains
   // clearly more of the scan: where the scan cannot tell, the first keeps it.
@@ -238,7 +239,7 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
                       SweepMotion turning = sweep;
                       turning.velocity(5) += yaw / dt;  // the turn made over the interval
                       return register_scan(source_, map_, start, 3.0 * wide, wide / 3.0, config_.registration, planes_,
-                                           turning);
+                                           turning, prior_term(config_.registration.point_sigma_m));
                     },
                     result.registration);
   }
@@ -330,6 +331,31 @@ OdometryResult Odometry::process(const ScanInput& scan, const std::optional<Moti
   const Eigen::Isometry3d to_body = pose_.inverse();
   start_inertial(scan, adjoint(to_body) * result.covariance * adjoint(to_body).transpose());
   return result;
+}
+
+void Odometry::anchor_to_prior(const VoxelHashMap& prior_index, const Eigen::Isometry3d& prior_from_odometry) {
+  prior_planes_.resize(planes_.size());
+  prior_map_ = {&prior_index, prior_from_odometry, 1.0, {}};
+}
+
+PriorMapTerm Odometry::prior_term(double local_sigma_m) {
+  PriorMapTerm term = prior_map_;
+  if (term.index == nullptr) return term;
+  term.planes = prior_planes_;
+  term.weight = (local_sigma_m * local_sigma_m) / (config_.prior_map_sigma_m * config_.prior_map_sigma_m);
+  return term;
+}
+
+void Odometry::release_prior() { prior_map_ = {}; }
+
+std::optional<Eigen::Isometry3d> Odometry::prior_from_odometry() const {
+  if (prior_map_.index == nullptr) return std::nullopt;
+  return prior_map_.prior_from_frame;
+}
+
+std::optional<Eigen::Vector3d> Odometry::up() const {
+  if (inertial_started_) return -inertial_.state().gravity.normalized();
+  return up_frame_;
 }
 
 void Odometry::add_deskewed_to_map() {

@@ -98,7 +98,8 @@ void Odometry::register_inertial(const ScanInput& scan, const std::optional<Moti
                                   : std::clamp(std::max(threshold_.sigma(), predicted_sigma), floor_sigma, reacquire_sigma);
   reacquire_ = false;
   const auto register_from = [&](const PosePrior& start) {
-    return register_scan(source, map_, start, 3.0 * sigma, sigma / 3.0, inertial_registration_, planes_);
+    return register_scan(source, map_, start, 3.0 * sigma, sigma / 3.0, inertial_registration_, planes_, SweepMotion{},
+                         prior_term(inertial_registration_.point_sigma_m));
   };
   result.registration = register_from(prior);
   // Moving already when the filter started, at a speed it does not know:

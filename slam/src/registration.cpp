@@ -29,39 +29,39 @@ struct NormalEquations {
   Vector12d g12 = Vector12d::Zero();
   double weight_sum = 0.0;
   double residual2_sum = 0.0;  // Σ w·r², robust-weighted
-  int count = 0;
+  int count = 0;        // points with a local-map plane
+  int prior_count = 0;  // points with a prior-map plane
 };
 
 // One pass over the points at pose T: each point's plane in the map, its
 // point-to-plane residual r = n·(T p − m), and the Jacobian for the body-frame
 // perturbation T·exp(δ): T·exp(δ)·p ≈ T(p + v + ω×p), so with n_b = Rᵀn,
 // ∂r/∂[v; ω] = [n_b; p × n_b] (p in the body frame: lever arms are ranges).
+// With a prior map, the point's plane there too, the same way through the
+// fixed prior_from_frame (PriorMapTerm), weighted by its weight.
 NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map, const Eigen::Isometry3d& T,
                       double max_distance_m, double kappa2, const RegistrationConfig& config,
-                      std::span<MapPlane> planes, bool associate, std::span<const float> times_s) {
+                      std::span<MapPlane> planes, bool associate, std::span<const float> times_s,
+                      const PriorMapTerm& prior_map) {
   NormalEquations ne;
   const bool timed = times_s.size() == points.size();
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
   const bool cached = planes.size() >= points.size();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f& p = points[i];
-    const Eigen::Vector3f q = R * p + t;
-    MapPlane local;
-    MapPlane& plane = cached ? planes[i] : local;
-    if (associate || !cached) {
-      // Three queries ahead: their slots arrive while this one is searched.
-      constexpr std::size_t kPrefetchAhead = 3;
-      if (i + kPrefetchAhead < points.size()) map.prefetch_around(R * points[i + kPrefetchAhead] + t);
-      plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
-    }
-    if (!plane.found) continue;
+  const bool with_prior = prior_map.index != nullptr;
+  const bool prior_cached = prior_map.planes.size() >= points.size();
+  const Eigen::Isometry3f A = prior_map.prior_from_frame.cast<float>();
+  const Eigen::Matrix3f prior_R = A.linear() * R;
+  const Eigen::Vector3f prior_t = A.linear() * t + A.translation();
+  // One residual into the normal equations; R_n maps the plane's frame to the body's.
+  const auto add = [&](std::size_t i, const MapPlane& plane, const Eigen::Vector3f& q, const Eigen::Matrix3f& R_n,
+                       double scale) {
     const double r = plane.normal.dot(q - plane.point);
-    if (std::abs(r) > max_distance_m) continue;
-    const Eigen::Vector3d n_b = (R.transpose() * plane.normal).cast<double>();
+    if (std::abs(r) > max_distance_m) return false;
+    const Eigen::Vector3d n_b = (R_n.transpose() * plane.normal).cast<double>();
     Vector6d J;
-    J << n_b, p.cast<double>().cross(n_b);
-    const double w = geman_mcclure_weight(r * r, kappa2);
+    J << n_b, points[i].cast<double>().cross(n_b);
+    const double w = scale * geman_mcclure_weight(r * r, kappa2);
     if (timed) {
       Vector12d J12;
       J12 << J, static_cast<double>(times_s[i]) * J;
@@ -73,7 +73,30 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
     }
     ne.weight_sum += w;
     ne.residual2_sum += w * r * r;
-    ++ne.count;
+    return true;
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    const Eigen::Vector3f q = R * p + t;
+    MapPlane local;
+    MapPlane& plane = cached ? planes[i] : local;
+    // Three queries ahead: their slots arrive while this one is searched.
+    constexpr std::size_t kPrefetchAhead = 3;
+    if (associate || !cached) {
+      if (i + kPrefetchAhead < points.size()) map.prefetch_around(R * points[i + kPrefetchAhead] + t);
+      plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
+    }
+    if (plane.found && add(i, plane, q, R, 1.0)) ++ne.count;
+    if (!with_prior) continue;
+    const Eigen::Vector3f q_prior = prior_R * p + prior_t;
+    MapPlane prior_local;
+    MapPlane& prior_plane = prior_cached ? prior_map.planes[i] : prior_local;
+    if (associate || !prior_cached) {
+      if (i + kPrefetchAhead < points.size())
+        prior_map.index->prefetch_around(prior_R * points[i + kPrefetchAhead] + prior_t);
+      prior_plane = prior_map.index->nearest_plane(q_prior, config.plane_neighbors, config.max_plane_error_m);
+    }
+    if (prior_plane.found && add(i, prior_plane, q_prior, prior_R, prior_map.weight)) ++ne.prior_count;
   }
   if (timed) {
     ne.H = ne.H12.topLeftCorner<6, 6>();
@@ -101,7 +124,7 @@ Degeneracy analyse(const NormalEquations& ne, double threshold, int min_correspo
     d.weakest << 1, 0, 0, 0, 0, 0;
     return d;
   }
-  d.degenerate = ne.count < min_correspondences;
+  d.degenerate = ne.count + ne.prior_count < min_correspondences;
   // Per unit weight: translation eigenvalues are the share of residuals that
   // watch a direction (0..1); rotation ones are that share times the squared
   // lever arm in m², i.e. displacement per radian judged at 1 m.
@@ -168,6 +191,13 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config, std::span<MapPlane> planes,
                                  const SweepMotion& sweep) {
+  return register_scan(measured, map, prior, max_distance_m, kernel_scale_m, config, planes, sweep, PriorMapTerm{});
+}
+
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes,
+                                 const SweepMotion& sweep, const PriorMapTerm& prior_map) {
   RegistrationResult result;
   // A sweep to deskew: the points are redone from `measured` whenever the velocity changes.
   const bool timed = sweep.times_s.size() == measured.size() && sweep.deskewed.size() >= measured.size();
@@ -213,7 +243,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
       associated_velocity = velocity;
     }
     ne = build(points, map, result.pose, max_distance_m, kappa * kappa, config, planes, associate,
-               estimate ? sweep.times_s : std::span<const float>{});
+               estimate ? sweep.times_s : std::span<const float>{}, prior_map);
     degeneracy = analyse(ne, config.degeneracy_threshold, config.min_plane_correspondences);
     // Prior residual in the body tangent space: e = log(mean⁻¹·T), and
     // e(T·exp(δ)) ≈ e + δ to first order.
@@ -262,6 +292,7 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> measured, cons
   }
   result.sweep_velocity = velocity;
   result.correspondences = ne.count;
+  result.prior_correspondences = ne.prior_count;
   result.inlier_ratio = points.empty() ? 0.0 : static_cast<double>(ne.count) / static_cast<double>(points.size());
   result.rmse_m = ne.weight_sum > 0.0 ? std::sqrt(ne.residual2_sum / ne.weight_sum) : 0.0;
   result.degenerate = degeneracy.degenerate;

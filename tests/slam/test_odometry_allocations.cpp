@@ -1,5 +1,6 @@
 // After warm-up, Odometry::process allocates nothing: every global operator
-// new in this test binary is counted while steady-state scans are processed.
+// new in this test binary is counted while steady-state scans are processed,
+// with and without a prior map (Odometry::anchor_to_prior).
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,7 @@
 namespace adit::slam {
 namespace {
 
-TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) {
+void steady_state_allocates_nothing(bool anchored) {
   ADIT_REQUIRE_ALLOCATION_COUNTING();
   const auto hall = test::room(200000, 31, 20.0F, 10.0F, 4.0F);
   OdometryConfig config;
@@ -29,6 +30,10 @@ TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) {
       times[i] = 0.1F * static_cast<float>(i) / static_cast<float>(scan.size());
     }
   };
+  // Anchored to a prior map (the hall itself), as once localised against one.
+  VoxelHashMap prior(0.5F, 1 << 16);
+  prior.add(hall);
+  if (anchored) odometry.anchor_to_prior(prior, Eigen::Isometry3d::Identity());
   for (int k = 0; k < 5; ++k) {  // warm-up
     fill(0.1 * k);
     ASSERT_TRUE(odometry.process({k * 100'000'000LL, scan, times}).valid);
@@ -40,9 +45,16 @@ TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) {
     const OdometryResult r = odometry.process({k * 100'000'000LL, scan, times});
     allocations += adit::test::allocations() - before;
     ASSERT_TRUE(r.valid);
+    if (anchored) {
+      ASSERT_GT(r.registration.prior_correspondences, 0);
+    }
   }
   EXPECT_EQ(allocations, 0U);
 }
+
+TEST(OdometryAllocations, SteadyStateProcessingAllocatesNothing) { steady_state_allocates_nothing(false); }
+
+TEST(OdometryAllocations, AnchoredToAPriorMapItAllocatesNothingEither) { steady_state_allocates_nothing(true); }
 
 }  // namespace
 }  // namespace adit::slam

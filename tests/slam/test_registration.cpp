@@ -194,6 +194,67 @@ TEST(Registration, GravityHoldsRollAndPitchAgainstATiltedMap) {
   EXPECT_NEAR(heading(held.pose), heading(tilt * truth), 0.05);
 }
 
+// A prior map in its own frame (A places the registration's frame in it) with
+// what the local map lacks: the room's end walls. The local map alone leaves
+// the room's axis to the initial guess, 0.3 m off; with the prior the scan
+// finds the axis in the prior, through A.
+std::vector<Eigen::Vector3f> without_end_walls(const std::vector<Eigen::Vector3f>& points, float hx) {
+  std::vector<Eigen::Vector3f> kept;
+  for (const auto& p : points)
+    if (std::abs(std::abs(p.x()) - hx) > 1e-3F && std::abs(p.x() + 3.0F) > 1e-3F) kept.push_back(p);
+  return kept;
+}
+
+TEST(Registration, APriorMapHoldsTheAxisTheLocalMapCannotSee) {
+  const Eigen::Isometry3d truth = pose(0.5, -0.2, 0.1, 3.0);
+  const Eigen::Isometry3d prior_from_frame = pose(120.0, -40.0, 3.0, 70.0, 0.5, -0.3);
+  VoxelHashMap local(0.5F, 1 << 14);
+  local.add(without_end_walls(test::room(80000, 11), 6.0F));
+  VoxelHashMap prior_index(0.5F, 1 << 14);
+  prior_index.add(test::transformed(test::room(80000, 12), prior_from_frame));
+  const auto scan = test::transformed(test::room(8000, 13), truth.inverse());
+  PosePrior guess;
+  guess.mean = pose(0.8, -0.2, 0.1, 3.0);
+  const RegistrationResult alone = register_scan(scan, local, guess, 1.0, 0.2);
+  std::vector<MapPlane> planes(scan.size());
+  std::vector<MapPlane> prior_planes(scan.size());
+  const RegistrationResult anchored = register_scan(scan, local, guess, 1.0, 0.2, RegistrationConfig{}, planes,
+                                                    SweepMotion{}, PriorMapTerm{&prior_index, prior_from_frame, 1.0, prior_planes});
+  std::printf("axis error: %.3f m with the local map alone, %.4f m with the prior\n",
+              std::abs(alone.pose.translation().x() - truth.translation().x()),
+              std::abs(anchored.pose.translation().x() - truth.translation().x()));
+  EXPECT_TRUE(alone.degenerate);
+  EXPECT_GT(std::abs(alone.pose.translation().x() - truth.translation().x()), 0.25);  // the test bites
+  EXPECT_FALSE(anchored.degenerate);
+  EXPECT_LT((anchored.pose.translation() - truth.translation()).norm(), 0.005);
+  EXPECT_LT(rotation_error_deg(anchored.pose, truth), 0.05);
+  EXPECT_GT(anchored.prior_correspondences, 6000);
+  EXPECT_EQ(alone.prior_correspondences, 0);
+}
+
+// What was changed since the prior (a wall moved 0.4 m) does not pull: its
+// points find the moved wall's plane beyond the kernel, and the local map and
+// the rest of the prior agree.
+TEST(Registration, AWallMovedSinceThePriorDoesNotPull) {
+  const Eigen::Isometry3d truth = pose(0.3, 0.4, 0.0, -5.0);
+  VoxelHashMap local(0.5F, 1 << 14);
+  local.add(test::room(80000, 14));
+  auto designed = test::room(80000, 15);
+  for (auto& p : designed)
+    if (std::abs(p.x() - 6.0F) < 1e-3F) p.x() = 6.4F;
+  VoxelHashMap prior_index(0.5F, 1 << 14);
+  prior_index.add(designed);
+  const auto scan = test::transformed(test::room(8000, 16), truth.inverse());
+  PosePrior guess;
+  guess.mean = pose(0.4, 0.35, 0.0, -4.0);
+  std::vector<MapPlane> planes(scan.size());
+  std::vector<MapPlane> prior_planes(scan.size());
+  const RegistrationResult r = register_scan(scan, local, guess, 1.0, 0.2, RegistrationConfig{}, planes, SweepMotion{},
+                                             PriorMapTerm{&prior_index, Eigen::Isometry3d::Identity(), 1.0, prior_planes});
+  EXPECT_LT((r.pose.translation() - truth.translation()).norm(), 0.01);
+  EXPECT_LT(rotation_error_deg(r.pose, truth), 0.05);
+}
+
 TEST(Registration, AnEmptyMapOrScanLeavesThePriorAndFlagsIt) {
   VoxelHashMap map(0.5F, 1024);
   PosePrior prior;

@@ -62,7 +62,11 @@ class ScanOdometry {
   // The last scan in the body frame, with each point's time after the scan's start (s).
   std::span<const Eigen::Vector3f> body_points() const { return body_points_; }
   std::span<const float> body_times() const { return body_times_; }
-  double registration_ms() const { return registration_ms_; }  // slam::Odometry::process, last scan
+  double registration_ms() const { return registration_ms_; }
+  // The odometry itself: its local map, its last registered scan, its up,
+  // and anchoring it to a prior map (slam::Odometry::anchor_to_prior).
+  slam::Odometry& odometry() { return odometry_; }
+  const slam::Odometry& odometry() const { return odometry_; }  // slam::Odometry::process, last scan
   const MotionAidCounts& counts() const { return counts_; }
   // The IMU the odometry reads (its readings, mounting and stats), or null.
   const ImuSource* imu() const { return imu_; }

@@ -156,6 +156,15 @@ struct OdometryConfig {
   // With the IMU: a zero-velocity update when the scan shows the body still
   // (standstill.hpp).
   StandstillConfig standstill;
+  // Anchored to a prior map (anchor_to_prior): σ of one point-to-plane
+  // residual against the prior. Tighter than LiDAR-only's 1 m against the
+  // local map: that σ is loose because the scan and the local map share the
+  // rings' sampling pattern (decision 010), which a prior sampled from a model
+  // or another session's map does not; and the prior is what must overrule
+  // the wheels' scale error and the local map's drift. FAST-LIO2's map
+  // residuals use 0.0316 m (0.001 m²). Why 0.03 m:
+  // docs/decisions/048-prior-map-in-the-odometry.md.
+  double prior_map_sigma_m = 0.03;
 };
 
 // Body motion since the previous scan from wheel odometry, with its
@@ -222,6 +231,24 @@ class Odometry {
 
   OdometryResult process(const ScanInput& scan, const std::optional<MotionPrior>& wheel = std::nullopt);
 
+  // From the next scan on, registers every scan against a prior map as well
+  // (PriorMapTerm): `prior_index` (index_prior_map; it must outlive this
+  // odometry or the next anchor), its frame placed at `prior_from_odometry`
+  // (global localisation). The poses stay in the odometry frame; the prior
+  // holds them where the prior says, so prior_from_odometry·pose is the pose
+  // in the prior's frame. Allocates the prior's plane buffer: call it once
+  // localised, not per scan.
+  // Its residuals count with OdometryConfig::prior_map_sigma_m.
+  void anchor_to_prior(const VoxelHashMap& prior_index, const Eigen::Isometry3d& prior_from_odometry);
+  // Back to the local map alone (a prior found wrong, a session's end).
+  void release_prior();
+  // The prior's frame, while anchored.
+  std::optional<Eigen::Isometry3d> prior_from_odometry() const;
+
+  // Gravity's up in the odometry frame, once measured: the LiDAR-inertial
+  // filter's, or the accelerometer's settled mean (OdometryConfig::gravity_settle_s).
+  std::optional<Eigen::Vector3d> up() const;
+
   const VoxelHashMap& local_map() const { return map_; }
   // The IMU filter's state (biases, gravity, velocity), meaningful once a
   // result had `inertial` set.
@@ -246,6 +273,11 @@ class Odometry {
   std::vector<Eigen::Vector3f> source_deskewed_;  // registration's scratch
   std::vector<Eigen::Vector3f> registered_;
   std::vector<MapPlane> planes_;             // registration's per-point planes
+  PriorMapTerm prior_map_;                   // index null: not anchored to a prior; planes: see prior_term()
+  std::vector<MapPlane> prior_planes_;       // registration's per-point planes in the prior
+  // prior_map_ with prior_planes_ (a copy of the odometry keeps its own),
+  // weighted against residuals of σ `local_sigma_m` (the registration's point_sigma_m).
+  PriorMapTerm prior_term(double local_sigma_m);
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Vector6d velocity_ = Vector6d::Zero();     // body twist per second, between the last two sweep middles
   Eigen::Isometry3d start_to_mid_ = Eigen::Isometry3d::Identity();  // pose_ to the middle of its sweep

@@ -101,12 +101,32 @@ struct SweepMotion {
   std::span<Eigen::Vector3f> deskewed;     // scratch of points.size(): the points deskewed with the final velocity
 };
 
+// A prior map (a BIM model, an earlier survey: prior_map.hpp) the scan is
+// registered against together with the local map: each point's plane in the
+// prior adds a point-to-plane residual to the same robust least squares, as
+// the BIM-aided odometry that issue #22 describes registers against the
+// model beside its own map. Where the prior agrees, both pull alike; where
+// it lacks what was built (furniture, new supports) the point finds no
+// prior plane within the threshold, or a far one the kernel weighs down;
+// where the prior is missing the local map carries the scan alone. The
+// local map then holds scans placed in the prior's frame, so drift stays
+// bounded by the prior's accuracy instead of growing with the path.
+// Residual r = n·(A·T·p − m) with A = prior_from_frame fixed; for T·exp(δ),
+// ∂r/∂[v; ω] = [n_b; p × n_b] with n_b = (A_R·R)ᵀ·n, as for the local map.
+struct PriorMapTerm {
+  const VoxelHashMap* index = nullptr;  // the prior's index (index_prior_map); null: no prior (not owned)
+  Eigen::Isometry3d prior_from_frame = Eigen::Isometry3d::Identity();  // the registration's frame in the prior's
+  double weight = 1.0;                  // of a prior residual, against a local-map one's 1
+  std::span<MapPlane> planes;           // per point, as `planes`: the prior planes kept between iterations
+};
+
 struct RegistrationResult {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   // Of the pose, [v; ω], for a world-frame (left) perturbation exp(ε)·pose.
   Matrix6d covariance = Matrix6d::Identity();
   int iterations = 0;
   int correspondences = 0;      // points with a map neighbour within the threshold
+  int prior_correspondences = 0;  // points with a plane of the prior map within it (PriorMapTerm)
   double inlier_ratio = 0.0;    // correspondences / points
   double rmse_m = 0.0;          // robust-weighted RMS of the residuals: sqrt(Σw·r² / Σw)
   bool degenerate = false;
@@ -132,5 +152,10 @@ RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const 
                                  const PosePrior& prior, double max_distance_m, double kernel_scale_m,
                                  const RegistrationConfig& config, std::span<MapPlane> planes,
                                  const SweepMotion& sweep);
+// The same, registered against a prior map as well.
+RegistrationResult register_scan(std::span<const Eigen::Vector3f> points, const VoxelHashMap& map,
+                                 const PosePrior& prior, double max_distance_m, double kernel_scale_m,
+                                 const RegistrationConfig& config, std::span<MapPlane> planes,
+                                 const SweepMotion& sweep, const PriorMapTerm& prior_map);
 
 }  // namespace adit::slam
