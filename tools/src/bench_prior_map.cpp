@@ -26,6 +26,7 @@
 #include "adit/eval/interpolate.hpp"
 #include "adit/eval/trajectory_io.hpp"
 #include "adit/slam/global_localisation.hpp"
+#include "bench_prior_drift.hpp"
 #include "bench_scans.hpp"
 #include "prior_map_source.hpp"
 
@@ -43,6 +44,8 @@ struct Options {
   double hint_m = 0.0;           // > 0: give a hint this far off (at most), heading within 10°
   double tilt_sigma_deg = 0.3;   // the levelling's error (accelerometer, 1 mg ≈ 0.06°, plus motion)
   bool json = false;
+  bool drift = true;             // the odometry with and without the prior (bench_prior_drift.hpp)
+  double prior_sigma_m = 0.0;    // > 0: the odometry's prior_map_sigma_m for the anchored run
 };
 
 struct Start {
@@ -172,6 +175,26 @@ int run(const Options& o) {
   const double median_s = quantile(seconds, 0.5);
   const double max_s = *std::max_element(seconds.begin(), seconds.end());
   const std::size_t memory = prior_map_bytes(prior.map);
+  std::optional<PriorDrift> drift;
+  if (o.drift) drift = measure_prior_drift(dir, prior.map, index, world_from_prior, o.scans, o.prior_sigma_m);
+  const auto run_json = [](const DriftRun& r) {
+    nlohmann::json j;
+    j["anchored"] = r.anchored;
+    j["anchored_at_s"] = r.anchored_at_s;
+    j["localisation_tries"] = r.localisation_tries;
+    j["failure"] = r.failure;
+    j["path_m"] = r.path_m;
+    j["end_error_m"] = r.end_error_m;
+    j["drift_percent"] = r.drift_percent;
+    j["ape_rms_m"] = r.ape_rms_m;
+    j["ape_max_m"] = r.ape_max_m;
+    j["ape_max_deg"] = r.ape_max_deg;
+    j["ape_fitted_rms_m"] = std::isnan(r.ape_fitted_rms_m) ? nlohmann::json() : nlohmann::json(r.ape_fitted_rms_m);
+    j["odometry_median_ms"] = r.odometry_median_ms;
+    j["odometry_p99_ms"] = r.odometry_p99_ms;
+    j["invalid_poses"] = r.invalid_poses;
+    return j;
+  };
   if (o.json) {
     nlohmann::json j;
     j["session"] = o.session;
@@ -190,9 +213,13 @@ int run(const Options& o) {
     j["median_error_m"] = err_m.empty() ? 0.0 : quantile(err_m, 0.5);
     j["median_error_deg"] = err_deg.empty() ? 0.0 : quantile(err_deg, 0.5);
     j["failure_reasons"] = reasons;
-    // Drift correction against the prior is not built (docs/PRIOR-MAP.md).
-    j["drift_percent_with_prior"] = nullptr;
-    j["drift_percent_without_prior"] = nullptr;
+    // Null when not measured (--no-drift), or when the odometry never localised against the prior.
+    j["drift_percent_with_prior"] = drift && drift->with_prior.anchored ? nlohmann::json(drift->with_prior.drift_percent) : nlohmann::json();
+    j["drift_percent_without_prior"] = drift ? nlohmann::json(drift->without_prior.drift_percent) : nlohmann::json();
+    if (drift) {
+      j["with_prior"] = run_json(drift->with_prior);
+      j["without_prior"] = run_json(drift->without_prior);
+    }
     fmt::print("{}\n", j.dump(2));
     return kExitOk;
   }
@@ -209,8 +236,31 @@ int run(const Options& o) {
     fmt::print("error of the localised: median {:.3f} m {:.3f} deg, max {:.3f} m {:.3f} deg\n", quantile(err_m, 0.5),
                quantile(err_deg, 0.5), *std::max_element(err_m.begin(), err_m.end()),
                *std::max_element(err_deg.begin(), err_deg.end()));
-  fmt::print("drift_percent_with_prior not measured (drift correction against the prior is not built)\n");
-  fmt::print("drift_percent_without_prior not measured\n");
+  if (!drift) {
+    fmt::print("drift_percent_with_prior not measured (--no-drift)\ndrift_percent_without_prior not measured\n");
+    return kExitOk;
+  }
+  const DriftRun& with = drift->with_prior;
+  const DriftRun& without = drift->without_prior;
+  if (with.anchored)
+    fmt::print("odometry anchored to the prior after {:.1f} s ({} localisation tries)\n", with.anchored_at_s,
+               with.localisation_tries);
+  else
+    fmt::print("odometry never localised against the prior ({} tries; last: {})\n", with.localisation_tries, with.failure);
+  const auto line = [](const char* what, const DriftRun& r) {
+    fmt::print("{}: end {:.3f} m over {:.1f} m; APE rms {:.3f} m, max {:.3f} m {:.2f} deg (rms {:.3f} m after a rigid "
+               "fit); odometry median {:.2f} ms, p99 {:.2f} ms per scan; {} invalid\n",
+               what, r.end_error_m, r.path_m, r.ape_rms_m, r.ape_max_m, r.ape_max_deg, r.ape_fitted_rms_m, r.odometry_median_ms,
+               r.odometry_p99_ms, r.invalid_poses);
+  };
+  if (with.anchored) {
+    fmt::print("drift_percent_with_prior {:.4f}\n", with.drift_percent);
+  } else {
+    fmt::print("drift_percent_with_prior not measured (not localised)\n");
+  }
+  fmt::print("drift_percent_without_prior {:.4f}\n", without.drift_percent);
+  line("with the prior", with);
+  line("without the prior", without);
   return kExitOk;
 }
 
@@ -230,6 +280,10 @@ void add_bench_prior_map_command(CLI::App& bench, int& status) {
   cmd->add_option("--hint-m", o->hint_m, "Give a hint up to this far off (heading within 10 deg); 0: none")->capture_default_str();
   cmd->add_option("--tilt-sigma-deg", o->tilt_sigma_deg, "σ of the levelling error")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
+  cmd->add_option("--prior-sigma-m", o->prior_sigma_m,
+                  "σ of a residual against the prior in the anchored odometry (0: the odometry's default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("!--no-drift", o->drift, "Skip the odometry with and without the prior (drift_percent_*)");
   cmd->callback([o, &status] {
     if (o->prior_trajectory.empty() != o->prior_truth.empty())
       throw InputError("", "--prior-trajectory/--prior-truth", "give both or neither");
