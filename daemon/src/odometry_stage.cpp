@@ -6,6 +6,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/daemon/imu_pose_feed.hpp"
+#include "adit/daemon/prior_localiser.hpp"
 
 namespace adit::daemon {
 
@@ -72,12 +73,26 @@ void OdometryStage::loop() {
       out->pose_mono_ns = monotonic_ns();
       poses_.publish(out);
     }
+    if (prior_ != nullptr && result.valid) follow_prior(result);
     if (map_slots_ && result.valid) hand_to_mapping(slot->scan, result);
     scans_.release(slot);
   }
   stats_.dropped_scans.store(scans_.dropped());
   poses_.close();
   if (map_slots_) map_slots_->close();
+}
+
+// Until anchored, each scan as it entered the map goes to the localiser
+// (which ignores it while a try runs); once anchored, nothing per scan here.
+void OdometryStage::follow_prior(const slam::OdometryResult& result) {
+  slam::Odometry& odometry = odometry_.odometry();
+  if (odometry.prior_from_odometry()) return;
+  if (const std::optional<Eigen::Isometry3d> anchor = prior_->take_anchor(result.stamp_ns)) {
+    odometry.anchor_to_prior(prior_->index(), *anchor);  // allocates the prior's plane buffer: once a session
+    return;
+  }
+  const Eigen::Vector3d sensor = result.pose * odometry_.extrinsic().translation().cast<double>();
+  prior_->add_scan(odometry.last_registered_points(), sensor, odometry.up(), result.stamp_ns);
 }
 
 void OdometryStage::copy_imu_stats() {

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "adit/common/clock.hpp"
+#include "adit/common/log.hpp"
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/imu_pose_feed.hpp"
 #include "adit/daemon/journal_writer.hpp"
@@ -13,10 +14,12 @@
 #include "adit/daemon/loop_closure_stage.hpp"
 #include "adit/daemon/mapping_stage.hpp"
 #include "adit/daemon/packet_imu.hpp"
+#include "adit/daemon/prior_localiser.hpp"
 #include "adit/daemon/odometry_stage.hpp"
 #include "adit/daemon/output_stage.hpp"
 #include "adit/daemon/scan_odometry.hpp"
 #include "adit/daemon/thread_settings.hpp"
+#include "adit/slam/prior_map_file.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -34,6 +37,26 @@ ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& sou
   if (!c.imu.enabled) return nullptr;
   if (c.imu.source != config::ImuSource::can) return source.imu();
   return can;
+}
+
+// One localisation try gathers this many scans (1 s of a 10 Hz LiDAR, as the
+// benchmark's starts) and at most this many points (at the map's resolution a
+// VLP-16 scan has a few thousand).
+constexpr int kPriorScansPerTry = 10;
+constexpr std::size_t kPriorCloudPoints = 400'000;
+
+// The prior map (prior_map.dir), read again for this pipeline: a bad one was
+// named at start (run.cpp), and the session maps without it.
+std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, const std::atomic<bool>& stop) {
+  if (c.prior_map.dir.empty()) return nullptr;
+  try {
+    slam::PriorMap prior = slam::read_prior_map(c.prior_map.dir);
+    if (!slam::check_prior_map(prior).empty()) return nullptr;
+    return std::make_unique<PriorLocaliser>(std::move(prior), kPriorScansPerTry, kPriorCloudPoints, stop);
+  } catch (const std::exception& e) {
+    log::error("prior map {}: {}; mapping without it", c.prior_map.dir, e.what());
+    return nullptr;
+  }
 }
 
 }  // namespace
@@ -67,6 +90,8 @@ struct Pipeline::Impl {
       imu->feed_poses_to(&*imu_poses);
       odometry.anchor_imu_poses_in(&*imu_poses);
     }
+    prior = prior_localiser_of(c, stop);
+    odometry.localise_against(prior.get());
   }
 
   void open_files(const std::filesystem::path& trajectory_file, const std::filesystem::path& map_trajectory_file,
@@ -104,6 +129,7 @@ struct Pipeline::Impl {
   std::vector<std::string> memory_warnings;
   std::atomic<bool> started{false};
   std::int64_t started_ns = 0;
+  std::unique_ptr<PriorLocaliser> prior;  // last: its thread is joined before the rest goes
 };
 
 Pipeline::Pipeline(const config::Config& config, const PipelineOptions& options)
@@ -137,6 +163,7 @@ void Pipeline::start(const SessionFiles& files) {
   if (i.loops) i.loops->start();
   if (i.mapping) i.mapping->start();
   i.output.start();
+  if (i.prior) i.prior->start(files.prior_frame_file);
   i.odometry.start();
   i.source.start();
 }
@@ -152,6 +179,7 @@ void Pipeline::join() {
   Impl& i = *impl_;
   i.source.join();
   i.odometry.join();
+  if (i.prior) i.prior->join();
   i.output.join();
   if (i.mapping) i.mapping->join();
   // Clean when the mapping ended by draining (a stop, the end of a replay), not by an abort.
@@ -204,6 +232,7 @@ const LoopClosureStage* Pipeline::loop_closure() const { return impl_->loops ? &
 const JournalWriter* Pipeline::journal() const { return impl_->journal ? &*impl_->journal : nullptr; }
 const CanFeedStats* Pipeline::can_stats() const { return impl_->can ? &impl_->can->stats() : nullptr; }
 const ImuPoseFeed* Pipeline::imu_poses() const { return impl_->imu_poses ? &*impl_->imu_poses : nullptr; }
+const PriorLocaliser* Pipeline::prior_localiser() const { return impl_->prior.get(); }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

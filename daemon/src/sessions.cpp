@@ -26,6 +26,7 @@
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"
+#include "adit/daemon/prior_localiser.hpp"
 #include "adit/daemon/map_files.hpp"
 #include "adit/daemon/durable_file.hpp"
 #include "adit/daemon/can_feed.hpp"
@@ -69,6 +70,17 @@ nlohmann::json imu_summary(const ImuStats& imu) {
           {"time_offset_s", imu.time_offset_s.load()},
           {"clock_spread_s", std::isfinite(spread) ? nlohmann::json(spread) : nlohmann::json(nullptr)},
           {"problems", problems}};
+}
+
+// summary.json's "prior_map": whether the odometry localised against the
+// prior and anchored to it (prior_frame.json then places the session in it).
+nlohmann::json prior_summary(const PriorLocaliser* prior) {
+  if (prior == nullptr) return {{"enabled", false}};
+  const PriorLocaliserStats& s = prior->stats();
+  const bool anchored = s.anchored.load();
+  return {{"enabled", true}, {"anchored", anchored},
+          {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
+          {"tries", s.tries.load()}, {"failed_tries", s.failures.load()}};
 }
 
 // summary.json's "loops": what loop closure found, accepted and refused, and
@@ -290,6 +302,7 @@ std::string Sessions::start_locked() {
   if (config_.session.record_lidar && config_.lidar.source != config::LidarSource::scan_dir)
     files.record_file = dir / "lidar.pcap";  // a directory of scans has no packets to record
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
+  if (!config_.prior_map.dir.empty()) files.prior_frame_file = dir / "prior_frame.json";
   if (config_.session.journal) {
     files.journal_file = dir / "journal.adj";
     files.journal_header = nlohmann::json{{"session", id},
@@ -466,6 +479,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"can", can_summary(pipeline->can_stats())},
         {"host_clock", {{"steps", s.clock_steps.load()}, {"last_step_s", 1e-9 * static_cast<double>(s.last_clock_step_ns.load())}}},
         {"loops", loops_summary(loops, track, corrected)},
+        {"prior_map", prior_summary(pipeline->prior_localiser())},
         {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},

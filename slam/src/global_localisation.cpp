@@ -202,6 +202,13 @@ Refined refine(const CloudParts& parts, std::span<const Eigen::Vector3f> sparse,
 
 }  // namespace
 
+Eigen::Isometry3d levelled_frame_at(const Eigen::Vector3d& up, const Eigen::Vector3d& origin) {
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.linear() = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  level.translation() = -(level.linear() * origin);
+  return level;
+}
+
 LocalisationResult localise(std::span<const Eigen::Vector3f> cloud, const PriorMap& prior, const VoxelHashMap& index,
                             const std::optional<LocalisationHint>& hint, const LocalisationConfig& config) {
   LocalisationResult result;

@@ -25,14 +25,6 @@
 namespace adit::tools {
 namespace {
 
-// The rotation that turns `up` onto +z by the shortest arc: a levelled frame
-// keeping the odometry frame's heading as nearly as it can.
-Eigen::Isometry3d levelling(const Eigen::Vector3d& up) {
-  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
-  level.linear() = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return level;
-}
-
 // Positions (and rotations) against the truth's, associated by time, no fit.
 void score(const slam::Trajectory& truth, const slam::Trajectory& estimate, DriftRun& run) {
   const eval::Associated a = eval::associate(truth, estimate, 0.02);
@@ -100,9 +92,9 @@ DriftRun run_odometry(const std::filesystem::path& session, const std::vector<Be
     // A levelled frame at the sensor's position now (the localisation finds
     // the floor below its origin), as a crew's start would be.
     const std::optional<Eigen::Vector3d> up = odometry.odometry().up();
-    Eigen::Isometry3d level_from_odometry = levelling(up.value_or(Eigen::Vector3d::UnitZ()));
     const Eigen::Vector3d sensor = r.pose * daemon::isometry_of(payload.lidar.extrinsics).translation();
-    level_from_odometry.translation() = -(level_from_odometry.linear() * sensor);
+    const Eigen::Isometry3d level_from_odometry =
+        slam::levelled_frame_at(up.value_or(Eigen::Vector3d::UnitZ()), sensor);
     for (Eigen::Vector3f& p : cloud) p = level_from_odometry.cast<float>() * p;
     const slam::LocalisationResult found = slam::localise(cloud, *prior, *index);
     ++run.localisation_tries;

@@ -24,6 +24,8 @@
 
 namespace adit::daemon {
 
+class PriorLocaliser;
+
 class OdometryStage {
  public:
   // `max_points`: the most points a scan can hold (the map hand-off reserves
@@ -46,6 +48,9 @@ class OdometryStage {
   void copy_imu_stats();
   // Before start(): each LiDAR-inertial scan's filter state anchors the IMU-rate pose.
   void anchor_imu_poses_in(ImuPoseFeed* feed) { imu_poses_ = feed; }
+  // Hands the first scans to `prior` and, once it localised them, registers
+  // every later scan against the prior map too (prior_localiser.hpp). Before start().
+  void localise_against(PriorLocaliser* prior) { prior_ = prior; }
 
  private:
   void loop();
@@ -61,6 +66,8 @@ class OdometryStage {
   std::int64_t first_stamp_ns_ = 0;
   std::int64_t last_stamp_ns_ = 0;
   ImuPoseFeed* imu_poses_ = nullptr;
+  PriorLocaliser* prior_ = nullptr;
+  void follow_prior(const slam::OdometryResult& result);
 };
 
 }  // namespace adit::daemon

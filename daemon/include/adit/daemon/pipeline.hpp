@@ -31,6 +31,7 @@ namespace adit::daemon {
 class ImuPoseFeed;
 class LoopClosureStage;
 class JournalWriter;
+class PriorLocaliser;
 struct CanFeedStats;
 
 struct PipelineOptions {
@@ -63,6 +64,9 @@ struct SessionFiles {
   // the map; empty = none. `journal_header` is its header record (JSON).
   std::filesystem::path journal_file;
   std::string journal_header;
+  // Where the odometry frame's place in the prior map is written once aditd
+  // localised against it (prior_map.dir; prior_localiser.hpp); empty = not written.
+  std::filesystem::path prior_frame_file;
 };
 
 class Pipeline {
@@ -112,6 +116,8 @@ class Pipeline {
   const CanFeedStats* can_stats() const;
   // The IMU-rate pose (its count, and its latencies after join()); null without an IMU or with imu.pose_horizon_s 0.
   const ImuPoseFeed* imu_poses() const;
+  // Localisation against the prior map (prior_map.dir); null without a usable prior.
+  const PriorLocaliser* prior_localiser() const;
 
  private:
   struct Impl;

@@ -66,6 +66,7 @@ class ScanOdometry {
   // The odometry itself: its local map, its last registered scan, its up,
   // and anchoring it to a prior map (slam::Odometry::anchor_to_prior).
   slam::Odometry& odometry() { return odometry_; }
+  const Eigen::Isometry3f& extrinsic() const { return extrinsic_; }  // the sensor in the body frame
   const slam::Odometry& odometry() const { return odometry_; }  // slam::Odometry::process, last scan
   const MotionAidCounts& counts() const { return counts_; }
   // The IMU the odometry reads (its readings, mounting and stats), or null.

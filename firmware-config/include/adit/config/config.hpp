@@ -253,7 +253,9 @@ struct SessionSection {
 };
 
 // A prior map (BIM export, design model, earlier survey) prepared by
-// `adit prior-map prepare IN --out DIR` (docs/PRIOR-MAP.md).
+// `adit prior-map prepare IN --out DIR` (docs/PRIOR-MAP.md): each session
+// localises its first scans against it and then registers every scan against
+// it too (daemon/prior_localiser.hpp).
 struct PriorMapSection {
   std::string dir;  // the prepared folder (prior_map.bin); empty: no prior
 };

@@ -79,6 +79,13 @@ struct LocalisationResult {
   std::size_t wall_points = 0;                             // of the cloud, used by the search and the checks
 };
 
+// The levelled frame localise() wants for a cloud gathered in another frame
+// (the odometry's): z along gravity's `up` (a unit vector in that frame), the
+// shortest turn from the frame's own z, so the heading is kept as nearly as it
+// can be; the origin at `origin` (the sensor: the floor must lie below it).
+// Returns level_from_frame.
+Eigen::Isometry3d levelled_frame_at(const Eigen::Vector3d& up, const Eigen::Vector3d& origin);
+
 // `cloud`: points in a local frame whose z is up (levelled with gravity; roll
 // and pitch are refined, within a few degrees), e.g. a few scans accumulated
 // by the odometry. `index`: index_prior_map(prior).

@@ -1,0 +1,85 @@
+#pragma once
+// Live localisation against a prior map (prior_map.dir, docs/PRIOR-MAP.md):
+// the odometry thread hands over its first scans, in the odometry frame,
+// levelled by its up; thread "prior" (low priority: a search takes 1-3 s of a
+// core) runs slam::localise on them; once found, the odometry thread takes the
+// anchor (prior_from_odometry) and registers every later scan against the
+// prior as well (slam::Odometry::anchor_to_prior). A try that fails hands the
+// buffer back and the next scans are gathered for another.
+//
+// Hand-off: one preallocated cloud buffer whose owner is `state_` (an atomic,
+// release/acquire): the odometry thread while filling and once found, the
+// prior thread while localising. The odometry thread never waits, locks or
+// allocates per scan here (a scan that does not fit the buffer is cut).
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "adit/daemon/stage_thread.hpp"
+#include "adit/slam/prior_map.hpp"
+#include "adit/slam/voxel_hash_map.hpp"
+
+namespace adit::daemon {
+
+struct PriorLocaliserStats {
+  std::atomic<std::uint64_t> tries{0};
+  std::atomic<std::uint64_t> failures{0};
+  std::atomic<bool> anchored{false};
+  std::atomic<double> anchored_after_s{0.0};  // sensor time from the first scan handed over to the scan anchored from
+};
+
+class PriorLocaliser {
+ public:
+  // `scans_per_try`: scans gathered for one try; `max_points`: the buffer's
+  // room (a try with fewer points goes ahead when the scans are in).
+  PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::size_t max_points, const std::atomic<bool>& stop);
+  ~PriorLocaliser();
+  PriorLocaliser(const PriorLocaliser&) = delete;
+  PriorLocaliser& operator=(const PriorLocaliser&) = delete;
+
+  // `frame_file`: where the anchor is written once found (JSON; empty: none).
+  void start(const std::filesystem::path& frame_file);
+  void join();
+
+  // Odometry thread. `points`: the scan as it entered the map, odometry frame;
+  // `sensor`: the sensor's position (odometry frame); `up`: gravity's up there
+  // (none yet: the scan is skipped). Ignored while a try runs or once anchored.
+  void add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
+                const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns);
+  // Odometry thread: the anchor, once, when a try found it; `stamp_ns` is the
+  // scan the odometry anchors from.
+  std::optional<Eigen::Isometry3d> take_anchor(std::int64_t stamp_ns);
+
+  const slam::VoxelHashMap& index() const { return index_; }
+  const PriorLocaliserStats& stats() const { return stats_; }
+  const StageThread& thread() const { return thread_; }
+
+ private:
+  enum State : int { kFilling, kLocalising, kFound, kAnchored };
+  void loop();
+  void write_frame(const Eigen::Isometry3d& prior_from_odometry) const;
+
+  const slam::PriorMap prior_;
+  const slam::VoxelHashMap index_;
+  const int scans_per_try_;
+  std::filesystem::path frame_file_;
+  std::atomic<int> state_{kFilling};
+  std::atomic<bool> finished_{false};  // join(): the pipeline has drained
+  // Owned as state_ says.
+  std::vector<Eigen::Vector3f> cloud_;
+  Eigen::Isometry3d level_from_odometry_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d anchor_ = Eigen::Isometry3d::Identity();
+  int scans_ = 0;
+  std::int64_t first_stamp_ns_ = 0;  // odometry thread only
+  PriorLocaliserStats stats_;
+  StageThread thread_;
+};
+
+}  // namespace adit::daemon

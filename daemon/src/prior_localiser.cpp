@@ -1,0 +1,117 @@
+// Thread "prior": localises the odometry's first scans against the prior map
+// and hands the anchor back (prior_localiser.hpp).
+#include "adit/daemon/prior_localiser.hpp"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "adit/common/log.hpp"
+#include "adit/daemon/durable_file.hpp"
+#include "adit/slam/global_localisation.hpp"
+
+namespace adit::daemon {
+namespace {
+
+constexpr int kNice = 10;  // below the stages, as the loop-closure thread
+constexpr auto kPoll = std::chrono::milliseconds(50);
+
+}  // namespace
+
+PriorLocaliser::PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::size_t max_points,
+                               const std::atomic<bool>& stop)
+    : prior_(std::move(prior)),
+      index_(slam::index_prior_map(prior_)),
+      scans_per_try_(std::max(1, scans_per_try)),
+      thread_("prior", config::ThreadSettings{}, stop) {
+  cloud_.reserve(max_points);
+}
+
+PriorLocaliser::~PriorLocaliser() { join(); }
+
+void PriorLocaliser::start(const std::filesystem::path& frame_file) {
+  frame_file_ = frame_file;
+  thread_.start([this] { loop(); });
+}
+
+void PriorLocaliser::join() {
+  finished_.store(true, std::memory_order_release);
+  thread_.join();
+}
+
+void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
+                              const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
+  if (state_.load(std::memory_order_acquire) != kFilling || !up) return;
+  if (first_stamp_ns_ == 0) first_stamp_ns_ = stamp_ns;
+  const std::size_t room = cloud_.capacity() - cloud_.size();
+  cloud_.insert(cloud_.end(), points.begin(), points.begin() + static_cast<std::ptrdiff_t>(std::min(room, points.size())));
+  if (++scans_ < scans_per_try_) return;
+  // A levelled frame at the sensor now, as a crew's start would be.
+  level_from_odometry_ = slam::levelled_frame_at(*up, sensor);
+  scans_ = 0;
+  state_.store(kLocalising, std::memory_order_release);
+}
+
+std::optional<Eigen::Isometry3d> PriorLocaliser::take_anchor(std::int64_t stamp_ns) {
+  if (state_.load(std::memory_order_acquire) != kFound) return std::nullopt;
+  state_.store(kAnchored, std::memory_order_relaxed);
+  stats_.anchored_after_s.store(1e-9 * static_cast<double>(stamp_ns - first_stamp_ns_), std::memory_order_relaxed);
+  stats_.anchored.store(true, std::memory_order_release);
+  return anchor_;
+}
+
+void PriorLocaliser::loop() {
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kNice) != 0)
+    log::warn("prior: could not lower the thread's priority");
+  while (!thread_.stopping() && !finished_.load(std::memory_order_acquire)) {
+    thread_.beat.beat();
+    if (state_.load(std::memory_order_acquire) != kLocalising) {
+      std::this_thread::sleep_for(kPoll);
+      continue;
+    }
+    const Eigen::Isometry3f to_level = level_from_odometry_.cast<float>();
+    for (Eigen::Vector3f& p : cloud_) p = to_level * p;
+    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_);
+    stats_.tries.fetch_add(1, std::memory_order_relaxed);
+    cloud_.clear();
+    if (!found.success) {
+      stats_.failures.fetch_add(1, std::memory_order_relaxed);
+      log::info("prior: not localised yet ({}); trying again with the next scans", found.failure);
+      state_.store(kFilling, std::memory_order_release);
+      continue;
+    }
+    anchor_ = found.pose * level_from_odometry_;
+    const Eigen::Vector3d t = found.pose.translation();
+    log::info("prior: localised at ({:.2f}, {:.2f}, {:.2f}) m in the prior's frame, overlap {:.2f}, position sigma "
+              "{:.3f} m; the odometry registers against the prior from its next scan",
+              t.x(), t.y(), t.z(), found.overlap, found.position_sigma_m);
+    write_frame(anchor_);
+    state_.store(kFound, std::memory_order_release);
+    break;  // one anchor a session
+  }
+}
+
+void PriorLocaliser::write_frame(const Eigen::Isometry3d& prior_from_odometry) const {
+  if (frame_file_.empty()) return;
+  nlohmann::json j;
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int c = 0; c < 4; ++c) row.push_back(prior_from_odometry.matrix()(r, c));
+    rows.push_back(row);
+  }
+  j["prior_from_odometry"] = rows;
+  j["note"] = "the session's poses and map are in the odometry frame; this places them in the prior's";
+  try {
+    write_durably(frame_file_, j.dump(2) + "\n");
+  } catch (const std::exception& e) {
+    log::error("prior: cannot write {}: {}", frame_file_.string(), e.what());
+  }
+}
+
+}  // namespace adit::daemon

@@ -1,0 +1,110 @@
+// The live localisation against a prior map (daemon/prior_localiser.hpp): the
+// odometry thread's scans, in an odometry frame that is neither the prior's
+// nor level, are localised on thread "prior" and the anchor handed back once;
+// a prior of another building is never anchored to, and the buffer comes back
+// for another try; scans without an up are not used. Runs under TSan in CI.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "adit/daemon/prior_localiser.hpp"
+#include "adit/slam/prior_map.hpp"
+#include "plan_scene.hpp"
+#include "temp_file.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using namespace slam::plan_scene;
+
+// The odometry frame in the world (= the prior's frame here): turned, moved and tilted 3°.
+Eigen::Isometry3d world_from_odometry() {
+  Eigen::Isometry3d t = level_frame(6.0, 4.0, 1.1, 0.9);
+  t.linear() = t.linear() * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  return t;
+}
+
+struct Feed {
+  std::vector<Eigen::Vector3f> points;  // odometry frame
+  Eigen::Vector3d sensor;               // odometry frame
+  Eigen::Vector3d up;                   // odometry frame
+};
+
+Feed feed_at(double x, double y) {
+  const std::vector<Eigen::Vector3f> world = sample_plan(office(), 24, 16, 0.07, 0.01, 7);
+  const Eigen::Isometry3d sensor_in_world = pose_at(x, y, 0.4);
+  const Eigen::Isometry3d odometry_from_world = world_from_odometry().inverse();
+  Feed f;
+  for (const Eigen::Vector3f& p : cloud_at(world, sensor_in_world, 15.0F))
+    f.points.push_back((odometry_from_world * sensor_in_world).cast<float>() * p);
+  f.sensor = odometry_from_world * sensor_in_world.translation();
+  f.up = odometry_from_world.linear() * Eigen::Vector3d::UnitZ();
+  return f;
+}
+
+// Polls `done` (called once per poll: it may take what it checks) for up to a minute.
+template <typename Done>
+bool wait_for(Done done) {
+  for (int i = 0; i < 1200; ++i) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+TEST(PriorLocaliser, AnchorsTheOdometryFrameInThePriorOnceAndWritesIt) {
+  const std::atomic<bool> stop{false};
+  const test::TempFolder dir;
+  PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop);
+  localiser.start(dir.path() / "prior_frame.json");
+  const Feed f = feed_at(4.0, 5.0);
+  EXPECT_FALSE(localiser.take_anchor(0));
+  for (int k = 0; k < 3; ++k) localiser.add_scan(f.points, f.sensor, f.up, 1'000'000'000LL + k * 100'000'000LL);
+  std::optional<Eigen::Isometry3d> anchor;
+  ASSERT_TRUE(wait_for([&] { return (anchor = localiser.take_anchor(1'500'000'000LL)).has_value(); }));
+  const Eigen::Isometry3d e = world_from_odometry().inverse() * *anchor;
+  EXPECT_LT(e.translation().norm(), 0.05) << e.translation().transpose();
+  EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 0.5 * M_PI / 180.0);
+  EXPECT_FALSE(localiser.take_anchor(1'600'000'000LL));  // once
+  EXPECT_TRUE(localiser.stats().anchored.load());
+  EXPECT_NEAR(localiser.stats().anchored_after_s.load(), 0.5, 1e-9);
+  EXPECT_EQ(localiser.stats().tries.load(), 1U);
+  localiser.join();
+  std::ifstream in(dir.path() / "prior_frame.json");
+  ASSERT_TRUE(in.good());
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["prior_from_odometry"][0][3].get<double>(), anchor->translation().x(), 1e-9);
+  EXPECT_NEAR(j["prior_from_odometry"][2][2].get<double>(), anchor->linear()(2, 2), 1e-9);
+}
+
+TEST(PriorLocaliser, AnotherBuildingIsNeverAnchoredToAndEachFailedTryGetsNewScans) {
+  const std::atomic<bool> stop{false};
+  PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(other_building(), 30, 20, 0.1)), 2, 200'000, stop);
+  localiser.start({});
+  const Feed f = feed_at(4.0, 5.0);
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    for (int k = 0; k < 2; ++k) localiser.add_scan(f.points, f.sensor, f.up, k * 100'000'000LL);
+    ASSERT_TRUE(wait_for([&] { return localiser.stats().failures.load() == static_cast<std::uint64_t>(attempt); }));
+  }
+  EXPECT_EQ(localiser.stats().tries.load(), 2U);
+  EXPECT_FALSE(localiser.take_anchor(0));
+  EXPECT_FALSE(localiser.stats().anchored.load());
+}
+
+TEST(PriorLocaliser, ScansWithoutAnUpAreNotUsed) {
+  const std::atomic<bool> stop{false};
+  PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 1, 200'000, stop);
+  localiser.start({});
+  const Feed f = feed_at(4.0, 5.0);
+  localiser.add_scan(f.points, f.sensor, std::nullopt, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(localiser.stats().tries.load(), 0U);
+  localiser.join();  // and a join ends the thread with nothing to do
+}
+
+}  // namespace
+}  // namespace adit::daemon
