@@ -46,7 +46,11 @@ void PriorLocaliser::join() {
 
 void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
                               const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
-  if (state_.load(std::memory_order_acquire) != kFilling || !up) return;
+  if (state_.load(std::memory_order_acquire) != kFilling) return;
+  if (!up) {
+    stats_.scans_without_up.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   if (first_stamp_ns_ == 0) first_stamp_ns_ = stamp_ns;
   const std::size_t room = cloud_.capacity() - cloud_.size();
   cloud_.insert(cloud_.end(), points.begin(), points.begin() + static_cast<std::ptrdiff_t>(std::min(room, points.size())));
@@ -68,8 +72,14 @@ std::optional<Eigen::Isometry3d> PriorLocaliser::take_anchor(std::int64_t stamp_
 void PriorLocaliser::loop() {
   if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kNice) != 0)
     log::warn("prior: could not lower the thread's priority");
+  bool said_no_up = false;
   while (!thread_.stopping() && !finished_.load(std::memory_order_acquire)) {
     thread_.beat.beat();
+    if (!said_no_up && stats_.scans_without_up.load(std::memory_order_relaxed) >= static_cast<std::uint64_t>(scans_per_try_)) {
+      log::warn("prior: the odometry has no gravity (no IMU or accelerometer yet), so its scans cannot be levelled "
+                "for localisation; waiting for one");
+      said_no_up = true;
+    }
     if (state_.load(std::memory_order_acquire) != kLocalising) {
       std::this_thread::sleep_for(kPoll);
       continue;

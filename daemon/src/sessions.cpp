@@ -80,7 +80,8 @@ nlohmann::json prior_summary(const PriorLocaliser* prior) {
   const bool anchored = s.anchored.load();
   return {{"enabled", true}, {"anchored", anchored},
           {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
-          {"tries", s.tries.load()}, {"failed_tries", s.failures.load()}};
+          {"tries", s.tries.load()}, {"failed_tries", s.failures.load()},
+          {"scans_without_up", s.scans_without_up.load()}};
 }
 
 // summary.json's "loops": what loop closure found, accepted and refused, and

@@ -103,6 +103,7 @@ TEST(PriorLocaliser, ScansWithoutAnUpAreNotUsed) {
   localiser.add_scan(f.points, f.sensor, std::nullopt, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_EQ(localiser.stats().tries.load(), 0U);
+  EXPECT_EQ(localiser.stats().scans_without_up.load(), 1U);
   localiser.join();  // and a join ends the thread with nothing to do
 }
 

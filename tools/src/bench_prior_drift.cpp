@@ -53,7 +53,7 @@ void score(const slam::Trajectory& truth, const slam::Trajectory& estimate, Drif
   run.drift_percent = run.path_m > 0.0 ? 100.0 * run.end_error_m / run.path_m : 0.0;
 }
 
-DriftRun run_odometry(const std::filesystem::path& session, const std::vector<BenchScan>& scans,
+DriftRun run_odometry(const std::filesystem::path& session, std::span<const BenchScan> scans,
                       const slam::Trajectory& truth, const slam::PriorMap* prior, const slam::VoxelHashMap* index,
                       const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m) {
   config::Config payload = config::load_config(session / "session.yaml");
@@ -134,15 +134,9 @@ DriftRun run_odometry(const std::filesystem::path& session, const std::vector<Be
 
 }  // namespace
 
-PriorDrift measure_prior_drift(const std::filesystem::path& session, const slam::PriorMap& prior,
-                               const slam::VoxelHashMap& index, const Eigen::Isometry3d& world_from_prior,
-                               int scans_per_try, double prior_sigma_m) {
-  const config::Config cfg = config::load_config(session / "session.yaml");
-  BenchInput input;
-  input.pcap = cfg.lidar.pcap;
-  input.model = cfg.lidar.model;
-  input.calibration = cfg.lidar.calibration;
-  const std::vector<BenchScan> scans = load_bench_scans(input);
+PriorDrift measure_prior_drift(const std::filesystem::path& session, std::span<const BenchScan> scans,
+                               const slam::PriorMap& prior, const slam::VoxelHashMap& index,
+                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m) {
   const slam::Trajectory truth = eval::read_tum(session / "truth_body.tum");
   PriorDrift drift;
   drift.without_prior = run_odometry(session, scans, truth, nullptr, nullptr, world_from_prior, scans_per_try, prior_sigma_m);

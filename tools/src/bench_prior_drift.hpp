@@ -10,12 +10,14 @@
 // truth's; anchored, its frame is where its localisation put it.
 
 #include <filesystem>
+#include <span>
 #include <string>
 
 #include <Eigen/Geometry>
 
 #include "adit/slam/prior_map.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
+#include "bench_scans.hpp"
 
 namespace adit::tools {
 
@@ -43,13 +45,13 @@ struct PriorDrift {
   DriftRun with_prior;
 };
 
-// `session`: an `adit sim` folder (session.yaml, lidar.pcap, can.log,
-// truth_body.tum). `world_from_prior` places the prior in the truth's world.
+// `session`: an `adit sim` folder (session.yaml, can.log, truth_body.tum);
+// `scans`: its lidar.pcap as load_bench_scans gives it. `world_from_prior` places the prior in the truth's world.
 // `scans_per_try`: the scans accumulated for one localisation. Throws
 // adit::InputError naming a missing or unreadable file. `prior_sigma_m` > 0
 // replaces slam::OdometryConfig::prior_map_sigma_m (to compare values).
-PriorDrift measure_prior_drift(const std::filesystem::path& session, const slam::PriorMap& prior,
-                               const slam::VoxelHashMap& index, const Eigen::Isometry3d& world_from_prior,
-                               int scans_per_try, double prior_sigma_m = 0.0);
+PriorDrift measure_prior_drift(const std::filesystem::path& session, std::span<const BenchScan> scans,
+                               const slam::PriorMap& prior, const slam::VoxelHashMap& index,
+                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m = 0.0);
 
 }  // namespace adit::tools

@@ -176,7 +176,7 @@ int run(const Options& o) {
   const double max_s = *std::max_element(seconds.begin(), seconds.end());
   const std::size_t memory = prior_map_bytes(prior.map);
   std::optional<PriorDrift> drift;
-  if (o.drift) drift = measure_prior_drift(dir, prior.map, index, world_from_prior, o.scans, o.prior_sigma_m);
+  if (o.drift) drift = measure_prior_drift(dir, scans, prior.map, index, world_from_prior, o.scans, o.prior_sigma_m);
   const auto run_json = [](const DriftRun& r) {
     nlohmann::json j;
     j["anchored"] = r.anchored;

@@ -31,6 +31,9 @@ namespace adit::daemon {
 struct PriorLocaliserStats {
   std::atomic<std::uint64_t> tries{0};
   std::atomic<std::uint64_t> failures{0};
+  // Scans handed over before gravity was known (no IMU or accelerometer, or
+  // not yet): they cannot be levelled, so they are not used.
+  std::atomic<std::uint64_t> scans_without_up{0};
   std::atomic<bool> anchored{false};
   std::atomic<double> anchored_after_s{0.0};  // sensor time from the first scan handed over to the scan anchored from
 };
