@@ -343,6 +343,7 @@ PriorMapTerm Odometry::prior_term(double local_sigma_m) {
   if (term.index == nullptr) return term;
   term.planes = prior_planes_;
   term.weight = (local_sigma_m * local_sigma_m) / (config_.prior_map_sigma_m * config_.prior_map_sigma_m);
+  term.stride = config_.prior_map_stride;
   return term;
 }
 

@@ -50,6 +50,7 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
   const bool cached = planes.size() >= points.size();
   const bool with_prior = prior_map.index != nullptr;
   const bool prior_cached = prior_map.planes.size() >= points.size();
+  const std::size_t prior_stride = static_cast<std::size_t>(std::max(1, prior_map.stride));
   const Eigen::Isometry3f A = prior_map.prior_from_frame.cast<float>();
   const Eigen::Matrix3f prior_R = A.linear() * R;
   const Eigen::Vector3f prior_t = A.linear() * t + A.translation();
@@ -87,13 +88,13 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
       plane = map.nearest_plane(q, config.plane_neighbors, config.max_plane_error_m);
     }
     if (plane.found && add(i, plane, q, R, 1.0)) ++ne.count;
-    if (!with_prior) continue;
+    if (!with_prior || i % prior_stride != 0) continue;
     const Eigen::Vector3f q_prior = prior_R * p + prior_t;
     MapPlane prior_local;
     MapPlane& prior_plane = prior_cached ? prior_map.planes[i] : prior_local;
     if (associate || !prior_cached) {
-      if (i + kPrefetchAhead < points.size())
-        prior_map.index->prefetch_around(prior_R * points[i + kPrefetchAhead] + prior_t);
+      if (i + kPrefetchAhead * prior_stride < points.size())
+        prior_map.index->prefetch_around(prior_R * points[i + kPrefetchAhead * prior_stride] + prior_t);
       prior_plane = prior_map.index->nearest_plane(q_prior, config.plane_neighbors, config.max_plane_error_m);
     }
     if (prior_plane.found && add(i, prior_plane, q_prior, prior_R, prior_map.weight)) ++ne.prior_count;

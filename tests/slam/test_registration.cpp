@@ -230,6 +230,13 @@ TEST(Registration, APriorMapHoldsTheAxisTheLocalMapCannotSee) {
   EXPECT_LT(rotation_error_deg(anchored.pose, truth), 0.05);
   EXPECT_GT(anchored.prior_correspondences, 6000);
   EXPECT_EQ(alone.prior_correspondences, 0);
+  // Every other point looking up the prior: half the prior's residuals, the axis still held.
+  PriorMapTerm every_other{&prior_index, prior_from_frame, 1.0, prior_planes};
+  every_other.stride = 2;
+  const RegistrationResult halved =
+      register_scan(scan, local, guess, 1.0, 0.2, RegistrationConfig{}, planes, SweepMotion{}, every_other);
+  EXPECT_NEAR(halved.prior_correspondences, anchored.prior_correspondences / 2, anchored.prior_correspondences / 20);
+  EXPECT_LT((halved.pose.translation() - truth.translation()).norm(), 0.005);
 }
 
 // What was changed since the prior (a wall moved 0.4 m) does not pull: its

@@ -55,12 +55,13 @@ void score(const slam::Trajectory& truth, const slam::Trajectory& estimate, Drif
 
 DriftRun run_odometry(const std::filesystem::path& session, std::span<const BenchScan> scans,
                       const slam::Trajectory& truth, const slam::PriorMap* prior, const slam::VoxelHashMap* index,
-                      const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m) {
+                      const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m, int prior_stride) {
   config::Config payload = config::load_config(session / "session.yaml");
   std::size_t most_points = 1;
   for (const BenchScan& s : scans) most_points = std::max(most_points, s.points.size());
   slam::OdometryConfig config = daemon::odometry_config_of(payload, slam::OdometryConfig{}, most_points);
   if (prior_sigma_m > 0.0) config.prior_map_sigma_m = prior_sigma_m;
+  if (prior_stride > 0) config.prior_map_stride = prior_stride;
   std::unique_ptr<daemon::CanFeed> can;
   const bool can_imu = payload.imu.enabled && payload.imu.source == config::ImuSource::can;
   if (payload.can.enabled && (payload.wheel_odometry.enabled || can_imu)) {
@@ -136,11 +137,12 @@ DriftRun run_odometry(const std::filesystem::path& session, std::span<const Benc
 
 PriorDrift measure_prior_drift(const std::filesystem::path& session, std::span<const BenchScan> scans,
                                const slam::PriorMap& prior, const slam::VoxelHashMap& index,
-                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m) {
+                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m,
+                               int prior_stride) {
   const slam::Trajectory truth = eval::read_tum(session / "truth_body.tum");
   PriorDrift drift;
-  drift.without_prior = run_odometry(session, scans, truth, nullptr, nullptr, world_from_prior, scans_per_try, prior_sigma_m);
-  drift.with_prior = run_odometry(session, scans, truth, &prior, &index, world_from_prior, scans_per_try, prior_sigma_m);
+  drift.without_prior = run_odometry(session, scans, truth, nullptr, nullptr, world_from_prior, scans_per_try, prior_sigma_m, prior_stride);
+  drift.with_prior = run_odometry(session, scans, truth, &prior, &index, world_from_prior, scans_per_try, prior_sigma_m, prior_stride);
   return drift;
 }
 

@@ -49,9 +49,11 @@ struct PriorDrift {
 // `scans`: its lidar.pcap as load_bench_scans gives it. `world_from_prior` places the prior in the truth's world.
 // `scans_per_try`: the scans accumulated for one localisation. Throws
 // adit::InputError naming a missing or unreadable file. `prior_sigma_m` > 0
-// replaces slam::OdometryConfig::prior_map_sigma_m (to compare values).
+// and `prior_stride` > 0 replace slam::OdometryConfig::prior_map_sigma_m and
+// prior_map_stride (to compare values).
 PriorDrift measure_prior_drift(const std::filesystem::path& session, std::span<const BenchScan> scans,
                                const slam::PriorMap& prior, const slam::VoxelHashMap& index,
-                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m = 0.0);
+                               const Eigen::Isometry3d& world_from_prior, int scans_per_try, double prior_sigma_m = 0.0,
+                               int prior_stride = 0);
 
 }  // namespace adit::tools

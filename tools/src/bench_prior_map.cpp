@@ -46,6 +46,7 @@ struct Options {
   bool json = false;
   bool drift = true;             // the odometry with and without the prior (bench_prior_drift.hpp)
   double prior_sigma_m = 0.0;    // > 0: the odometry's prior_map_sigma_m for the anchored run
+  int prior_stride = 0;          // > 0: its prior_map_stride
 };
 
 struct Start {
@@ -176,7 +177,7 @@ int run(const Options& o) {
   const double max_s = *std::max_element(seconds.begin(), seconds.end());
   const std::size_t memory = prior_map_bytes(prior.map);
   std::optional<PriorDrift> drift;
-  if (o.drift) drift = measure_prior_drift(dir, scans, prior.map, index, world_from_prior, o.scans, o.prior_sigma_m);
+  if (o.drift) drift = measure_prior_drift(dir, scans, prior.map, index, world_from_prior, o.scans, o.prior_sigma_m, o.prior_stride);
   const auto run_json = [](const DriftRun& r) {
     nlohmann::json j;
     j["anchored"] = r.anchored;
@@ -282,6 +283,9 @@ void add_bench_prior_map_command(CLI::App& bench, int& status) {
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
   cmd->add_option("--prior-sigma-m", o->prior_sigma_m,
                   "σ of a residual against the prior in the anchored odometry (0: the odometry's default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--prior-stride", o->prior_stride,
+                  "Every Nth registration point looks up the prior in the anchored odometry (0: the odometry's default)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-drift", o->drift, "Skip the odometry with and without the prior (drift_percent_*)");
   cmd->callback([o, &status] {

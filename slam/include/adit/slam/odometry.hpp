@@ -165,6 +165,9 @@ struct OdometryConfig {
   // residuals use 0.0316 m (0.001 m²). Why 0.03 m:
   // docs/decisions/048-prior-map-in-the-odometry.md.
   double prior_map_sigma_m = 0.03;
+  // Every this many registration points looks up its plane in the prior (the
+  // prior's searches are most of what anchoring costs per scan; decision 048).
+  int prior_map_stride = 1;
 };
 
 // Body motion since the previous scan from wheel odometry, with its

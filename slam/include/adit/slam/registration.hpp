@@ -118,6 +118,7 @@ struct PriorMapTerm {
   Eigen::Isometry3d prior_from_frame = Eigen::Isometry3d::Identity();  // the registration's frame in the prior's
   double weight = 1.0;                  // of a prior residual, against a local-map one's 1
   std::span<MapPlane> planes;           // per point, as `planes`: the prior planes kept between iterations
+  int stride = 1;                       // every stride-th point looks up the prior (its cost halves at 2)
 };
 
 struct RegistrationResult {
