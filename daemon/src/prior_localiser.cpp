@@ -6,6 +6,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -20,6 +21,7 @@ namespace {
 
 constexpr int kNice = 10;  // below the stages, as the loop-closure thread
 constexpr auto kPoll = std::chrono::milliseconds(50);
+constexpr std::uint64_t kMaxBackoff = 10;  // tries' spacing grows to at most 11 × scans_per_try
 
 }  // namespace
 
@@ -47,6 +49,14 @@ void PriorLocaliser::join() {
 void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
                               const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
   if (state_.load(std::memory_order_acquire) != kFilling) return;
+  if (const std::uint64_t failures = stats_.failures.load(std::memory_order_relaxed); failures != failures_seen_) {
+    failures_seen_ = failures;
+    skip_ = scans_per_try_ * static_cast<int>(std::min<std::uint64_t>(failures, kMaxBackoff));
+  }
+  if (skip_ > 0) {
+    --skip_;
+    return;
+  }
   if (!up) {
     stats_.scans_without_up.fetch_add(1, std::memory_order_relaxed);
     return;
@@ -90,8 +100,9 @@ void PriorLocaliser::loop() {
     stats_.tries.fetch_add(1, std::memory_order_relaxed);
     cloud_.clear();
     if (!found.success) {
+      log::info("prior: not localised yet ({}); trying again with later scans", found.failure);
+      // Counted, then handed back: the odometry thread sees the count with the buffer.
       stats_.failures.fetch_add(1, std::memory_order_relaxed);
-      log::info("prior: not localised yet ({}); trying again with the next scans", found.failure);
       state_.store(kFilling, std::memory_order_release);
       continue;
     }

@@ -5,7 +5,10 @@
 // core) runs slam::localise on them; once found, the odometry thread takes the
 // anchor (prior_from_odometry) and registers every later scan against the
 // prior as well (slam::Odometry::anchor_to_prior). A try that fails hands the
-// buffer back and the next scans are gathered for another.
+// buffer back and later scans are gathered for another: after the k-th failure
+// k·scans_per_try scans are passed over first (at most 10×), so a prior that
+// never matches (another building, a start outside it) costs a search every
+// ~11 s at most, not one every second for the whole session.
 //
 // Hand-off: one preallocated cloud buffer whose owner is `state_` (an atomic,
 // release/acquire): the odometry thread while filling and once found, the
@@ -80,6 +83,8 @@ class PriorLocaliser {
   Eigen::Isometry3d level_from_odometry_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d anchor_ = Eigen::Isometry3d::Identity();
   int scans_ = 0;
+  int skip_ = 0;                         // odometry thread: scans still to pass over before the next try
+  std::uint64_t failures_seen_ = 0;      // odometry thread: stats_.failures when skip_ was last set
   std::int64_t first_stamp_ns_ = 0;  // odometry thread only
   PriorLocaliserStats stats_;
   StageThread thread_;
