@@ -42,7 +42,8 @@ TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndFollowsItsFrame) {
 
   const daemon::PriorLocaliserStats& stats = pipeline.prior_localiser()->stats();
   ASSERT_TRUE(stats.anchored.load()) << stats.tries.load() << " tries";
-  EXPECT_LT(stats.anchored_after_s.load(), 6.0);
+  // Within the drive with a second to spare (about 2-3 s on an idle machine; CI runs tests side by side).
+  EXPECT_LT(stats.anchored_after_s.load(), 12.0);
   std::ifstream in(files.prior_frame_file);
   ASSERT_TRUE(in.good());
   const auto j = nlohmann::json::parse(in);
