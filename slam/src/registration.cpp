@@ -55,8 +55,10 @@ NormalEquations build(std::span<const Eigen::Vector3f> points, const VoxelHashMa
   const Eigen::Matrix3f prior_R = A.linear() * R;
   const Eigen::Vector3f prior_t = A.linear() * t + A.translation();
   // One residual into the normal equations; R_n maps the plane's frame to the body's.
+  // Inlined at both calls: the per-point path was one loop body before the
+  // prior came, and a call per residual slowed it (measured under ASan).
   const auto add = [&](std::size_t i, const MapPlane& plane, const Eigen::Vector3f& q, const Eigen::Matrix3f& R_n,
-                       double scale) {
+                       double scale) __attribute__((always_inline)) {
     const double r = plane.normal.dot(q - plane.point);
     if (std::abs(r) > max_distance_m) return false;
     const Eigen::Vector3d n_b = (R_n.transpose() * plane.normal).cast<double>();
