@@ -115,11 +115,8 @@ DriftRun run_odometry(const std::filesystem::path& session, std::span<const Benc
   // frame; otherwise its first pose on the truth's.
   Eigen::Isometry3d world_from_odometry = world_from_prior * prior_from_odometry;
   if (!run.anchored && !odometry_poses.empty()) {
-    const slam::Trajectory first = [&] {
-      slam::Trajectory one;
-      one.push_back(odometry_poses.stamps.front(), odometry_poses.poses.front());
-      return one;
-    }();
+    slam::Trajectory first;
+    first.push_back(odometry_poses.stamps.front(), odometry_poses.poses.front());
     const eval::Associated a = eval::associate(truth, first, 0.02);
     if (a.ref.empty()) throw InputError(session / "truth_body.tum", "", "no truth at the first scan");
     world_from_odometry = a.ref.front() * odometry_poses.poses.front().inverse();
