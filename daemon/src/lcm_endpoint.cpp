@@ -24,6 +24,7 @@
 #include "adit/protocol/command_auth.hpp"
 #include "adit/protocol/command_gate.hpp"
 #include "adit/common/clock.hpp"
+#include "adit/frame_t.hpp"
 #include "adit/grid_patch_t.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
@@ -109,6 +110,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   TilePublisher publisher;
   GridPublisher grid_publisher;
   std::int64_t pose_seq = 0;
+  MapFrame frame;  // the current (or last) session's, sent with each status
   EndpointCounters counters;
   FileIdentity key_identity;
   Clock::time_point next_key_check{};
@@ -345,6 +347,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       publisher.reset(session_id, hooks.session_folder ? hooks.session_folder(session_id) : std::filesystem::path{});
       grid_publisher.reset(session_id);
       pose_seq = 0;
+      frame = MapFrame{};
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
       hooks.stop();
@@ -409,7 +412,24 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       m.fault = s.fault;
       send(Channel::status, m);
       ++counters.status_published;
+      if (s.frame) frame = *s.frame;
+      if (!session_id.empty()) send_frame(m.utime);
     }
+  }
+
+  // The session's frame, for a client that draws its poses and tiles in the
+  // map frame (the prior's once anchored; docs/PROTOCOL.md).
+  void send_frame(std::int64_t utime) {
+    frame_t f;
+    f.utime = utime;
+    f.schema = 1;
+    f.payload_id = options.payload_id;
+    f.session_id = session_id;
+    f.source = frame.source;
+    std::copy(frame.position.begin(), frame.position.end(), f.position);
+    std::copy(frame.orientation.begin(), frame.orientation.end(), f.orientation);
+    send(Channel::frame, f);
+    ++counters.frames_published;
   }
 
   // --- tiles ----------------------------------------------------------------

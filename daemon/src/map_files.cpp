@@ -23,14 +23,21 @@ std::uintmax_t write_live_grid(const std::filesystem::path& stem, const slam::Li
   return products::write_grid(stem, products::grid_of(mosaic.image()));
 }
 
-std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m) {
-  std::array<double, 3> corner{0, 0, 0};
-  for (std::size_t i = 0; i < coords.size(); ++i) {
-    const std::array<double, 3> c{coords[i].x * tile_size_m, coords[i].y * tile_size_m, coords[i].z * tile_size_m};
-    for (std::size_t a = 0; a < 3; ++a) corner[a] = i == 0 ? c[a] : std::min(corner[a], c[a]);
+std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m,
+                                 const Eigen::Isometry3d& placed_by) {
+  Eigen::Vector3d corner = Eigen::Vector3d::Zero();
+  bool first = true;
+  for (const slam::TileCoord& c : coords) {
+    const Eigen::Vector3d low(c.x * tile_size_m, c.y * tile_size_m, c.z * tile_size_m);
+    for (int k = 0; k < 8; ++k) {  // a rotated tile's lowest point is one of its corners
+      const Eigen::Vector3d offset((k & 1) != 0 ? tile_size_m : 0.0, (k & 2) != 0 ? tile_size_m : 0.0,
+                                   (k & 4) != 0 ? tile_size_m : 0.0);
+      const Eigen::Vector3d p = placed_by * (low + offset);
+      corner = first ? p : corner.cwiseMin(p);
+      first = false;
+    }
   }
-  for (double& v : corner) v = std::floor(v - margin_m);
-  return corner;
+  return {std::floor(corner.x() - margin_m), std::floor(corner.y() - margin_m), std::floor(corner.z() - margin_m)};
 }
 
 std::vector<std::string> write_map_files(

@@ -10,10 +10,9 @@
 #include <chrono>
 #include <thread>
 
-#include <nlohmann/json.hpp>
 
 #include "adit/common/log.hpp"
-#include "adit/daemon/durable_file.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/slam/global_localisation.hpp"
 
 namespace adit::daemon {
@@ -119,20 +118,17 @@ void PriorLocaliser::loop() {
 
 void PriorLocaliser::write_frame(const Eigen::Isometry3d& prior_from_odometry) const {
   if (frame_file_.empty()) return;
-  nlohmann::json j;
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) {
-    nlohmann::json row = nlohmann::json::array();
-    for (int c = 0; c < 4; ++c) row.push_back(prior_from_odometry.matrix()(r, c));
-    rows.push_back(row);
-  }
-  j["prior_from_odometry"] = rows;
-  j["note"] = "the session's poses and map are in the odometry frame; this places them in the prior's";
   try {
-    write_durably(frame_file_, j.dump(2) + "\n");
+    write_prior_frame(frame_file_, prior_from_odometry);
   } catch (const std::exception& e) {
     log::error("prior: cannot write {}: {}", frame_file_.string(), e.what());
   }
+}
+
+std::optional<Eigen::Isometry3d> PriorLocaliser::anchor() const {
+  const int state = state_.load(std::memory_order_acquire);
+  if (state != kFound && state != kAnchored) return std::nullopt;
+  return anchor_;  // written before kFound was released, never after
 }
 
 }  // namespace adit::daemon

@@ -105,8 +105,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   if (!keep_large_blocks_mmapped()) log::warn("malloc: cannot fix the mmap threshold; a long session's RSS may creep");
   // The prior map (prior_map.dir) is read and checked at start, so a bad one is
   // named before a flight; the odometry goes on without it when it is unusable.
-  // Localising against it and correcting drift live are not wired in yet
-  // (docs/PRIOR-MAP.md, "Not done").
+  // Each session localises against it and corrects its drift live (docs/PRIOR-MAP.md, "In aditd").
   if (!config.prior_map.dir.empty()) {
     try {
       const slam::PriorMap prior = slam::read_prior_map(config.prior_map.dir);

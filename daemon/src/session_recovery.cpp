@@ -15,8 +15,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "adit/common/log.hpp"
 #include "adit/daemon/durable_file.hpp"
 #include "adit/daemon/map_files.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/protocol/session_journal.hpp"
 #include "adit/slam/tum.hpp"
@@ -94,6 +96,7 @@ nlohmann::json summary_of(const RecoveryReport& r, double voxel_m, double tile_s
                          {"problem", r.problem}}},
           {"map", {{"points", r.points}, {"tiles", r.tiles}, {"voxel_m", voxel_m}, {"tile_size_m", tile_size_m},
                    {"keyframes", r.keyframes}}},
+          {"frame", frame_summary(r.prior_from_odometry)},
           {"files", r.files}};
 }
 
@@ -204,6 +207,13 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
           odometry_end && !map_poses.stamps.empty())
         r.lost_s = std::max(0.0, *odometry_end - r.last_stamp_s);
 
+      // Anchored to a prior map, the exports go into its frame, as at a normal end.
+      try {
+        r.prior_from_odometry = read_prior_frame(dir / "prior_frame.json");
+      } catch (const std::exception& e) {
+        log::warn("session {}: {}; its exports stay in the odometry frame", r.session, e.what());
+      }
+      const Eigen::Isometry3d placed_by = r.prior_from_odometry.value_or(Eigen::Isometry3d::Identity());
       // The tiles and the map files, one tile decoded at a time.
       TileSpill tiles(dir / "tiles", stored_tile_params(tile_size_m));
       std::vector<slam::TileCoord> coords;
@@ -220,9 +230,22 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
           samples.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
                              p.intensity, p.time});
         if (const std::string problem = tiles.write(c, samples); !problem.empty()) throw std::runtime_error(problem);
+        if (r.prior_from_odometry)  // tiles/ stays in the odometry frame; the map files go into the prior's
+          for (protocol::MapPoint& p : points) {
+            const Eigen::Vector3d q = placed_by * Eigen::Vector3d(p.x, p.y, p.z);
+            p.x = q.x();
+            p.y = q.y();
+            p.z = q.z();
+          }
       };
-      r.files = write_map_files(dir, exports, r.points, map_corner(coords, tile_size_m, 0.0), coords, read_tile);
+      r.files = write_map_files(dir, exports, r.points, map_corner(coords, tile_size_m, 0.0, placed_by), coords,
+                                read_tile);
       r.files.insert(r.files.begin(), "tiles/");
+    }
+    if (r.prior_from_odometry) {
+      for (slam::Pose& p : map_poses.poses) p = *r.prior_from_odometry * p;
+      for (slam::Pose& p : keyframes.poses) p = *r.prior_from_odometry * p;
+      place_trajectory_file(dir / "trajectory.tum", *r.prior_from_odometry);
     }
     slam::write_tum(dir / "map_trajectory.tum", map_poses);
     slam::write_tum(dir / "keyframes.tum", keyframes);

@@ -34,6 +34,7 @@
 #include "adit/drivers/pcap_replay.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/products_worker.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/daemon/session_recovery.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/slam/tum.hpp"
@@ -41,6 +42,9 @@
 namespace adit::daemon {
 
 namespace {
+
+// frame_t.SOURCE_PRIOR_MAP, as a number: this file needs no LCM header.
+constexpr std::int8_t kFrameSourcePriorMap = 1;
 
 // summary.json's "imu": the IMU source's figures (imu_stats.hpp).
 // The CAN feed's frames and its bus's health; null without a CAN feed.
@@ -82,6 +86,18 @@ nlohmann::json prior_summary(const PriorLocaliser* prior) {
           {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
           {"tries", s.tries.load()}, {"failed_tries", s.failures.load()},
           {"scans_without_up", s.scans_without_up.load()}};
+}
+
+// The running session's map frame for frame_t: the prior's once found.
+MapFrame session_frame(const PriorLocaliser* prior) {
+  MapFrame f;
+  const std::optional<Eigen::Isometry3d> anchor = prior != nullptr ? prior->anchor() : std::nullopt;
+  if (!anchor) return f;
+  const Eigen::Quaterniond q(anchor->linear());
+  f.source = kFrameSourcePriorMap;
+  f.position = {anchor->translation().x(), anchor->translation().y(), anchor->translation().z()};
+  f.orientation = {q.w(), q.x(), q.y(), q.z()};
+  return f;
 }
 
 // summary.json's "loops": what loop closure found, accepted and refused, and
@@ -164,11 +180,14 @@ nlohmann::json journal_summary(const JournalWriter* journal) {
 }
 
 // The map follows the graph: each sample moves by the correction at its
-// scan's time (slam/correction_track.hpp).
-void correct(std::span<const slam::MapSample> in, const slam::CorrectionTrack& track, std::vector<slam::MapSample>& out) {
+// scan's time (slam/correction_track.hpp), when `track` is given; then into
+// the session's frame, `placed_by` (session_frame.hpp).
+void move_samples(std::span<const slam::MapSample> in, const slam::CorrectionTrack* track,
+                  const Eigen::Isometry3d& placed_by, std::vector<slam::MapSample>& out) {
   out.assign(in.begin(), in.end());
   for (slam::MapSample& s : out) {
-    const Eigen::Isometry3d c = track.at(static_cast<std::int64_t>(std::llround(s.time_s * 1e9)));
+    const Eigen::Isometry3d c =
+        track != nullptr ? placed_by * track->at(static_cast<std::int64_t>(std::llround(s.time_s * 1e9))) : placed_by;
     s.position = (c * s.position.cast<double>()).cast<float>();
   }
 }
@@ -404,6 +423,10 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     const LoopClosureStage* loops = pipeline->loop_closure();
     const slam::CorrectionTrack track = loops != nullptr ? loops->correction() : slam::CorrectionTrack{};
     const bool corrected = loops != nullptr && config_.map.loops_move_map && loops->closer().stats().accepted > 0;
+    // Anchored to a prior map, every export is in the prior's frame.
+    const std::optional<Eigen::Isometry3d> anchor =
+        pipeline->prior_localiser() != nullptr ? pipeline->prior_localiser()->anchor() : std::nullopt;
+    const Eigen::Isometry3d placed_by = anchor.value_or(Eigen::Isometry3d::Identity());
     double margin = 0.0;  // the corner stays at or below every moved point
     if (corrected) {
       double reach = 0.0;
@@ -423,22 +446,24 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         if (!problem.empty()) throw std::runtime_error(problem);
         samples = read_back;
       }
-      if (corrected) {
-        correct(samples, track, moved);
+      if (corrected || anchor) {
+        move_samples(samples, corrected ? &track : nullptr, placed_by, moved);
         samples = moved;
       }
       points = map_points_of(samples);
     };
     for (std::string& name : write_map_files(dir, config_.session.exports, map.size(),
-                                             map_corner(coords, config_.map.tile_size_m, margin), coords, read_tile))
+                                             map_corner(coords, config_.map.tile_size_m, margin, placed_by), coords, read_tile))
       files.push_back(std::move(name));
     slam::Trajectory keyframes;  // the graph's poses with loop closure (the same keyframes, in order)
     const std::vector<Eigen::Isometry3d>* graph = loops != nullptr ? &loops->closer().poses() : nullptr;
     for (std::size_t i = 0; i < pipeline->keyframes().size(); ++i) {
       const slam::Keyframe& k = pipeline->keyframes()[i];
       keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
-      keyframes.poses.push_back(graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose);
+      keyframes.poses.push_back(placed_by * (graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose));
     }
+    if (anchor)
+      for (const char* f : {"trajectory.tum", "map_trajectory.tum"}) place_trajectory_file(dir / f, *anchor);
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
     std::uintmax_t grid_bytes = 0;
@@ -481,6 +506,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"host_clock", {{"steps", s.clock_steps.load()}, {"last_step_s", 1e-9 * static_cast<double>(s.last_clock_step_ns.load())}}},
         {"loops", loops_summary(loops, track, corrected)},
         {"prior_map", prior_summary(pipeline->prior_localiser())},
+        {"frame", frame_summary(anchor)},
         {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
@@ -691,6 +717,7 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
+  sample.frame = session_frame(pipeline_->prior_localiser());
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;
 }

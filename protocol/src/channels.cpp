@@ -27,6 +27,7 @@ std::string_view channel_kind(Channel channel) {
     case Channel::file: return "FILE";
     case Channel::imu_pose: return "POSE_IMU";
     case Channel::grid: return "GRID";
+    case Channel::frame: return "FRAME";
   }
   return "UNKNOWN";
 }

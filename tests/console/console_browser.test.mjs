@@ -132,6 +132,20 @@ try {
   figures.coverage_top = await mapCoverage(page);
   assert.ok(figures.coverage_top > 0.02, `the map covers ${(100 * figures.coverage_top).toFixed(1)} % of the view`);
   await page.click('#camera-modes button[data-mode="follow"]');
+  // The payload's frame (frame_t: a prior map's anchor) places the whole view:
+  // the pose marker moves with it, and back. This drive has no prior: identity.
+  assert.equal(await page.evaluate(() => window.adit.metrics.mapFrame?.source), 'odometry',
+               await page.evaluate(async () => JSON.stringify((await (await fetch('/api/state')).json()).frame)));
+  const shift = await page.evaluate(() => {
+    const v = window.adit.view;
+    const before = v.markerPosition();
+    v.setFrame({ p: [100, -20, 0], q: [Math.SQRT1_2, 0, 0, Math.SQRT1_2] });  // a quarter turn about z
+    const after = v.markerPosition();
+    v.setFrame(window.adit.metrics.mapFrame);
+    const back = v.markerPosition();
+    return { x: after.x - (100 - before.y), y: after.y - (-20 + before.x), back: back.distanceTo(before) };
+  });
+  assert.ok(Math.abs(shift.x) < 1e-3 && Math.abs(shift.y) < 1e-3 && shift.back < 1e-6, JSON.stringify(shift));
   if (screenshots) {
     await waitFor('the phone page to draw the map', async () => (await metrics(other)).tileFetches > 3, 20000);
     await other.screenshot({ path: path.join(screenshots, 'console-phone.png') });

@@ -266,6 +266,39 @@ TEST(LcmEndpoint, PosesAndStatusArriveInWatch) {
   EXPECT_EQ(status.exit_status, 1) << "nobody publishes status any more: " << status.out;
 }
 
+// Once the session is anchored to a prior map, its frame_t goes out with the
+// status, and `adit watch` shows the pose in the prior's frame.
+TEST(LcmEndpoint, TheFrameGoesOutWithTheStatusAndWatchShowsThePoseInIt) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  std::atomic<bool> feeding{true};
+  std::thread feeder([&] {
+    for (int i = 0; feeding; ++i) {
+      PoseSample p;
+      p.utime = i * 100'000;
+      p.position = {1.0, 0.0, 1.0};
+      p.flags = 1;
+      h.endpoint->publish_pose(p);
+      if (i % 5 == 0) {
+        StatusSample s;
+        MapFrame f;  // a quarter turn about z, then 100 m east and 50 m north
+        f.source = 1;
+        f.position = {100.0, 50.0, 0.0};
+        f.orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+        if (i >= 5) s.frame = f;  // the first status has none yet: identity
+        h.endpoint->publish_status(std::move(s));
+      }
+      std::this_thread::sleep_for(100ms);
+    }
+  });
+  const auto r = h.adit({"watch", "--duration", "2"});
+  feeding = false;
+  feeder.join();
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("x 100.00 y 51.00 z 1.00 (prior map)"), std::string::npos) << r.out;
+  EXPECT_GE(h.endpoint->counters().frames_published.load(), 3U);
+}
+
 TEST(LcmEndpoint, DownloadAssemblesTheWholeMapDespite20PercentDroppedChunks) {
   Harness h(0.2);
   Sniffer sniffer(h.url);

@@ -12,7 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/daemon/journal_writer.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/daemon/session_recovery.hpp"
+#include "adit/slam/tum.hpp"
 #include "map_readers.hpp"
 #include "shared_data.hpp"
 
@@ -175,6 +177,54 @@ TEST(SessionRecovery, ARecoveryThatCrashedIsNotTriedAgain) {
   EXPECT_NE(r.problem.find("did not finish"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "journal.adj"));  // kept for a person to look at
   EXPECT_TRUE(interrupted_sessions(dir.parent_path()).empty());  // summary.json says why
+}
+
+// A session anchored to a prior map before the crash (its prior_frame.json)
+// is recovered in the prior's frame, as it would have ended: the map files and
+// the trajectories moved by the anchor, tiles/ left in the odometry frame.
+TEST(SessionRecovery, AnAnchoredSessionIsRecoveredInThePriorsFrame) {
+  const std::filesystem::path plain = work_dir("plain");
+  const std::filesystem::path anchored = work_dir("anchored");
+  write_session(plain, 20, 0.0, 4);
+  write_session(anchored, 20, 0.0, 4);
+  Eigen::Isometry3d anchor = Eigen::Isometry3d::Identity();
+  anchor.linear() = Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  anchor.translation() = Eigen::Vector3d(-130.0, 45.5, 2.25);  // below every odometry point: the LAS corner must follow
+  write_prior_frame(anchored / "prior_frame.json", anchor);
+  ASSERT_TRUE(recover_session(plain, {"ply", "las"}, 20.0).recovered);
+  const RecoveryReport r = recover_session(anchored, {"ply", "las"}, 20.0);
+  ASSERT_TRUE(r.recovered) << r.problem;
+  ASSERT_TRUE(r.prior_from_odometry.has_value());
+
+  const std::vector<test::XyzI> before = test::read_ply(plain / "map.ply");
+  const std::vector<test::XyzI> after = test::read_ply(anchored / "map.ply");
+  ASSERT_EQ(before.size(), after.size());
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const Eigen::Vector3d expected = anchor * Eigen::Vector3d(before[i].x, before[i].y, before[i].z);
+    ASSERT_LT((Eigen::Vector3d(after[i].x, after[i].y, after[i].z) - expected).norm(), 1e-3) << i;
+  }
+  for (const char* file : {"trajectory.tum", "map_trajectory.tum", "keyframes.tum"}) {
+    const slam::Trajectory a = slam::read_tum(plain / file);
+    const slam::Trajectory b = slam::read_tum(anchored / file);
+    ASSERT_EQ(a.size(), b.size()) << file;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE((anchor * a.poses[i]).isApprox(b.poses[i], 1e-6)) << file << " pose " << i;
+  }
+  for (const auto& e : std::filesystem::directory_iterator(plain / "tiles"))  // the odometry frame's, byte for byte
+    EXPECT_EQ(test::slurp(e.path()), test::slurp(anchored / "tiles" / e.path().filename())) << e.path();
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(anchored / "summary.json"));
+  EXPECT_EQ(summary["frame"]["name"], "prior_map");
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(plain / "summary.json"))["frame"]["name"], "odometry");
+}
+
+TEST(SessionRecovery, ABrokenPriorFrameLeavesTheSessionInTheOdometryFrame) {
+  const std::filesystem::path dir = work_dir("broken-frame");
+  write_session(dir, 5, 0.0, 5);
+  std::ofstream(dir / "prior_frame.json") << R"({"prior_from_odometry": [[1, 0, 0], [0, 1, 0]]})";
+  const RecoveryReport r = recover_session(dir, {"ply"}, 20.0);
+  ASSERT_TRUE(r.recovered) << r.problem;  // nothing is lost for a bad anchor
+  EXPECT_FALSE(r.prior_from_odometry.has_value());
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "summary.json"))["frame"]["name"], "odometry");
 }
 
 }  // namespace

@@ -103,6 +103,12 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   patch.data = {4, 5, 6, 7, 8};
   patch.size = 5;
   expect_round_trip(patch);
+
+  frame_t frame{};
+  frame.session_id = "s1";
+  frame.source = frame_t::SOURCE_PRIOR_MAP;
+  frame.orientation[0] = 1.0;
+  expect_round_trip(frame);
 }
 
 // Byte offset of n_args in sample_command(): hash, utime, schema, request id,

@@ -3,7 +3,8 @@
 // `adit console` runs as a child process, and the test reads what a browser
 // reads: GET /api/grid (a PNG and where it lies), the snapshot and the event
 // stream. The PNG is decoded here with libpng's own reader, independently of
-// the console's encoder, and compared cell for cell with what was sent.
+// the console's encoder, and compared cell for cell with what was sent. The
+// session's frame (frame_t) travels the same way to the page's snapshot.
 #include <gtest/gtest.h>
 
 #include <httplib.h>
@@ -267,6 +268,35 @@ TEST(ConsoleGrid, ANewSessionStartsAnEmptyGrid) {
   EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-X")), 6.4, 1e-6);
   EXPECT_NEAR(std::stod(r->get_header_value("X-Grid-Origin-Y")), -3.2, 1e-6);
   EXPECT_EQ(decode(r->body).width, kCells);
+}
+
+// The session's frame (frame_t, sent with each status) reaches the page's
+// snapshot: identity until the payload anchors to its prior map, then the anchor;
+// a new session starts in its own odometry frame again.
+TEST(ConsoleFrame, TheSessionsFrameReachesThePageAndANewSessionForgetsIt) {
+  Harness h;
+  ASSERT_TRUE(h.console_listens()) << "adit console did not listen on " << h.port;
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.endpoint->publish_status(daemon::StatusSample{});
+  for (int i = 0; i < 50 && h.state()["frame"].is_null(); ++i) std::this_thread::sleep_for(100ms);
+  ASSERT_EQ(h.state()["frame"]["source"], "odometry") << h.state().dump();
+  daemon::StatusSample anchored;
+  anchored.frame = daemon::MapFrame{1, {100.0, 50.0, -2.0}, {0.0, 0.0, 0.0, 1.0}};  // a half turn about z
+  h.endpoint->publish_status(std::move(anchored));
+  for (int i = 0; i < 50 && h.state()["frame"]["source"] != "prior_map"; ++i) std::this_thread::sleep_for(100ms);
+  const nlohmann::json frame = h.state()["frame"];
+  ASSERT_EQ(frame["source"], "prior_map") << frame.dump();
+  EXPECT_EQ(frame["session"], "s1");
+  EXPECT_EQ(frame["p"], nlohmann::json::array({100.0, 50.0, -2.0}));
+  EXPECT_EQ(frame["q"], nlohmann::json::array({0.0, 0.0, 0.0, 1.0}));
+
+  ASSERT_EQ(h.adit("stop").exit_status, 0);
+  h.endpoint->session_stopped();
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.endpoint->publish_status(daemon::StatusSample{});  // s2, not anchored
+  for (int i = 0; i < 50 && h.state()["frame"]["session"] != "s2"; ++i) std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(h.state()["frame"]["session"], "s2");
+  EXPECT_EQ(h.state()["frame"]["source"], "odometry");
 }
 
 }  // namespace

@@ -17,7 +17,7 @@ const pointBudget = Number(params.get('budget')) || 300000;
 
 // What the browser tests read (tests/console): latencies, poses, frames.
 const metrics = { latencies: [], poses: 0, lastSeq: -1, frames: 0, frameTimes: [], tileFetches: 0, tileBytes: 0,
-                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0 };
+                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0, mapFrame: null };
 window.adit = { metrics };
 
 const view = new MapView(el('map'));
@@ -31,6 +31,7 @@ let lastPose = null;
 let pendingLatency = null;  // the console's receive time (ms) of the newest pose not drawn yet
 let mapPoints = 0;
 let mapSession = null;  // the session whose map the view holds
+let mapFrame = null;    // its frame (frame_t), null: the odometry's
 let payload = 'adit';
 let locked = false;
 let token = sessionStorage.getItem('adit-token') || '';
@@ -180,6 +181,7 @@ function applySnapshot(s) {
   // (restarted) lists fewer, and the ones held stay. A console that has not
   // heard the payload yet knows no session (""): that is no new session.
   if (s.session && s.session !== mapSession) { view.clear(); queue.clear(); clearGrid(); mapSession = s.session; }
+  if (s.frame) onFrame(s.frame);
   if (s.path.length >= view.pathCount) view.setPath(s.path);  // a restarted console knows less of it
   mapPoints = Math.max(mapPoints, s.map_points);
   for (const t of s.tiles) wantTile(t.id, t.v);
@@ -197,8 +199,20 @@ function onPose(p, live) {
   }
   const flag = p.lost ? ' (LOST: held on the prediction)' : !p.valid ? ' (invalid)' : p.relocalised ? ' (relocalised)'
     : p.degenerate ? ' (degenerate)' : p.held ? ' (held)' : '';
+  const at = view.markerPosition();  // in the map frame
+  const where = mapFrame && mapFrame.source === 'prior_map' ? ' in the prior map' : '';
   el('pose-text').textContent =
-    `pose ${p.seq}: ${p.p.map((v) => v.toFixed(2)).join(', ')} m${flag}`;
+    `pose ${p.seq}: ${[at.x, at.y, at.z].map((v) => v.toFixed(2)).join(', ')} m${where}${flag}`;
+}
+
+// The payload's frame (frame_t): the odometry frame placed in the map frame,
+// the prior map's once the payload localised in it.
+function onFrame(f) {
+  if (mapSession && f.session && f.session !== mapSession) return;
+  mapFrame = f;
+  metrics.mapFrame = f;
+  view.setFrame(f);
+  if (lastPose) onPose(lastPose, false);
 }
 
 function connect() {
@@ -207,6 +221,7 @@ function connect() {
   events.onerror = () => { consoleUp = false; showBanner(); };  // EventSource retries by itself
   events.addEventListener('hello', (e) => { consoleUp = true; applySnapshot(JSON.parse(e.data)); });
   events.addEventListener('pose', (e) => onPose(JSON.parse(e.data), true));
+  events.addEventListener('frame', (e) => onFrame(JSON.parse(e.data)));
   events.addEventListener('status', (e) => {
     const s = JSON.parse(e.data);
     mapPoints = Math.max(mapPoints, s.map_points);
@@ -225,6 +240,8 @@ function connect() {
     clearGrid();
     mapPoints = 0;
     mapSession = session;
+    mapFrame = null;
+    metrics.mapFrame = null;
   });
   events.addEventListener('link', (e) => {
     const l = JSON.parse(e.data);

@@ -75,8 +75,8 @@ function cellsOf(grid) {
 }
 
 export class GridLayer {
-  constructor(scene) {
-    this.scene = scene;
+  constructor(parent) {
+    this.parent = parent;  // the map view's group in the odometry frame
     this.grid = null;
     this.mesh = null;
     this.material = new THREE.ShaderMaterial({
@@ -122,7 +122,7 @@ export class GridLayer {
     this.mesh.position.set(grid.originX + w / 2, grid.originY + h / 2, z);
     this.mesh.renderOrder = this.onTop ? 1 : -1;
     this.mesh.visible = this.visible;
-    this.scene.add(this.mesh);
+    this.parent.add(this.mesh);
   }
 
   clear() {
@@ -156,7 +156,7 @@ export class GridLayer {
 
   drop() {
     if (!this.mesh) return;
-    this.scene.remove(this.mesh);
+    this.parent.remove(this.mesh);
     this.mesh.geometry.dispose();
     this.material.uniforms.cells.value.dispose();
     this.material.uniforms.cells.value = null;

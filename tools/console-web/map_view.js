@@ -3,7 +3,9 @@
 // one colour scale that follows the map's extent without recolouring); the
 // path is a line, the current pose a cone; the live 2D grid a textured plane
 // under the points (grid_layer.js); cameras: follow, top, free (orbit with a
-// finger or the mouse, pinch or wheel to zoom).
+// finger or the mouse, pinch or wheel to zoom). All of them are in the
+// session's odometry frame, inside one group that the payload's frame
+// (frame_t: the prior map's once anchored) places in the map frame.
 import * as THREE from '/vendor/three/three.module.js';
 import { GridLayer } from './grid_layer.js';
 
@@ -33,6 +35,9 @@ export class MapView {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
     this.scene = new THREE.Scene();
+    this.world = new THREE.Group();  // map <- odometry (setFrame)
+    this.world.matrixAutoUpdate = false;
+    this.scene.add(this.world);
     this.camera = new THREE.PerspectiveCamera(60, 1, 0.1, 5000);
     this.camera.up.set(0, 0, 1);  // the map frame has z up
     this.material = new THREE.ShaderMaterial({
@@ -50,13 +55,13 @@ export class MapView {
     this.pathGeometry.setDrawRange(0, 0);
     this.path = new THREE.Line(this.pathGeometry, new THREE.LineBasicMaterial({ color: 0xffffff }));
     this.path.frustumCulled = false;
-    this.scene.add(this.path);
+    this.world.add(this.path);
     const cone = new THREE.ConeBufferGeometry(0.5, 1.6, 12);
     cone.rotateZ(-Math.PI / 2);  // the cone points along the body's x axis
     this.marker = new THREE.Mesh(cone, new THREE.MeshBasicMaterial({ color: 0xff2bd6 }));
     this.marker.visible = false;
-    this.scene.add(this.marker);
-    this.grid = new GridLayer(this.scene);
+    this.world.add(this.marker);
+    this.grid = new GridLayer(this.world);
     this.mode = 'follow';
     this.orbit = { target: new THREE.Vector3(), distance: 40, azimuth: -Math.PI / 2, elevation: 0.9 };
     this.poseDirty = false;
@@ -97,8 +102,25 @@ export class MapView {
     this.pathGeometry.setDrawRange(0, 0);
     this.marker.visible = false;
     this.grid.clear();
+    this.setFrame(null);
     this.dirty = true;
   }
+
+  // Where the odometry frame lies in the map frame ({p: [x y z], q: [w x y z]}, or null: identity).
+  setFrame(frame) {
+    if (frame) {
+      const q = new THREE.Quaternion(frame.q[1], frame.q[2], frame.q[3], frame.q[0]);  // three.js: x y z w
+      this.world.matrix.compose(new THREE.Vector3(frame.p[0], frame.p[1], frame.p[2]), q, new THREE.Vector3(1, 1, 1));
+    } else {
+      this.world.matrix.identity();
+    }
+    this.world.matrixWorldNeedsUpdate = true;
+    this.dirty = true;
+  }
+
+  // The pose marker in the map frame.
+  markerPosition() { this.world.updateMatrixWorld(); return this.marker.getWorldPosition(new THREE.Vector3()); }
+  markerQuaternion() { this.world.updateMatrixWorld(); return this.marker.getWorldQuaternion(new THREE.Quaternion()); }
 
   // The live 2D grid (grid_layer.js fetchGrid's answer), and whether it shows.
   setGrid(grid) {
@@ -113,7 +135,7 @@ export class MapView {
 
   dropTile(t) {
     if (t.points) {
-      this.scene.remove(t.points);
+      this.world.remove(t.points);
       t.points.geometry.dispose();
     }
   }
@@ -149,7 +171,7 @@ export class MapView {
       t.points.geometry = geometry;
     } else {
       t.points = new THREE.Points(geometry, this.material);
-      this.scene.add(t.points);
+      this.world.add(t.points);
     }
     t.n = n / 3;
     this.dirty = true;
@@ -197,7 +219,7 @@ export class MapView {
   setMode(mode) {
     if (mode === 'free' && this.mode !== 'free') {
       // Start orbiting from where the camera looks now.
-      this.orbit.target.copy(this.marker.visible ? this.marker.position : new THREE.Vector3());
+      this.orbit.target.copy(this.marker.visible ? this.markerPosition() : new THREE.Vector3());
       const d = this.camera.position.clone().sub(this.orbit.target);
       this.orbit.distance = Math.max(d.length(), 2);
       this.orbit.azimuth = Math.atan2(d.y, d.x);
@@ -208,9 +230,9 @@ export class MapView {
   }
 
   placeCamera() {
-    const at = this.marker.visible ? this.marker.position : new THREE.Vector3();
+    const at = this.marker.visible ? this.markerPosition() : new THREE.Vector3();
     if (this.mode === 'follow') {
-      const heading = new THREE.Vector3(1, 0, 0).applyQuaternion(this.marker.quaternion);
+      const heading = new THREE.Vector3(1, 0, 0).applyQuaternion(this.markerQuaternion());
       heading.z = 0;
       if (heading.lengthSq() < 1e-6) heading.set(1, 0, 0);
       heading.normalize();

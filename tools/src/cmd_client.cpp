@@ -109,18 +109,26 @@ void register_watch(CLI::App& app, int& status) {
     auto rate_window = start;
     std::size_t rate_count = 0;
     pose_t pose;
+    frame_t frame;  // map <- odometry (frame_t); the pose is shown in the map frame
+    frame.source = frame_t::SOURCE_ODOMETRY;
     std::string health = "(no status yet)";
     bool any = false;
     const auto print = [&] {
-      fmt::print("\r\033[K#{} x {:.2f} y {:.2f} z {:.2f} {} {:.1f} Hz | {}", pose.seq, pose.position[0],
-                 pose.position[1], pose.position[2], pose_flags(pose.flags), pose_rate, health);
+      const Eigen::Vector3d p =
+          map_from_odometry(frame) * Eigen::Vector3d(pose.position[0], pose.position[1], pose.position[2]);
+      fmt::print("\r\033[K#{} x {:.2f} y {:.2f} z {:.2f}{} {} {:.1f} Hz | {}", pose.seq, p.x(), p.y(), p.z(),
+                 frame.source == frame_t::SOURCE_PRIOR_MAP ? " (prior map)" : "", pose_flags(pose.flags), pose_rate,
+                 health);
       std::fflush(stdout);
       last_print = Clock::now();
     };
     const auto elapsed = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     bool silent = false;
-    client.watch(
-        [&](const pose_t& p) {
+    LcmClient::FollowHandlers handlers;
+    handlers.frame = [&](const frame_t& f) {
+      if (f.session_id == pose.session_id || pose.session_id.empty()) frame = f;
+    };
+    handlers.pose = [&](const pose_t& p) {
           pose = p;
           ++poses;
           ++rate_count;
@@ -132,13 +140,14 @@ void register_watch(CLI::App& app, int& status) {
             rate_window = Clock::now();
           }
           if (elapsed(last_print) >= 0.1) print();
-        },
-        [&](const status_t& s) {
+        };
+    handlers.status = [&](const status_t& s) {
           health = status_line(s);
           any = true;
           last_message = Clock::now();
           print();
-        },
+        };
+    client.follow(handlers,
         [&] {
           if (elapsed(last_message) > options->timeout_s) silent = true;
           return silent || (*duration > 0 && elapsed(start) >= *duration);

@@ -73,6 +73,13 @@ nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms) {
           {"relocalised", (p.flags & pose_t::FLAG_RELOCALISED) != 0}};
 }
 
+nlohmann::json frame_json(const frame_t& f) {
+  return {{"session", f.session_id},
+          {"source", f.source == frame_t::SOURCE_PRIOR_MAP ? "prior_map" : "odometry"},
+          {"p", {f.position[0], f.position[1], f.position[2]}},
+          {"q", {f.orientation[0], f.orientation[1], f.orientation[2], f.orientation[3]}}};
+}
+
 LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)
     : options_(std::move(options)), hub_(hub), client_(std::make_unique<LcmClient>(options_)) {
   last_status_ms_ = now_ms();  // silent since the console started, until a status arrives
@@ -89,7 +96,8 @@ void LiveFeed::run() {
                    .status = [this](const status_t& s) { on_status(s); },
                    .tile_index = [this](const tile_index_t& m) { on_index(m); },
                    .tile_segment = [this](const tile_segment_t& m) { on_segment(m); },
-                   .grid_patch = [this](const grid_patch_t& m) { on_grid(m); }},
+                   .grid_patch = [this](const grid_patch_t& m) { on_grid(m); },
+                   .frame = [this](const frame_t& m) { on_frame(m); }},
                   [this] {
                     tick();
                     return stop_.load();
@@ -107,6 +115,7 @@ void LiveFeed::switch_session(const std::string& session) {
   grid_ = {};
   grid_changed_ = false;
   grid_png_.reset();
+  frame_.reset();
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
 }
 
@@ -151,6 +160,19 @@ void LiveFeed::on_status(const status_t& s) {
   }
   if (came_back) hub_.publish("link", nlohmann::json{{"up", true}}.dump());
   hub_.publish("status", j.dump());
+}
+
+// Sent on to the page when it changes (frame_t comes at 2 Hz, changes once a session at most).
+void LiveFeed::on_frame(const frame_t& f) {
+  if (f.payload_id != options_.payload_id || f.session_id.empty()) return;
+  nlohmann::json j = frame_json(f);
+  {
+    const std::lock_guard lock(mutex_);
+    switch_session(f.session_id);
+    if (frame_ == j) return;
+    frame_ = j;
+  }
+  hub_.publish("frame", j.dump());
 }
 
 void LiveFeed::on_index(const tile_index_t& m) {
@@ -251,6 +273,7 @@ nlohmann::json LiveFeed::snapshot() const {
           {"session", session_},
           {"status", status_ ? *status_ : nlohmann::json()},
           {"pose", pose_ ? *pose_ : nlohmann::json()},
+          {"frame", frame_ ? *frame_ : nlohmann::json()},
           {"path", path},
           {"tiles", tiles},
           {"map_points", points},

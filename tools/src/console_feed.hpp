@@ -34,6 +34,9 @@ namespace adit::tools::console {
 
 nlohmann::json status_json(const status_t& s);
 nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms);
+// frame_t for the page: map <- odometry as {"source", "p": [x y z], "q": [w x y z]};
+// the page draws the tiles, the path and the pose through it.
+nlohmann::json frame_json(const frame_t& f);
 
 // A tile's points for a browser: segments `from` .. n-1 at `version`, every
 // `every`-th point (x y z as float32, little-endian, per segment a uint32
@@ -66,6 +69,7 @@ class LiveFeed {
   void run();
   void on_pose(const pose_t& p);
   void on_status(const status_t& s);
+  void on_frame(const frame_t& f);
   void on_index(const tile_index_t& m);
   void on_segment(const tile_segment_t& m);
   void on_grid(const grid_patch_t& m);
@@ -80,6 +84,7 @@ class LiveFeed {
   std::string session_;
   std::optional<nlohmann::json> status_;
   std::optional<nlohmann::json> pose_;
+  std::optional<nlohmann::json> frame_;  // the session's, once its frame_t came
   std::vector<std::array<float, 3>> path_;
   protocol::TileAssembler tiles_;
   // Per tile, the completions seen: (version before, version, first segment replaced).

@@ -1,8 +1,10 @@
 #include "lcm_client.hpp"
 
+#include <cmath>
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -132,9 +134,20 @@ std::optional<status_t> LcmClient::wait_status() {
   return status;
 }
 
+Eigen::Isometry3d map_from_odometry(const frame_t& frame) {
+  const Eigen::Quaterniond q(frame.orientation[0], frame.orientation[1], frame.orientation[2], frame.orientation[3]);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d p(frame.position[0], frame.position[1], frame.position[2]);
+  if (!(std::abs(q.norm() - 1.0) <= 1e-3) || !p.allFinite()) return t;  // NaN fails the first test too
+  t.linear() = q.normalized().toRotationMatrix();
+  t.translation() = p;
+  return t;
+}
+
 void LcmClient::watch(const std::function<void(const pose_t&)>& on_pose,
                       const std::function<void(const status_t&)>& on_status, const std::function<bool()>& until) {
-  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}, .grid_patch = {}}, until);
+  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}, .grid_patch = {}, .frame = {}},
+         until);
 }
 
 void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
@@ -152,6 +165,7 @@ void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool(
   const auto index = listen(Channel::tile_index, handlers.tile_index);
   const auto segments = listen(Channel::tile, handlers.tile_segment);
   const auto grid = listen(Channel::grid, handlers.grid_patch);
+  const auto frames = listen(Channel::frame, handlers.frame);
   while (!until()) impl_->handle_for(0.05);
 }
 

@@ -11,7 +11,10 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "adit/command_ack_t.hpp"
+#include "adit/frame_t.hpp"
 #include "adit/grid_patch_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/tile_assembler.hpp"
@@ -28,6 +31,11 @@ struct ClientOptions {
   // A key file (`adit keygen`): every command is signed with its first key.
   std::string key_file;
 };
+
+// frame_t's transform, map <- odometry; identity for a default-constructed
+// frame_t (none received: its quaternion is zero), a non-unit quaternion or
+// a position that is not finite.
+Eigen::Isometry3d map_from_odometry(const frame_t& frame);
 
 class LcmClient {
  public:
@@ -55,6 +63,7 @@ class LcmClient {
     std::function<void(const tile_index_t&)> tile_index;
     std::function<void(const tile_segment_t&)> tile_segment;
     std::function<void(const grid_patch_t&)> grid_patch;
+    std::function<void(const frame_t&)> frame;
   };
   // Calls the handlers for every message until `until` returns true (checked
   // at least every 50 ms).

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,13 @@ struct ThreadLoad {
   std::int32_t queue_capacity = 0;
 };
 
+// Where the running session's odometry frame lies in its map frame (frame_t).
+struct MapFrame {
+  std::int8_t source = 0;  // frame_t.SOURCE_*
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation{1, 0, 0, 0};  // w, x, y, z
+};
+
 // What the daemon knows about its health; the endpoint adds state, session
 // and map size.
 struct StatusSample {
@@ -54,6 +62,9 @@ struct StatusSample {
   std::vector<ThreadLoad> threads;
   std::int64_t disk_free_bytes = 0;
   std::string fault;
+  // A running session's frame; none between sessions (the endpoint keeps
+  // sending the last session's, so a client still draws its map in place).
+  std::optional<MapFrame> frame;
 };
 
 // The whole new content of one tile (after voxel downsampling).
@@ -105,6 +116,7 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> poses_published{0};
   std::atomic<std::uint64_t> poses_dropped{0};  // hand-off queue full
   std::atomic<std::uint64_t> status_published{0};
+  std::atomic<std::uint64_t> frames_published{0};
   std::atomic<std::uint64_t> status_dropped{0};
   std::atomic<std::uint64_t> tiles_dropped{0};
   std::atomic<std::uint64_t> chunks_published{0};

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "adit/protocol/map_point.hpp"
 #include "adit/slam/tiled_map.hpp"
 
@@ -26,10 +28,12 @@ namespace adit::daemon {
 // cannot be written.
 std::uintmax_t write_live_grid(const std::filesystem::path& stem, const slam::LiveGrid& grid);
 
-// A corner at or below every point of the tiles `coords` (tile_size_m each),
-// lowered by `margin_m` (points moved after mapping), floored to whole metres:
-// the LAS offset.
-std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m);
+// A corner at or below every point of the tiles `coords` (tile_size_m each)
+// once moved by `placed_by` (the prior map's frame, session_frame.hpp, or
+// identity), lowered by `margin_m` (points moved by the loops' correction
+// before that), floored to whole metres: the LAS offset.
+std::array<double, 3> map_corner(const std::vector<slam::TileCoord>& coords, double tile_size_m, double margin_m,
+                                 const Eigen::Isometry3d& placed_by);
 
 // Writes dir/map.<format> for each of `formats` with `n_points` points, asking
 // `read` for each tile's points in the order of `coords` (its vector is

@@ -62,6 +62,9 @@ class PriorLocaliser {
   // Odometry thread: the anchor, once, when a try found it; `stamp_ns` is the
   // scan the odometry anchors from.
   std::optional<Eigen::Isometry3d> take_anchor(std::int64_t stamp_ns);
+  // Any thread: prior_from_odometry once found (what prior_frame.json holds),
+  // whether or not the odometry has taken it yet; it never changes after.
+  std::optional<Eigen::Isometry3d> anchor() const;
 
   const slam::VoxelHashMap& index() const { return index_; }
   const PriorLocaliserStats& stats() const { return stats_; }

@@ -10,8 +10,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 namespace adit::daemon {
 
@@ -34,6 +37,9 @@ struct RecoveryReport {
   // How far the odometry's trajectory.tum went past the journal's last map
   // pose: the part of the session the map lost (0 when it did not).
   double lost_s = 0.0;
+  // The session's prior_frame.json: the exports are in the prior map's frame
+  // (session_frame.hpp). Unset without one, or when it could not be read (logged).
+  std::optional<Eigen::Isometry3d> prior_from_odometry;
   std::vector<std::string> files;
 };
 

@@ -1,0 +1,42 @@
+#pragma once
+// The frame a session's exports are written in (docs/PRIOR-MAP.md, "The
+// session's frame"): the prior map's once the odometry anchored to it, else
+// the odometry's own. The anchor, prior_from_odometry, is kept in the
+// session's prior_frame.json the moment it is found; at the session's end, and
+// on its recovery after a crash, the map files and the trajectories are
+// written through it, and summary.json's "frame" says which frame they are in.
+// The tiles/ folder and the live tiles stay in the odometry frame (the live
+// frame_t places them).
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+namespace adit::daemon {
+
+// Writes the anchor durably (a 4 × 4 matrix, row by row); throws
+// std::runtime_error naming the file when it cannot be written.
+void write_prior_frame(const std::filesystem::path& file, const Eigen::Isometry3d& prior_from_odometry);
+
+// The anchor in `file`, nullopt when the file does not exist. A file that is
+// not a finite rigid 4 × 4 matrix throws adit::InputError naming it and the key.
+std::optional<Eigen::Isometry3d> read_prior_frame(const std::filesystem::path& file);
+// The same from the file's text; `name` is the file named in errors.
+Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& name);
+
+// Rewrites the TUM trajectory `file` with each pose T as frame·T, durably,
+// under a first line saying so; a file already under that line is left as it
+// is (a recovery after a crash between this and the summary does not move it
+// twice). Returns false when there is no such file; throws adit::InputError
+// naming a malformed one, std::runtime_error one that cannot be written.
+bool place_trajectory_file(const std::filesystem::path& file, const Eigen::Isometry3d& frame);
+
+// summary.json's "frame": {"name": "prior_map", "prior_from_odometry": 4 × 4}
+// with an anchor, {"name": "odometry"} without.
+nlohmann::json frame_summary(const std::optional<Eigen::Isometry3d>& prior_from_odometry);
+
+}  // namespace adit::daemon

@@ -1,0 +1,98 @@
+// The frame a session's exports are in (daemon/session_frame.hpp): the anchor
+// written and read back, a bad prior_frame.json named, a trajectory file moved
+// into the prior's frame once only, and the LAS corner below a moved map.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "adit/common/error.hpp"
+#include "adit/daemon/map_files.hpp"
+#include "adit/daemon/session_frame.hpp"
+#include "adit/slam/tum.hpp"
+#include "temp_file.hpp"
+
+namespace adit::daemon {
+namespace {
+
+Eigen::Isometry3d sample_anchor() {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = (Eigen::AngleAxisd(2.0, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  t.translation() = Eigen::Vector3d(153.25, -48.5, 3.125);
+  return t;
+}
+
+TEST(SessionFrame, TheAnchorIsReadBackAsWritten) {
+  const test::TempFolder dir;
+  EXPECT_FALSE(read_prior_frame(dir.path() / "prior_frame.json").has_value());  // none: the odometry frame
+  write_prior_frame(dir.path() / "prior_frame.json", sample_anchor());
+  const std::optional<Eigen::Isometry3d> back = read_prior_frame(dir.path() / "prior_frame.json");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_TRUE(back->isApprox(sample_anchor(), 1e-12));
+  EXPECT_EQ(frame_summary(back)["name"], "prior_map");
+  EXPECT_EQ(frame_summary(std::nullopt)["name"], "odometry");
+}
+
+TEST(SessionFrame, ABadFileIsNamedWithItsKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"not json", "missing"},
+      {R"({"other": 1})", "missing"},
+      {R"({"prior_from_odometry": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]})", "4 x 4"},
+      {R"({"prior_from_odometry": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, "x"], [0, 0, 0, 1]]})", "finite"},
+      {R"({"prior_from_odometry": [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})", "rigid"},  // a scale
+      {R"({"prior_from_odometry": [[-1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})", "rigid"},  // a mirror
+      {R"({"prior_from_odometry": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]})", "rigid"},
+  };
+  for (const auto& [text, why] : cases) {
+    try {
+      parse_prior_frame(text, "s/prior_frame.json");
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where(), "s/prior_frame.json") << text;
+      EXPECT_EQ(e.key(), "prior_from_odometry") << text;
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SessionFrame, ATrajectoryIsMovedIntoThePriorsFrameOnce) {
+  const test::TempFolder dir;
+  const std::filesystem::path file = dir.path() / "trajectory.tum";
+  slam::Trajectory t;
+  for (int i = 0; i < 5; ++i) {
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.linear() = Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    p.translation() = Eigen::Vector3d(0.5 * i, 0.1 * i, 0.0);
+    t.stamps.push_back(1.7e9 + 0.1 * i);
+    t.poses.push_back(p);
+  }
+  slam::write_tum(file, t);
+  EXPECT_FALSE(place_trajectory_file(dir.path() / "none.tum", sample_anchor()));
+  ASSERT_TRUE(place_trajectory_file(file, sample_anchor()));
+  ASSERT_TRUE(place_trajectory_file(file, sample_anchor()));  // again (a recovery after a crash here): unchanged
+  const slam::Trajectory back = slam::read_tum(file);
+  ASSERT_EQ(back.size(), t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    EXPECT_NEAR(back.stamps[i], t.stamps[i], 1e-6);
+    EXPECT_LT(((sample_anchor() * t.poses[i]).translation() - back.poses[i].translation()).norm(), 2e-6) << i;
+    EXPECT_TRUE((sample_anchor() * t.poses[i]).linear().isApprox(back.poses[i].linear(), 1e-6)) << i;
+  }
+}
+
+TEST(SessionFrame, TheMapCornerStaysBelowAMovedMap) {
+  const std::vector<slam::TileCoord> coords{{0, 0, 0}, {1, 2, 0}, {-1, 0, 1}};
+  const double tile = 20.0;
+  const std::array<double, 3> plain = map_corner(coords, tile, 0.0, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(plain, (std::array<double, 3>{-20.0, 0.0, 0.0}));
+  const Eigen::Isometry3d anchor = sample_anchor();
+  const std::array<double, 3> moved = map_corner(coords, tile, 0.5, anchor);
+  for (const slam::TileCoord& c : coords)
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d p = anchor * (Eigen::Vector3d(c.x, c.y, c.z) * tile +
+                                          tile * Eigen::Vector3d((k & 1) != 0, (k & 2) != 0, (k & 4) != 0));
+      for (int a = 0; a < 3; ++a) EXPECT_LE(moved[static_cast<std::size_t>(a)], p[a] - 0.5);
+    }
+}
+
+}  // namespace
+}  // namespace adit::daemon

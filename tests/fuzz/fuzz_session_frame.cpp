@@ -1,0 +1,28 @@
+// Fuzzes what places a session in the map frame: prior_frame.json's text (read
+// back at the session's end and on recovery after a crash) and the frame_t a
+// client receives. A bad file must throw adit::InputError, a bad message be
+// refused; whatever is accepted must be a finite rigid transform.
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+#include "adit/common/error.hpp"
+#include "adit/daemon/session_frame.hpp"
+#include "adit/frame_t.hpp"
+#include "adit/protocol/checked_decode.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    const Eigen::Isometry3d t =
+        adit::daemon::parse_prior_frame(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json");
+    const double error = (t.linear().transpose() * t.linear() - Eigen::Matrix3d::Identity()).norm();
+    if (!t.matrix().allFinite() || !(error < 1e-5)) std::abort();  // accepted, yet not rigid
+  } catch (const adit::InputError&) {
+  }
+  adit::frame_t frame;
+  (void)adit::protocol::checked_decode(data, size, frame);
+  return 0;
+}
