@@ -319,6 +319,15 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
           for (const std::string& s : hooks.sessions()) ack.detail += s + "\n";
         return;
       }
+      case Verb::hint: {
+        std::string problem;
+        const std::optional<protocol::LocaliseHint> hint = protocol::parse_localise_hint(command.args, problem);
+        if (hint && machine.state() != protocol::SessionState::mapping) problem = "no session is mapping";
+        if (hint && problem.empty()) problem = hooks.hint ? hooks.hint(*hint) : "this daemon has no prior map";
+        ack.accepted = problem.empty();
+        ack.reason = ack.accepted ? "hint taken" : "hint refused: " + problem;
+        return;
+      }
       case Verb::export_map: {
         if (!hooks.export_map) {
           ack.accepted = false;

@@ -91,7 +91,7 @@ void OdometryStage::follow_prior(const slam::OdometryResult& result) {
     odometry.anchor_to_prior(prior_->index(), *anchor);  // allocates the prior's plane buffer: once a session
     return;
   }
-  const Eigen::Vector3d sensor = result.pose * odometry_.extrinsic().translation().cast<double>();
+  const Eigen::Isometry3d sensor = result.pose * odometry_.extrinsic().cast<double>();
   prior_->add_scan(odometry.last_registered_points(), sensor, odometry.up(), result.stamp_ns);
 }
 

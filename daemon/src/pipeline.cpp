@@ -233,6 +233,7 @@ const JournalWriter* Pipeline::journal() const { return impl_->journal ? &*impl_
 const CanFeedStats* Pipeline::can_stats() const { return impl_->can ? &impl_->can->stats() : nullptr; }
 const ImuPoseFeed* Pipeline::imu_poses() const { return impl_->imu_poses ? &*impl_->imu_poses : nullptr; }
 const PriorLocaliser* Pipeline::prior_localiser() const { return impl_->prior.get(); }
+PriorLocaliser* Pipeline::prior_localiser() { return impl_->prior.get(); }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

@@ -8,8 +8,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <numbers>
 #include <thread>
 
+
+#include <fmt/format.h>
 
 #include "adit/common/log.hpp"
 #include "adit/daemon/session_frame.hpp"
@@ -45,13 +49,14 @@ void PriorLocaliser::join() {
   thread_.join();
 }
 
-void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
+void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Isometry3d& sensor,
                               const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
   if (state_.load(std::memory_order_acquire) != kFilling) return;
   if (const std::uint64_t failures = stats_.failures.load(std::memory_order_relaxed); failures != failures_seen_) {
     failures_seen_ = failures;
     skip_ = scans_per_try_ * static_cast<int>(std::min<std::uint64_t>(failures, kMaxBackoff));
   }
+  if (hint_arrived_.exchange(false, std::memory_order_relaxed)) skip_ = 0;  // a new hint is tried at once
   if (skip_ > 0) {
     --skip_;
     return;
@@ -64,8 +69,11 @@ void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eig
   const std::size_t room = cloud_.capacity() - cloud_.size();
   cloud_.insert(cloud_.end(), points.begin(), points.begin() + static_cast<std::ptrdiff_t>(std::min(room, points.size())));
   if (++scans_ < scans_per_try_) return;
-  // A levelled frame at the sensor now, as a crew's start would be.
-  level_from_odometry_ = slam::levelled_frame_at(*up, sensor);
+  // A levelled frame at the sensor now, as a crew's start would be, and the
+  // sensor's heading in it (a hint gives the heading in the prior's frame).
+  level_from_odometry_ = slam::levelled_frame_at(*up, sensor.translation());
+  const Eigen::Vector3d forward = level_from_odometry_.linear() * sensor.linear().col(0);
+  sensor_heading_rad_ = std::atan2(forward.y(), forward.x());
   scans_ = 0;
   state_.store(kLocalising, std::memory_order_release);
 }
@@ -95,7 +103,9 @@ void PriorLocaliser::loop() {
     }
     const Eigen::Isometry3f to_level = level_from_odometry_.cast<float>();
     for (Eigen::Vector3f& p : cloud_) p = to_level * p;
-    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_);
+    const std::optional<slam::LocalisationHint> hint = search_hint();
+    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_, hint);
+    if (hint) stats_.hinted_tries.fetch_add(1, std::memory_order_relaxed);
     stats_.tries.fetch_add(1, std::memory_order_relaxed);
     cloud_.clear();
     if (!found.success) {
@@ -123,6 +133,38 @@ void PriorLocaliser::write_frame(const Eigen::Isometry3d& prior_from_odometry) c
   } catch (const std::exception& e) {
     log::error("prior: cannot write {}: {}", frame_file_.string(), e.what());
   }
+}
+
+std::string PriorLocaliser::set_hint(const protocol::LocaliseHint& hint) {
+  const int state = state_.load(std::memory_order_acquire);
+  if (state == kFound || state == kAnchored) return "already localised in the prior map";
+  {
+    const std::lock_guard lock(hint_mutex_);
+    hint_ = hint;
+  }
+  hint_arrived_.store(true, std::memory_order_relaxed);
+  log::info("prior: hint ({:.1f}, {:.1f}) m within {:.1f} m, heading {}; the next try searches there only", hint.x_m,
+            hint.y_m, hint.radius_m,
+            hint.heading_deg ? fmt::format("{:.0f}° ± {:.0f}°", *hint.heading_deg, hint.heading_tolerance_deg) : "any");
+  return {};
+}
+
+// Prior thread: the hint as the search takes it. Its heading is the sensor's;
+// the search turns the levelled frame, whose x is the sensor's heading less
+// sensor_heading_rad_.
+std::optional<slam::LocalisationHint> PriorLocaliser::search_hint() const {
+  const std::lock_guard lock(hint_mutex_);
+  if (!hint_) return std::nullopt;
+  slam::LocalisationHint h;
+  h.position = Eigen::Vector2d(hint_->x_m, hint_->y_m);
+  h.radius_m = hint_->radius_m;
+  if (hint_->heading_deg) {
+    h.yaw_rad = *hint_->heading_deg * std::numbers::pi / 180.0 - sensor_heading_rad_;
+    h.yaw_tolerance_rad = hint_->heading_tolerance_deg * std::numbers::pi / 180.0;
+  } else {
+    h.yaw_tolerance_rad = std::numbers::pi;  // any heading
+  }
+  return h;
 }
 
 std::optional<Eigen::Isometry3d> PriorLocaliser::anchor() const {

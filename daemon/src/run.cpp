@@ -190,6 +190,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   };
   hooks.load_tiles = [&sessions](const std::string& id, TileStore& into) { return sessions.load_tiles(id, into); };
   hooks.session_folder = [&sessions](const std::string& id) { return sessions.folder(id); };
+  hooks.hint = [&sessions](const protocol::LocaliseHint& hint) { return sessions.hint(hint); };
   auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));
   endpoint_ptr.store(endpoint.get());
   log::info("LCM: {} as payload '{}'", config.lcm.url, config.payload.id);

@@ -85,7 +85,7 @@ nlohmann::json prior_summary(const PriorLocaliser* prior) {
   return {{"enabled", true}, {"anchored", anchored},
           {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
           {"tries", s.tries.load()}, {"failed_tries", s.failures.load()},
-          {"scans_without_up", s.scans_without_up.load()}};
+          {"scans_without_up", s.scans_without_up.load()}, {"hinted_tries", s.hinted_tries.load()}};
 }
 
 // The running session's map frame for frame_t: the prior's once found.
@@ -587,6 +587,14 @@ std::vector<std::string> Sessions::list() const {
 }
 
 std::filesystem::path Sessions::folder(const std::string& id) const { return root_ / id; }
+
+std::string Sessions::hint(const protocol::LocaliseHint& hint) {
+  const std::lock_guard lock(mutex_);
+  if (!pipeline_ || finishing_) return "no session is mapping";
+  PriorLocaliser* prior = pipeline_->prior_localiser();
+  if (prior == nullptr) return "no prior map is configured (prior_map.dir)";
+  return prior->set_hint(hint);
+}
 
 std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
   const bool plain = !id.empty() && id.size() <= 64 && id.front() != '.' &&

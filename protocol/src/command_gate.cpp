@@ -12,6 +12,7 @@ std::optional<Verb> parse_verb(std::string_view text) {
   if (text == "EXPORT") return Verb::export_map;
   if (text == "PING") return Verb::ping;
   if (text == "SESSIONS") return Verb::sessions;
+  if (text == "HINT") return Verb::hint;
   return std::nullopt;
 }
 
@@ -22,6 +23,7 @@ std::string_view verb_name(Verb verb) {
     case Verb::export_map: return "EXPORT";
     case Verb::ping: return "PING";
     case Verb::sessions: return "SESSIONS";
+    case Verb::hint: return "HINT";
   }
   return "UNKNOWN";
 }

@@ -82,6 +82,8 @@ struct Harness {
   std::string payload = fmt::format("test-{}", ::getpid());
   std::atomic<int> starts{0};
   std::atomic<int> stops{0};
+  std::mutex hints_mutex;
+  std::vector<protocol::LocaliseHint> hints;  // HINTs handed to the daemon
   std::unique_ptr<LcmEndpoint> endpoint;
 
   explicit Harness(double drop = 0.0, const std::filesystem::path& key_file = {}, std::size_t command_window = 1024,
@@ -102,6 +104,11 @@ struct Harness {
     // (the test does that from its own thread, like the daemon's main loop).
     hooks.stop = [this] { ++stops; };
     hooks.sessions = [] { return std::vector<std::string>{"s0", "s1"}; };
+    hooks.hint = [this](const protocol::LocaliseHint& h) {
+      const std::lock_guard lock(hints_mutex);
+      hints.push_back(h);
+      return hints.size() > 1 ? std::string("already localised in the prior map") : std::string();
+    };
     if (!sessions_root.empty())
       hooks.session_folder = [sessions_root](const std::string& id) { return sessions_root / id; };
     endpoint = std::make_unique<LcmEndpoint>(o, hooks);
@@ -297,6 +304,47 @@ TEST(LcmEndpoint, TheFrameGoesOutWithTheStatusAndWatchShowsThePoseInIt) {
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("x 100.00 y 51.00 z 1.00 (prior map)"), std::string::npos) << r.out;
   EXPECT_GE(h.endpoint->counters().frames_published.load(), 3U);
+}
+
+// HINT (`adit hint`): refused with the reason while idle or with a bad
+// argument; while mapping its arguments reach the daemon's hook whole, and the
+// hook's refusal comes back in the ack.
+TEST(LcmEndpoint, HintReachesTheSessionWhileMappingWithItsReasonWhenRefused) {
+  Harness h;
+  auto r = h.adit({"hint", "--x", "12.5", "--y", "-3"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("hint refused: no session is mapping"), std::string::npos) << r.err;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  r = h.adit({"hint", "--x", "12.5", "--y", "-3", "--radius", "3", "--heading", "90"});
+  ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("hint taken"), std::string::npos) << r.out;
+  {
+    const std::lock_guard lock(h.hints_mutex);
+    ASSERT_EQ(h.hints.size(), 1U);
+    EXPECT_EQ(h.hints[0].x_m, 12.5);
+    EXPECT_EQ(h.hints[0].y_m, -3.0);
+    EXPECT_EQ(h.hints[0].radius_m, 3.0);
+    EXPECT_EQ(h.hints[0].heading_deg, 90.0);
+    EXPECT_EQ(h.hints[0].heading_tolerance_deg, 20.0);
+  }
+  r = h.adit({"hint", "--x", "1", "--y", "2"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("hint refused: already localised"), std::string::npos) << r.err;
+  // A bad argument from another client is refused before the daemon sees it.
+  lcm::LCM lcm(h.url);
+  Sniffer sniffer(h.url);
+  std::this_thread::sleep_for(50ms);
+  command_t c = command(h, 900, "HINT");
+  c.args = {"x=1", "y=nan"};
+  c.n_args = 2;
+  lcm.publish(protocol::channel_name(h.payload, Channel::command), &c);
+  for (int i = 0; i < 100 && sniffer.acks_for(900).empty(); ++i) std::this_thread::sleep_for(10ms);
+  const auto acks = sniffer.acks_for(900);
+  ASSERT_FALSE(acks.empty());
+  EXPECT_FALSE(acks[0].accepted);
+  EXPECT_NE(acks[0].reason.find("y: 'nan' is not a number"), std::string::npos) << acks[0].reason;
+  const std::lock_guard lock(h.hints_mutex);
+  EXPECT_EQ(h.hints.size(), 2U);
 }
 
 TEST(LcmEndpoint, DownloadAssemblesTheWholeMapDespite20PercentDroppedChunks) {

@@ -30,18 +30,18 @@ Eigen::Isometry3d world_from_odometry() {
 
 struct Feed {
   std::vector<Eigen::Vector3f> points;  // odometry frame
-  Eigen::Vector3d sensor;               // odometry frame
+  Eigen::Isometry3d sensor;             // odometry frame
   Eigen::Vector3d up;                   // odometry frame
 };
 
-Feed feed_at(double x, double y) {
+Feed feed_at(double x, double y, double yaw = 0.4) {
   const std::vector<Eigen::Vector3f> world = sample_plan(office(), 24, 16, 0.07, 0.01, 7);
-  const Eigen::Isometry3d sensor_in_world = pose_at(x, y, 0.4);
+  const Eigen::Isometry3d sensor_in_world = pose_at(x, y, yaw);
   const Eigen::Isometry3d odometry_from_world = world_from_odometry().inverse();
   Feed f;
   for (const Eigen::Vector3f& p : cloud_at(world, sensor_in_world, 15.0F))
     f.points.push_back((odometry_from_world * sensor_in_world).cast<float>() * p);
-  f.sensor = odometry_from_world * sensor_in_world.translation();
+  f.sensor = odometry_from_world * sensor_in_world;
   f.up = odometry_from_world.linear() * Eigen::Vector3d::UnitZ();
   return f;
 }
@@ -116,6 +116,51 @@ TEST(PriorLocaliser, ScansWithoutAnUpAreNotUsed) {
   EXPECT_EQ(localiser.stats().tries.load(), 0U);
   EXPECT_EQ(localiser.stats().scans_without_up.load(), 1U);
   localiser.join();  // and a join ends the thread with nothing to do
+}
+
+// A hint (HINT: the sensor's position and heading in the prior's frame)
+// narrows the search: the right one anchors as before, the sensor's heading
+// turned into the levelled frame's (the odometry frame is turned 0.9 rad, the
+// sensor here 2.5 rad: a hint taken as the frame's heading would search 92°
+// off); one in the wrong room never anchors.
+TEST(PriorLocaliser, ARightHintAnchorsAndAWrongOneNever) {
+  const std::atomic<bool> stop{false};
+  const double sensor_yaw = 2.5;
+  const Feed f = feed_at(4.0, 5.0, sensor_yaw);
+  {
+    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop);
+    localiser.start({});
+    protocol::LocaliseHint hint;
+    hint.x_m = 5.0;  // a metre off
+    hint.y_m = 5.5;
+    hint.radius_m = 2.0;
+    hint.heading_deg = sensor_yaw * 180.0 / M_PI + 3.0;  // 3° off
+    hint.heading_tolerance_deg = 10.0;
+    ASSERT_EQ(localiser.set_hint(hint), "");
+    for (int k = 0; k < 3; ++k) localiser.add_scan(f.points, f.sensor, f.up, k * 100'000'000LL);
+    std::optional<Eigen::Isometry3d> anchor;
+    ASSERT_TRUE(wait_for([&] { return (anchor = localiser.take_anchor(500'000'000LL)).has_value(); }));
+    const Eigen::Isometry3d e = world_from_odometry().inverse() * *anchor;
+    EXPECT_LT(e.translation().norm(), 0.05) << e.translation().transpose();
+    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 0.5 * M_PI / 180.0);
+    EXPECT_EQ(localiser.stats().hinted_tries.load(), 1U);
+    EXPECT_NE(localiser.set_hint(hint), "");  // already localised
+    localiser.join();
+  }
+  {
+    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop);
+    localiser.start({});
+    protocol::LocaliseHint wrong;
+    wrong.x_m = 18.0;  // another room
+    wrong.y_m = 12.0;
+    wrong.radius_m = 2.0;
+    ASSERT_EQ(localiser.set_hint(wrong), "");
+    for (int k = 0; k < 3; ++k) localiser.add_scan(f.points, f.sensor, f.up, k * 100'000'000LL);
+    ASSERT_TRUE(wait_for([&] { return localiser.stats().failures.load() == 1U; }));
+    EXPECT_FALSE(localiser.take_anchor(500'000'000LL));
+    EXPECT_EQ(localiser.stats().hinted_tries.load(), 1U);
+    localiser.join();
+  }
 }
 
 }  // namespace

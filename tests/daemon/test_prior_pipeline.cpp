@@ -46,11 +46,14 @@ TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndTheSessionIsInItsFrame) {
   double anchored_after_s = 0.0;
   {
     daemon::Sessions sessions(c, {});
+    const protocol::LocaliseHint hint;  // HINT reaches the running session's localiser only
+    EXPECT_EQ(sessions.hint(hint), "no session is mapping");
     id = sessions.start();
     dir = sessions.folder(id);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
     while (!sessions.poll() && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_EQ(sessions.hint(hint), "already localised in the prior map");
     sessions.stop_and_wait();
   }
   std::ifstream summary_in(dir / "summary.json");

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "adit/protocol/command_gate.hpp"
+#include "adit/protocol/localise_hint.hpp"
 #include "adit/protocol/session_state.hpp"
 
 namespace adit::protocol {
@@ -35,12 +36,12 @@ GateResult inspect(CommandGate& gate, const command_t& c) {
 
 TEST(CommandGate, PassesKnownVerbsForThisPayload) {
   CommandGate gate("rig1");
-  for (const char* verb : {"START", "STOP", "EXPORT", "PING", "SESSIONS"}) {
+  for (const char* verb : {"START", "STOP", "EXPORT", "PING", "SESSIONS", "HINT"}) {
     const auto r = inspect(gate, make(static_cast<std::int64_t>(std::hash<std::string>{}(verb) >> 2), verb));
     EXPECT_EQ(r.kind, GateResult::Kind::execute) << verb << ": " << r.reason;
     EXPECT_EQ(verb_name(r.verb), verb);
   }
-  EXPECT_EQ(gate.counts().passed, 5u);
+  EXPECT_EQ(gate.counts().passed, 6u);
 }
 
 TEST(CommandGate, RejectsUnknownVerbsAndOtherPayloadsWithAReason) {
@@ -123,6 +124,43 @@ TEST(SessionState, RejectsInvalidTransitionsWithAReasonAndKeepsTheState) {
     EXPECT_FALSE(t.accepted);
     EXPECT_EQ(t.to, c.from);
     EXPECT_EQ(t.reason, c.reason);
+  }
+}
+
+// HINT's key=value arguments: parsed back from what a client sends, and each
+// bad one named.
+TEST(LocaliseHint, ArgumentsRoundTripAndBadOnesAreNamed) {
+  LocaliseHint hint;
+  hint.x_m = 12.25;
+  hint.y_m = -3.5;
+  hint.radius_m = 4.0;
+  hint.heading_deg = 271.5;
+  hint.heading_tolerance_deg = 15.0;
+  std::string error;
+  const std::optional<LocaliseHint> back = parse_localise_hint(localise_hint_args(hint), error);
+  ASSERT_TRUE(back.has_value()) << error;
+  EXPECT_EQ(back->x_m, 12.25);
+  EXPECT_EQ(back->y_m, -3.5);
+  EXPECT_EQ(back->radius_m, 4.0);
+  EXPECT_EQ(back->heading_deg, 271.5);
+  EXPECT_EQ(back->heading_tolerance_deg, 15.0);
+  const std::optional<LocaliseHint> plain = parse_localise_hint({"x=1", "y=2"}, error);
+  ASSERT_TRUE(plain.has_value());
+  EXPECT_FALSE(plain->heading_deg.has_value());  // any heading
+  EXPECT_EQ(plain->radius_m, 5.0);
+  const std::pair<std::vector<std::string>, const char*> bad[] = {
+      {{"x=1"}, "x and y are needed"},
+      {{"x=1", "y"}, "'y' is not key=value"},
+      {{"x=1", "y=2m"}, "y: '2m' is not a number"},
+      {{"x=1", "y=inf"}, "y: 'inf' is not a number"},
+      {{"x=1", "y=2", "radius=0.1"}, "radius: 0.1 is outside 0.5..100"},
+      {{"x=1", "y=2", "heading_tolerance=0"}, "heading_tolerance: 0 is outside 1..180"},
+      {{"x=1", "y=2", "z=3"}, "unknown argument 'z'"},
+  };
+  for (const auto& [args, why] : bad) {
+    error.clear();
+    EXPECT_FALSE(parse_localise_hint(args, error).has_value()) << why;
+    EXPECT_NE(error.find(why), std::string::npos) << error;
   }
 }
 

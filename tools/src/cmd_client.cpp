@@ -1,4 +1,4 @@
-// adit status | watch | start | stop | export | grid | sessions | ping: talk to a running aditd
+// adit status | watch | start | stop | hint | export | grid | sessions | ping: talk to a running aditd
 // over LCM (docs/PROTOCOL.md).
 
 #include <chrono>
@@ -12,6 +12,7 @@
 #include "adit/common/error.hpp"
 #include "adit/products/grid_io.hpp"
 #include "adit/protocol/grid_mosaic.hpp"
+#include "adit/protocol/localise_hint.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "client_options.hpp"
 #include "commands.hpp"
@@ -180,6 +181,27 @@ void register_export(CLI::App& app, int& status) {
   });
 }
 
+// HINT: where the payload is in the prior map's frame, for its search against
+// the prior (docs/PRIOR-MAP.md).
+void register_hint(CLI::App& app, int& status) {
+  auto options = std::make_shared<ClientOptions>();
+  auto hint = std::make_shared<protocol::LocaliseHint>();
+  auto heading = std::make_shared<double>(std::nan(""));
+  CLI::App* sub = app.add_subcommand("hint", "Tell the mapping payload roughly where it is in its prior map");
+  add_client_options(*sub, *options);
+  sub->add_option("--x", hint->x_m, "Position in the prior map's frame, m")->required();
+  sub->add_option("--y", hint->y_m, "Position in the prior map's frame, m")->required();
+  sub->add_option("--radius", hint->radius_m, "How far off the position may be, m")->capture_default_str()->check(CLI::Range(0.5, 100.0));
+  sub->add_option("--heading", *heading, "The way the payload faces, degrees counter-clockwise from the prior's x axis (default: any)");
+  sub->add_option("--heading-tolerance", hint->heading_tolerance_deg, "Degrees either side of --heading")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 180.0));
+  sub->callback([options, hint, heading, &status] {
+    if (!std::isnan(*heading)) hint->heading_deg = *heading;
+    status = run_command(*options, "HINT", false, protocol::localise_hint_args(*hint));
+  });
+}
+
 // The live 2D grid as the tablet receives it (grid_patch_t on GRID), written
 // as a ROS map_server PGM + YAML. The daemon sends every patch again within
 // grid.refresh_s, so listening that long gets the whole grid.
@@ -230,6 +252,7 @@ void register_grid(CLI::App& app, int& status) {
 void register_client_commands(CLI::App& app, int& status) {
   register_status(app, status);
   register_watch(app, status);
+  register_hint(app, status);
   register_verb(app, status, "start", "START", "Start a mapping session", false);
   register_verb(app, status, "stop", "STOP", "Stop the mapping session (the payload flushes, then goes idle)", false);
   register_export(app, status);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "adit/protocol/localise_hint.hpp"
 #include "adit/protocol/map_point.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "adit/protocol/tile_codec.hpp"
@@ -88,6 +89,9 @@ struct SessionHooks {
   // The folder of a session just started: the tile stream keeps its segments
   // in a file there rather than in RAM. Empty (or unset): in RAM.
   std::function<std::filesystem::path(const std::string& session)> session_folder;
+  // HINT: hands the running session's search against its prior map an
+  // approximate start; returns "" or why it was not taken.
+  std::function<std::string(const protocol::LocaliseHint& hint)> hint;
 };
 
 struct EndpointOptions {

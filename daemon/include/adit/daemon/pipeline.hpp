@@ -118,6 +118,7 @@ class Pipeline {
   const ImuPoseFeed* imu_poses() const;
   // Localisation against the prior map (prior_map.dir); null without a usable prior.
   const PriorLocaliser* prior_localiser() const;
+  PriorLocaliser* prior_localiser();  // for a hint (HINT)
 
  private:
   struct Impl;

@@ -8,7 +8,9 @@
 // buffer back and later scans are gathered for another: after the k-th failure
 // k·scans_per_try scans are passed over first (at most 10×), so a prior that
 // never matches (another building, a start outside it) costs a search every
-// ~11 s at most, not one every second for the whole session.
+// ~11 s at most, not one every second for the whole session. A crew's hint
+// (HINT: set_hint, on the endpoint's thread) narrows the tries after it and
+// starts the next at once; it is held under a mutex the odometry thread never takes.
 //
 // Hand-off: one preallocated cloud buffer whose owner is `state_` (an atomic,
 // release/acquire): the odometry thread while filling and once found, the
@@ -18,6 +20,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -26,6 +29,8 @@
 #include <Eigen/Geometry>
 
 #include "adit/daemon/stage_thread.hpp"
+#include "adit/protocol/localise_hint.hpp"
+#include "adit/slam/global_localisation.hpp"
 #include "adit/slam/prior_map.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
 
@@ -37,6 +42,7 @@ struct PriorLocaliserStats {
   // Scans handed over before gravity was known (no IMU or accelerometer, or
   // not yet): they cannot be levelled, so they are not used.
   std::atomic<std::uint64_t> scans_without_up{0};
+  std::atomic<std::uint64_t> hinted_tries{0};  // tries narrowed by a hint (HINT)
   std::atomic<bool> anchored{false};
   std::atomic<double> anchored_after_s{0.0};  // sensor time from the first scan handed over to the scan anchored from
 };
@@ -55,10 +61,14 @@ class PriorLocaliser {
   void join();
 
   // Odometry thread. `points`: the scan as it entered the map, odometry frame;
-  // `sensor`: the sensor's position (odometry frame); `up`: gravity's up there
+  // `sensor`: the sensor's pose (odometry frame); `up`: gravity's up there
   // (none yet: the scan is skipped). Ignored while a try runs or once anchored.
-  void add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& sensor,
+  void add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Isometry3d& sensor,
                 const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns);
+  // Any thread (HINT): later tries search only round `hint` (the sensor's
+  // position and heading in the prior's frame), the next one at once; "" or
+  // why not (already localised). A later hint replaces it.
+  std::string set_hint(const protocol::LocaliseHint& hint);
   // Odometry thread: the anchor, once, when a try found it; `stamp_ns` is the
   // scan the odometry anchors from.
   std::optional<Eigen::Isometry3d> take_anchor(std::int64_t stamp_ns);
@@ -74,6 +84,7 @@ class PriorLocaliser {
   enum State : int { kFilling, kLocalising, kFound, kAnchored };
   void loop();
   void write_frame(const Eigen::Isometry3d& prior_from_odometry) const;
+  std::optional<slam::LocalisationHint> search_hint() const;
 
   const slam::PriorMap prior_;
   const slam::VoxelHashMap index_;
@@ -84,11 +95,15 @@ class PriorLocaliser {
   // Owned as state_ says.
   std::vector<Eigen::Vector3f> cloud_;
   Eigen::Isometry3d level_from_odometry_ = Eigen::Isometry3d::Identity();
+  double sensor_heading_rad_ = 0.0;  // the sensor's x in the levelled frame
   Eigen::Isometry3d anchor_ = Eigen::Isometry3d::Identity();
   int scans_ = 0;
   int skip_ = 0;                         // odometry thread: scans still to pass over before the next try
   std::uint64_t failures_seen_ = 0;      // odometry thread: stats_.failures when skip_ was last set
   std::int64_t first_stamp_ns_ = 0;  // odometry thread only
+  mutable std::mutex hint_mutex_;  // the endpoint's thread sets, the prior thread reads: never the odometry's
+  std::optional<protocol::LocaliseHint> hint_;
+  std::atomic<bool> hint_arrived_{false};  // the odometry thread then starts the next try at once
   PriorLocaliserStats stats_;
   StageThread thread_;
 };

@@ -35,6 +35,7 @@
 #include <thread>
 #include <vector>
 
+#include "adit/protocol/localise_hint.hpp"
 #include "adit/config/config.hpp"
 #include "adit/daemon/heartbeat.hpp"
 #include "adit/daemon/lcm_endpoint.hpp"
@@ -93,6 +94,9 @@ class Sessions {
   // Fills `into` with a stored session's tiles (tiles/*.adt); "" or why not.
   // `id` comes from the network: only a plain session name is accepted.
   std::string load_tiles(const std::string& id, TileStore& into) const;
+  // HINT: the running session's search against its prior map narrowed to
+  // `hint` (prior_localiser.hpp); "" or why not (no session, no prior, anchored).
+  std::string hint(const protocol::LocaliseHint& hint);
   // What the status message says about the running session (empty when idle).
   StatusSample status_sample();
   // Heartbeats of the running session's threads (empty when idle).

@@ -21,7 +21,7 @@
 
 namespace adit::protocol {
 
-enum class Verb { start, stop, export_map, ping, sessions };
+enum class Verb { start, stop, export_map, ping, sessions, hint };
 std::optional<Verb> parse_verb(std::string_view text);
 std::string_view verb_name(Verb verb);
 
