@@ -19,6 +19,7 @@
 #include "adit/daemon/output_stage.hpp"
 #include "adit/daemon/scan_odometry.hpp"
 #include "adit/daemon/thread_settings.hpp"
+#include "adit/protocol/map_import.hpp"
 #include "adit/slam/prior_map_file.hpp"
 
 namespace adit::daemon {
@@ -47,14 +48,35 @@ constexpr std::size_t kPriorCloudPoints = 400'000;
 
 // The prior map (prior_map.dir), read again for this pipeline: a bad one was
 // named at start (run.cpp), and the session maps without it.
-std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, const std::atomic<bool>& stop) {
-  if (c.prior_map.dir.empty()) return nullptr;
+// The prior (prior_map.dir, or a stored session's map prepared here: about
+// half a second for a 90 s session's 680 k points) and its localiser; none
+// when there is no prior or it is unusable (logged: the session maps without it).
+std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, const PipelineOptions& o,
+                                                   const std::atomic<bool>& stop, std::string& source) {
+  const bool from_session = c.prior_map.dir.empty() && !o.prior_session_map.empty();
+  source = from_session ? o.prior_session_map.string() : c.prior_map.dir;
+  if (source.empty()) return nullptr;
   try {
-    slam::PriorMap prior = slam::read_prior_map(c.prior_map.dir);
-    if (!slam::check_prior_map(prior).empty()) return nullptr;
+    slam::PriorMap prior;
+    if (from_session) {
+      const std::vector<protocol::MapPoint> map = protocol::read_map(o.prior_session_map);
+      std::vector<Eigen::Vector3f> points;
+      points.reserve(map.size());
+      for (const protocol::MapPoint& p : map) points.push_back(Eigen::Vector3d(p.x, p.y, p.z).cast<float>());
+      prior = slam::prepare_prior_map(points);
+    } else {
+      prior = slam::read_prior_map(c.prior_map.dir);
+    }
+    if (const std::string problem = slam::check_prior_map(prior); !problem.empty()) {
+      log::error("prior map {}: not usable ({}); mapping without it", source, problem);
+      source.clear();
+      return nullptr;
+    }
+    if (from_session) log::info("prior map: the previous session's map {} ({} points kept)", source, prior.points.size());
     return std::make_unique<PriorLocaliser>(std::move(prior), kPriorScansPerTry, kPriorCloudPoints, stop);
   } catch (const std::exception& e) {
-    log::error("prior map {}: {}; mapping without it", c.prior_map.dir, e.what());
+    log::error("prior map {}: {}; mapping without it", source, e.what());
+    source.clear();
     return nullptr;
   }
 }
@@ -90,7 +112,7 @@ struct Pipeline::Impl {
       imu->feed_poses_to(&*imu_poses);
       odometry.anchor_imu_poses_in(&*imu_poses);
     }
-    prior = prior_localiser_of(c, stop);
+    prior = prior_localiser_of(c, o, stop, prior_source);
     odometry.localise_against(prior.get());
   }
 
@@ -129,6 +151,7 @@ struct Pipeline::Impl {
   std::vector<std::string> memory_warnings;
   std::atomic<bool> started{false};
   std::int64_t started_ns = 0;
+  std::string prior_source;
   std::unique_ptr<PriorLocaliser> prior;  // last: its thread is joined before the rest goes
 };
 
@@ -234,6 +257,7 @@ const CanFeedStats* Pipeline::can_stats() const { return impl_->can ? &impl_->ca
 const ImuPoseFeed* Pipeline::imu_poses() const { return impl_->imu_poses ? &*impl_->imu_poses : nullptr; }
 const PriorLocaliser* Pipeline::prior_localiser() const { return impl_->prior.get(); }
 PriorLocaliser* Pipeline::prior_localiser() { return impl_->prior.get(); }
+const std::string& Pipeline::prior_source() const { return impl_->prior_source; }
 const TileSpill* Pipeline::tile_spill() const { return impl_->mapping ? impl_->mapping->tile_spill() : nullptr; }
 const std::vector<slam::Keyframe>& Pipeline::keyframes() const {
   return impl_->mapping ? impl_->mapping->keyframes() : impl_->no_keyframes;

@@ -78,11 +78,11 @@ nlohmann::json imu_summary(const ImuStats& imu) {
 
 // summary.json's "prior_map": whether the odometry localised against the
 // prior and anchored to it (prior_frame.json then places the session in it).
-nlohmann::json prior_summary(const PriorLocaliser* prior) {
+nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& source) {
   if (prior == nullptr) return {{"enabled", false}};
   const PriorLocaliserStats& s = prior->stats();
   const bool anchored = s.anchored.load();
-  return {{"enabled", true}, {"anchored", anchored},
+  return {{"enabled", true}, {"source", source}, {"anchored", anchored},
           {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
           {"tries", s.tries.load()}, {"failed_tries", s.failures.load()},
           {"scans_without_up", s.scans_without_up.load()}, {"hinted_tries", s.hinted_tries.load()}};
@@ -98,6 +98,21 @@ MapFrame session_frame(const PriorLocaliser* prior) {
   f.position = {anchor->translation().x(), anchor->translation().y(), anchor->translation().z()};
   f.orientation = {q.w(), q.x(), q.y(), q.z()};
   return f;
+}
+
+// The map of the newest session under `root` that was finished (its
+// summary.json written: stopped, or recovered after a crash); empty when none.
+// Session ids are UTC times, so the greatest name is the newest.
+std::filesystem::path newest_session_map(const std::filesystem::path& root) {
+  std::filesystem::path newest;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
+    const std::filesystem::path& d = entry.path();
+    if (!entry.is_directory() || !std::filesystem::exists(d / "summary.json") || !std::filesystem::exists(d / "map.ply"))
+      continue;
+    if (newest.empty() || d.filename() > newest.parent_path().filename()) newest = d / "map.ply";
+  }
+  return newest;
 }
 
 // summary.json's "loops": what loop closure found, accepted and refused, and
@@ -280,6 +295,8 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
                            static_cast<float>(c.resolution_m), c.patch_cells, {cells.begin(), cells.end()}});
     };
   }
+  if (config_.prior_map.previous_session && config_.prior_map.dir.empty())
+    options.prior_session_map = newest_session_map(root_);
   return std::make_unique<Pipeline>(config_, options);
 }
 
@@ -322,7 +339,6 @@ std::string Sessions::start_locked() {
   if (config_.session.record_lidar && config_.lidar.source != config::LidarSource::scan_dir)
     files.record_file = dir / "lidar.pcap";  // a directory of scans has no packets to record
   if (config_.can.enabled && config_.can.record) files.can_record_file = dir / "can.log";
-  if (!config_.prior_map.dir.empty()) files.prior_frame_file = dir / "prior_frame.json";
   if (config_.session.journal) {
     files.journal_file = dir / "journal.adj";
     files.journal_header = nlohmann::json{{"session", id},
@@ -335,6 +351,7 @@ std::string Sessions::start_locked() {
   }
   try {
     if (!pipeline) pipeline = build_pipeline();  // the last one could not be built ahead
+    if (pipeline->prior_localiser() != nullptr) files.prior_frame_file = dir / "prior_frame.json";
     pipeline->start(files);
   } catch (...) {
     std::filesystem::remove_all(dir, ec);  // nothing was recorded: leave no empty session behind
@@ -505,7 +522,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"can", can_summary(pipeline->can_stats())},
         {"host_clock", {{"steps", s.clock_steps.load()}, {"last_step_s", 1e-9 * static_cast<double>(s.last_clock_step_ns.load())}}},
         {"loops", loops_summary(loops, track, corrected)},
-        {"prior_map", prior_summary(pipeline->prior_localiser())},
+        {"prior_map", prior_summary(pipeline->prior_localiser(), pipeline->prior_source())},
         {"frame", frame_summary(anchor)},
         {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},

@@ -24,6 +24,8 @@ void check_consistency(const Config& c, const ReadContext& ctx) {
     throw InputError(fmt::format("{}:{}", ctx.file, line), key, reason);
   };
 
+  if (c.prior_map.previous_session && !c.prior_map.dir.empty())
+    fail("prior_map.previous_session", "prior_map", "choose one prior: prior_map.dir or the previous session's map");
   if (c.lidar.source == LidarSource::pcap && c.lidar.pcap.empty())
     fail("lidar.pcap", "lidar.source", "required when lidar.source is pcap");
   if (c.lidar.source == LidarSource::scan_dir && c.lidar.scan_dir.empty())

@@ -303,5 +303,22 @@ TEST(ConfigLoader, PriorMapMustBeAPreparedFolder) {
             dir.string());
 }
 
+TEST(ConfigLoader, ThePreviousSessionOrAPriorDirectoryNotBoth) {
+  EXPECT_FALSE(parse_config(kMinimal, "test.yaml", "/base").prior_map.previous_session);
+  EXPECT_TRUE(parse_config(std::string(kMinimal) + "prior_map:\n  previous_session: true\n", "test.yaml", "/base")
+                  .prior_map.previous_session);
+  const auto dir = std::filesystem::temp_directory_path() / "adit_config_prior";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "prior_map.bin") << "x";
+  try {
+    parse_config(std::string(kMinimal) + "prior_map:\n  dir: " + dir.string() + "\n  previous_session: true\n",
+                 "test.yaml", "/base");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "prior_map.previous_session") << e.what();
+    EXPECT_NE(std::string(e.what()).find("choose one prior"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace adit::config

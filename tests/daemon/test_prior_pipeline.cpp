@@ -21,6 +21,7 @@
 #include "adit/protocol/map_import.hpp"
 #include "adit/slam/prior_map.hpp"
 #include "adit/slam/prior_map_file.hpp"
+#include "adit/eval/align.hpp"
 #include "adit/eval/associate.hpp"
 #include "adit/eval/trajectory_io.hpp"
 #include "pipeline_run.hpp"
@@ -106,6 +107,61 @@ TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndTheSessionIsInItsFrame) {
   // 1.5 cm measured (two runs): the range noise and the prior's differences;
   // a map left in the odometry frame lies metres off.
   EXPECT_LT(median, 0.03F);
+}
+
+// prior_map.previous_session: a survey carried on after a stop. One session
+// maps a drive; the next, on another drive of the same floor, takes that map
+// as its prior, localises in it and is written in its frame: its trajectory
+// follows its truth carried into the first session's frame (by the first
+// session's first pose), with no fit of its own.
+TEST(PriorPipeline, TheNextSessionContinuesInThePreviousSessionsFrame) {
+  const std::filesystem::path first =
+      simulated_session("session-building-robot-30s", "--scene building --platform robot --duration 30 --seed 3");
+  const std::filesystem::path second =
+      simulated_session("session-building-robot-s2", "--scene building --platform robot --duration 15 --seed 2");
+  const TempFolder work;
+  const auto run = [](const config::Config& c) {
+    daemon::Sessions sessions(c, {});
+    const std::string id = sessions.start();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!sessions.poll() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    sessions.stop_and_wait();
+    return sessions.folder(id);
+  };
+  config::Config c1 = replay_config(first, work.path(), "session:\n  products: false\n");
+  c1.lidar.replay_speed = 0.0;  // as fast as it goes: a map is all it must leave
+  const std::filesystem::path dir1 = run(c1);
+  config::Config c2 = replay_config(second, work.path(), "session:\n  products: false\n");
+  c2.lidar.replay_speed = 1.0;
+  c2.prior_map.previous_session = true;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // session ids are whole seconds
+  const std::filesystem::path dir2 = run(c2);
+
+  std::ifstream summary_in(dir2 / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_in, nullptr, false);
+  ASSERT_TRUE(summary.is_object());
+  EXPECT_EQ(summary["prior_map"]["source"], (dir1 / "map.ply").string());
+  ASSERT_TRUE(summary["prior_map"]["anchored"].get<bool>()) << summary["prior_map"].dump();
+  EXPECT_EQ(summary["frame"]["name"], "prior_map");
+
+  // The first session's frame in the world, from its first pose (this short
+  // out-and-back drive is too straight for a fit of its whole path to fix a roll).
+  const eval::Associated a1 =
+      eval::associate(eval::read_tum(first / "truth_body.tum"), eval::read_tum(dir1 / "trajectory.tum"), 0.02);
+  const std::optional<eval::Similarity> first_from_world = eval::align_trajectory(a1.est, a1.ref, eval::Alignment::origin);
+  ASSERT_TRUE(first_from_world.has_value());
+  const eval::Associated a2 =
+      eval::associate(eval::read_tum(second / "truth_body.tum"), eval::read_tum(dir2 / "trajectory.tum"), 0.02);
+  ASSERT_GT(a2.ref.size(), 100U);
+  const double anchored_from = a2.stamps.front() + summary["prior_map"]["anchored_after_s"].get<double>() + 1.0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a2.ref.size(); ++i)
+    if (a2.stamps[i] >= anchored_from)
+      worst = std::max(worst, (a2.est[i].translation() - first_from_world->apply(a2.ref[i].translation())).norm());
+  std::printf("second session anchored after %.1f s in the first's map; worst position error in its frame after "
+              "it: %.3f m\n", summary["prior_map"]["anchored_after_s"].get<double>(), worst);
+  EXPECT_LT(worst, 0.05);  // the first session's own map error is in it
 }
 
 TEST(PriorPipeline, WithoutAPriorThereIsNoLocaliser) {

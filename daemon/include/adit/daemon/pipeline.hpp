@@ -43,6 +43,10 @@ struct PipelineOptions {
   double replay_speed = -1.0;             // pcap/scan_dir: overrides lidar.replay_speed when ≥ 0
   slam::OdometryConfig odometry;          // range limits come from the lidar section
   bool mapping = true;                    // run the mapping thread (config `map` section)
+  // A stored session's map (map.ply) to localise against and follow, prepared
+  // as a prior when the pipeline is built (prior_map.previous_session); used
+  // only without prior_map.dir. Empty: none.
+  std::filesystem::path prior_session_map;
   PipelineSinks sinks;
 };
 
@@ -119,6 +123,8 @@ class Pipeline {
   // Localisation against the prior map (prior_map.dir); null without a usable prior.
   const PriorLocaliser* prior_localiser() const;
   PriorLocaliser* prior_localiser();  // for a hint (HINT)
+  // Where the prior came from (prior_map.dir or the stored session's map); "" without one.
+  const std::string& prior_source() const;
 
  private:
   struct Impl;

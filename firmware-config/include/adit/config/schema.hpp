@@ -226,6 +226,7 @@ void describe(V& v, GridSection& s) {
 template <typename V>
 void describe(V& v, PriorMapSection& s) {
   v.optional("dir", s.dir);
+  v.optional("previous_session", s.previous_session);
 }
 
 template <typename V>
