@@ -191,6 +191,27 @@ command_t command(const Harness& h, std::int64_t id, const std::string& verb) {
   return c;
 }
 
+// Poses at 10 Hz (`position(i)`) and a status every fifth (`status(i, utime)`)
+// from a thread of their own while `body` runs.
+template <typename Position, typename Status, typename Body>
+void feed_while(Harness& h, Position position, Status status, Body body) {
+  std::atomic<bool> feeding{true};
+  std::thread feeder([&] {
+    for (int i = 0; feeding; ++i) {
+      PoseSample p;
+      p.utime = i * 100'000;
+      p.position = position(i);
+      p.flags = 1;
+      h.endpoint->publish_pose(p);  // scan rate: 10 Hz
+      if (i % 5 == 0) h.endpoint->publish_status(status(i, p.utime));  // status: 2 Hz
+      std::this_thread::sleep_for(100ms);
+    }
+  });
+  body();
+  feeding = false;
+  feeder.join();
+}
+
 TEST(LcmEndpoint, StartAndStopChangeTheStateWithAcks) {
   Harness h;
   auto r = h.adit({"start"});
@@ -242,26 +263,16 @@ TEST(LcmEndpoint, AcksArriveWithin100ms) {
 TEST(LcmEndpoint, PosesAndStatusArriveInWatch) {
   Harness h;
   ASSERT_EQ(h.adit({"start"}).exit_status, 0);
-  std::atomic<bool> feeding{true};
-  std::thread feeder([&] {
-    for (int i = 0; feeding; ++i) {
-      PoseSample p;
-      p.utime = i * 100'000;
-      p.position = {0.1 * i, 0, 1};
-      p.flags = 1;
-      h.endpoint->publish_pose(p);  // scan rate: 10 Hz
-      if (i % 5 == 0) {             // status: 2 Hz
+  test::ProgramResult r;
+  feed_while(
+      h, [](int i) { return std::array<double, 3>{0.1 * i, 0, 1}; },
+      [](int, std::int64_t utime) {
         StatusSample s;
-        s.sensors.push_back({"lidar0", 10.0f, 0, p.utime, 0.0f});
+        s.sensors.push_back({"lidar0", 10.0f, 0, utime, 0.0f});
         s.disk_free_bytes = 5'000'000'000;
-        h.endpoint->publish_status(std::move(s));
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-  });
-  const auto r = h.adit({"watch", "--duration", "2"});
-  feeding = false;
-  feeder.join();
+        return s;
+      },
+      [&] { r = h.adit({"watch", "--duration", "2"}); });
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("MAPPING s1 | lidar0 10.0 Hz"), std::string::npos) << r.out;
   std::size_t poses = 0;
@@ -278,29 +289,19 @@ TEST(LcmEndpoint, PosesAndStatusArriveInWatch) {
 TEST(LcmEndpoint, TheFrameGoesOutWithTheStatusAndWatchShowsThePoseInIt) {
   Harness h;
   ASSERT_EQ(h.adit({"start"}).exit_status, 0);
-  std::atomic<bool> feeding{true};
-  std::thread feeder([&] {
-    for (int i = 0; feeding; ++i) {
-      PoseSample p;
-      p.utime = i * 100'000;
-      p.position = {1.0, 0.0, 1.0};
-      p.flags = 1;
-      h.endpoint->publish_pose(p);
-      if (i % 5 == 0) {
+  test::ProgramResult r;
+  feed_while(
+      h, [](int) { return std::array<double, 3>{1.0, 0.0, 1.0}; },
+      [](int i, std::int64_t) {
         StatusSample s;
         MapFrame f;  // a quarter turn about z, then 100 m east and 50 m north
         f.source = 1;
         f.position = {100.0, 50.0, 0.0};
         f.orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
         if (i >= 5) s.frame = f;  // the first status has none yet: identity
-        h.endpoint->publish_status(std::move(s));
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-  });
-  const auto r = h.adit({"watch", "--duration", "2"});
-  feeding = false;
-  feeder.join();
+        return s;
+      },
+      [&] { r = h.adit({"watch", "--duration", "2"}); });
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("x 100.00 y 51.00 z 1.00 (prior map)"), std::string::npos) << r.out;
   EXPECT_GE(h.endpoint->counters().frames_published.load(), 3U);
