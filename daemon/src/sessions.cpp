@@ -100,17 +100,22 @@ MapFrame session_frame(const PriorLocaliser* prior) {
   return f;
 }
 
-// The map of the newest session under `root` that was finished (its
-// summary.json written: stopped, or recovered after a crash); empty when none.
-// Session ids are UTC times, so the greatest name is the newest.
+// The map file (map.ply, else .las, else .pcd: session.exports) of the newest
+// session under `root` that was finished (its summary.json written: stopped,
+// or recovered after a crash); empty when none. Session ids are UTC times, so
+// the greatest name is the newest.
 std::filesystem::path newest_session_map(const std::filesystem::path& root) {
   std::filesystem::path newest;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
     const std::filesystem::path& d = entry.path();
-    if (!entry.is_directory() || !std::filesystem::exists(d / "summary.json") || !std::filesystem::exists(d / "map.ply"))
-      continue;
-    if (newest.empty() || d.filename() > newest.parent_path().filename()) newest = d / "map.ply";
+    if (!entry.is_directory() || !std::filesystem::exists(d / "summary.json")) continue;
+    if (!newest.empty() && d.filename() <= newest.parent_path().filename()) continue;
+    for (const char* name : {"map.ply", "map.las", "map.pcd"})
+      if (std::filesystem::exists(d / name)) {
+        newest = d / name;
+        break;
+      }
   }
   return newest;
 }

@@ -57,7 +57,8 @@ async function clickWhenDrawn(page, selector) {
 }
 
 function watchErrors(page, errors) {
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  // With the resource's address: a 404 alone does not say which request failed.
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()} ${m.location()?.url ?? ''}`); });
   page.on('pageerror', (e) => errors.push(`page: ${e.message}`));
 }
 const t0 = Date.now();

@@ -258,7 +258,7 @@ struct SessionSection {
 // it too (daemon/prior_localiser.hpp).
 struct PriorMapSection {
   std::string dir;  // the prepared folder (prior_map.bin); empty: no prior
-  // Without `dir`: the newest finished session's map.ply is each session's
+  // Without `dir`: the newest finished session's map file is each session's
   // prior, so a survey carried on after a stop (a battery swap) continues in
   // the frame of the one before (docs/PRIOR-MAP.md, "The previous session").
   bool previous_session = false;
