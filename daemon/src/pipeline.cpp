@@ -19,7 +19,7 @@
 #include "adit/daemon/output_stage.hpp"
 #include "adit/daemon/scan_odometry.hpp"
 #include "adit/daemon/thread_settings.hpp"
-#include "adit/protocol/map_import.hpp"
+#include "adit/protocol/prior_input.hpp"
 #include "adit/slam/prior_map_file.hpp"
 
 namespace adit::daemon {
@@ -46,11 +46,10 @@ ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& sou
 constexpr int kPriorScansPerTry = 10;
 constexpr std::size_t kPriorCloudPoints = 400'000;
 
-// The prior map (prior_map.dir), read again for this pipeline: a bad one was
-// named at start (run.cpp), and the session maps without it.
-// The prior (prior_map.dir, or a stored session's map prepared here: about
-// half a second for a 90 s session's 680 k points) and its localiser; none
-// when there is no prior or it is unusable (logged: the session maps without it).
+// The prior (prior_map.dir, read again for this pipeline: a bad one was named
+// at start in run.cpp; or a stored session's map prepared here: about half a
+// second for a 90 s session's 680 k points) and its localiser; none when there
+// is no prior or it is unusable (logged: the session maps without it).
 std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, const PipelineOptions& o,
                                                    const std::atomic<bool>& stop, std::string& source) {
   const bool from_session = c.prior_map.dir.empty() && !o.prior_session_map.empty();
@@ -59,10 +58,10 @@ std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, cons
   try {
     slam::PriorMap prior;
     if (from_session) {
-      const std::vector<protocol::MapPoint> map = protocol::read_map(o.prior_session_map);
-      std::vector<Eigen::Vector3f> points;
-      points.reserve(map.size());
-      for (const protocol::MapPoint& p : map) points.push_back(Eigen::Vector3d(p.x, p.y, p.z).cast<float>());
+      const protocol::PriorInput input = protocol::read_prior_input(o.prior_session_map);
+      std::vector<Eigen::Vector3f> points(input.points.size());
+      for (std::size_t i = 0; i < points.size(); ++i)
+        points[i] = Eigen::Vector3f(input.points[i][0], input.points[i][1], input.points[i][2]);
       prior = slam::prepare_prior_map(points);
     } else {
       prior = slam::read_prior_map(c.prior_map.dir);

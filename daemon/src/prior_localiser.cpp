@@ -12,7 +12,6 @@
 #include <numbers>
 #include <thread>
 
-
 #include <fmt/format.h>
 
 #include "adit/common/log.hpp"

@@ -31,6 +31,28 @@
 namespace adit::test {
 namespace {
 
+// Polls `sessions` until its replay has ended (or two minutes).
+void run_to_end(daemon::Sessions& sessions) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!sessions.poll() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+nlohmann::json read_summary(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in, nullptr, false);
+}
+
+// The largest distance from `from_s` on between the estimate's positions and
+// the truth's carried into the estimate's frame by `frame_from_world`.
+double worst_error_after(const eval::Associated& a, double from_s, const eval::Similarity& frame_from_world = {}) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.ref.size(); ++i)
+    if (a.stamps[i] >= from_s)
+      worst = std::max(worst, (a.est[i].translation() - frame_from_world.apply(a.ref[i].translation())).norm());
+  return worst;
+}
+
 TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndTheSessionIsInItsFrame) {
   const std::filesystem::path session =
       simulated_session("session-building-robot", "--scene building --platform robot --duration 15 --seed 3");
@@ -42,26 +64,20 @@ TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndTheSessionIsInItsFrame) {
   config::Config c = replay_config(session, work.path(), "session:\n  products: false\n");
   c.lidar.replay_speed = 1.0;  // live pace: localisation takes a second or two of a core
   c.prior_map.dir = prior_dir.string();
-  std::string id;
   std::filesystem::path dir;
-  double anchored_after_s = 0.0;
   {
     daemon::Sessions sessions(c, {});
     const protocol::LocaliseHint hint;  // HINT reaches the running session's localiser only
     EXPECT_EQ(sessions.hint(hint), "no session is mapping");
-    id = sessions.start();
-    dir = sessions.folder(id);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!sessions.poll() && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    dir = sessions.folder(sessions.start());
+    run_to_end(sessions);
     EXPECT_EQ(sessions.hint(hint), "already localised in the prior map");
     sessions.stop_and_wait();
   }
-  std::ifstream summary_in(dir / "summary.json");
-  const nlohmann::json summary = nlohmann::json::parse(summary_in, nullptr, false);
+  const nlohmann::json summary = read_summary(dir);
   ASSERT_TRUE(summary.is_object());
   ASSERT_TRUE(summary["prior_map"]["anchored"].get<bool>()) << summary["prior_map"].dump();
-  anchored_after_s = summary["prior_map"]["anchored_after_s"].get<double>();
+  const double anchored_after_s = summary["prior_map"]["anchored_after_s"].get<double>();
   // Within the drive with a second to spare (about 2-3 s on an idle machine; CI runs tests side by side).
   EXPECT_LT(anchored_after_s, 12.0);
   const std::optional<Eigen::Isometry3d> prior_from_odometry = daemon::read_prior_frame(dir / "prior_frame.json");
@@ -76,14 +92,9 @@ TEST(PriorPipeline, TheOdometryAnchorsToThePriorAndTheSessionIsInItsFrame) {
   const slam::Trajectory estimate = eval::read_tum(dir / "trajectory.tum");
   const eval::Associated a = eval::associate(truth, estimate, 0.02);
   ASSERT_GT(a.ref.size(), 100U);
-  double worst_after = 0.0;
   // From a second after the scan the odometry anchored from: the prior pulls
   // the pose in from the localisation's error (σ about 1.5 cm) within a few scans.
-  const double anchored_from = a.stamps.front() + anchored_after_s + 1.0;
-  for (std::size_t i = 0; i < a.ref.size(); ++i) {
-    if (a.stamps[i] < anchored_from) continue;
-    worst_after = std::max(worst_after, (a.est[i].translation() - a.ref[i].translation()).norm());
-  }
+  const double worst_after = worst_error_after(a, a.stamps.front() + anchored_after_s + 1.0);
   // And the map lies on the prior, its differences aside: the median point's
   // distance to the prior's plane there, over the points that have one.
   const slam::PriorMap prior = slam::read_prior_map(prior_dir);
@@ -122,12 +133,10 @@ TEST(PriorPipeline, TheNextSessionContinuesInThePreviousSessionsFrame) {
   const TempFolder work;
   const auto run = [](const config::Config& c) {
     daemon::Sessions sessions(c, {});
-    const std::string id = sessions.start();
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!sessions.poll() && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::filesystem::path dir = sessions.folder(sessions.start());
+    run_to_end(sessions);
     sessions.stop_and_wait();
-    return sessions.folder(id);
+    return dir;
   };
   config::Config c1 = replay_config(first, work.path(), "session:\n  products: false\n");
   c1.lidar.replay_speed = 0.0;  // as fast as it goes: a map is all it must leave
@@ -138,8 +147,7 @@ TEST(PriorPipeline, TheNextSessionContinuesInThePreviousSessionsFrame) {
   std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // session ids are whole seconds
   const std::filesystem::path dir2 = run(c2);
 
-  std::ifstream summary_in(dir2 / "summary.json");
-  const nlohmann::json summary = nlohmann::json::parse(summary_in, nullptr, false);
+  const nlohmann::json summary = read_summary(dir2);
   ASSERT_TRUE(summary.is_object());
   EXPECT_EQ(summary["prior_map"]["source"], (dir1 / "map.ply").string());
   ASSERT_TRUE(summary["prior_map"]["anchored"].get<bool>()) << summary["prior_map"].dump();
@@ -154,11 +162,9 @@ TEST(PriorPipeline, TheNextSessionContinuesInThePreviousSessionsFrame) {
   const eval::Associated a2 =
       eval::associate(eval::read_tum(second / "truth_body.tum"), eval::read_tum(dir2 / "trajectory.tum"), 0.02);
   ASSERT_GT(a2.ref.size(), 100U);
-  const double anchored_from = a2.stamps.front() + summary["prior_map"]["anchored_after_s"].get<double>() + 1.0;
-  double worst = 0.0;
-  for (std::size_t i = 0; i < a2.ref.size(); ++i)
-    if (a2.stamps[i] >= anchored_from)
-      worst = std::max(worst, (a2.est[i].translation() - first_from_world->apply(a2.ref[i].translation())).norm());
+  const double worst =
+      worst_error_after(a2, a2.stamps.front() + summary["prior_map"]["anchored_after_s"].get<double>() + 1.0,
+                        *first_from_world);
   std::printf("second session anchored after %.1f s in the first's map; worst position error in its frame after "
               "it: %.3f m\n", summary["prior_map"]["anchored_after_s"].get<double>(), worst);
   EXPECT_LT(worst, 0.05);  // the first session's own map error is in it

@@ -109,9 +109,8 @@ void register_watch(CLI::App& app, int& status) {
     double pose_rate = 0;
     auto rate_window = start;
     std::size_t rate_count = 0;
-    pose_t pose;
-    frame_t frame;  // map <- odometry (frame_t); the pose is shown in the map frame
-    frame.source = frame_t::SOURCE_ODOMETRY;
+    pose_t pose{};  // value-initialised: LCM types leave numbers unset
+    frame_t frame{};  // map <- odometry; none yet (a zero quaternion): identity, the odometry frame
     std::string health = "(no status yet)";
     bool any = false;
     const auto print = [&] {
@@ -130,29 +129,28 @@ void register_watch(CLI::App& app, int& status) {
       if (f.session_id == pose.session_id || pose.session_id.empty()) frame = f;
     };
     handlers.pose = [&](const pose_t& p) {
-          pose = p;
-          ++poses;
-          ++rate_count;
-          any = true;
-          last_message = Clock::now();
-          if (elapsed(rate_window) >= 1.0) {
-            pose_rate = rate_count / elapsed(rate_window);
-            rate_count = 0;
-            rate_window = Clock::now();
-          }
-          if (elapsed(last_print) >= 0.1) print();
-        };
+      pose = p;
+      ++poses;
+      ++rate_count;
+      any = true;
+      last_message = Clock::now();
+      if (elapsed(rate_window) >= 1.0) {
+        pose_rate = rate_count / elapsed(rate_window);
+        rate_count = 0;
+        rate_window = Clock::now();
+      }
+      if (elapsed(last_print) >= 0.1) print();
+    };
     handlers.status = [&](const status_t& s) {
-          health = status_line(s);
-          any = true;
-          last_message = Clock::now();
-          print();
-        };
-    client.follow(handlers,
-        [&] {
-          if (elapsed(last_message) > options->timeout_s) silent = true;
-          return silent || (*duration > 0 && elapsed(start) >= *duration);
-        });
+      health = status_line(s);
+      any = true;
+      last_message = Clock::now();
+      print();
+    };
+    client.follow(handlers, [&] {
+      if (elapsed(last_message) > options->timeout_s) silent = true;
+      return silent || (*duration > 0 && elapsed(start) >= *duration);
+    });
     if (any) fmt::print("\n{} poses received\n", poses);
     status = silent && !any ? no_answer(*options) : kExitOk;
     if (silent && any) {

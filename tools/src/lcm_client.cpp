@@ -144,12 +144,6 @@ Eigen::Isometry3d map_from_odometry(const frame_t& frame) {
   return t;
 }
 
-void LcmClient::watch(const std::function<void(const pose_t&)>& on_pose,
-                      const std::function<void(const status_t&)>& on_status, const std::function<bool()>& until) {
-  follow({.pose = on_pose, .status = on_status, .tile_index = {}, .tile_segment = {}, .grid_patch = {}, .frame = {}},
-         until);
-}
-
 void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
   // Subscribes `channel` for as long as the follow lasts, when `handler` is set.
   const auto listen = [this]<typename Message>(Channel channel, const std::function<void(const Message&)>& handler) {

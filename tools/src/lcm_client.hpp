@@ -52,10 +52,6 @@ class LcmClient {
   double last_round_trip_ms() const;
   std::optional<status_t> wait_status();
 
-  // Calls `on_pose`/`on_status` for every message until `until` returns true.
-  void watch(const std::function<void(const pose_t&)>& on_pose, const std::function<void(const status_t&)>& on_status,
-             const std::function<bool()>& until);
-
   // Everything a live view follows; an empty handler is not subscribed.
   struct FollowHandlers {
     std::function<void(const pose_t&)> pose;
