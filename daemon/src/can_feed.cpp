@@ -13,6 +13,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/daemon/can_imu_pairing.hpp"
+#include "adit/daemon/extrinsics.hpp"
 #include "adit/daemon/imu_monitor.hpp"
 #include "adit/drivers/can/candump.hpp"
 #include "adit/drivers/can/decoder.hpp"
@@ -187,11 +188,7 @@ struct CanFeed::Impl {
           limits[3 + axis] = encoding_limits(messages, wanted[first_imu + 3 + axis].first, converts(c));
         }
       }
-      const auto rad = [](double deg) { return deg * std::numbers::pi / 180.0; };
-      imu_to_body = (Eigen::AngleAxisd(rad(c.imu.rpy_deg[2]), Eigen::Vector3d::UnitZ()) *
-                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[1]), Eigen::Vector3d::UnitY()) *
-                     Eigen::AngleAxisd(rad(c.imu.rpy_deg[0]), Eigen::Vector3d::UnitX()))
-                        .toRotationMatrix();
+      imu_to_body = rotation_of_rpy_deg(c.imu.rpy_deg);
     }
     values.resize(decoder.slot_count());
     if (c.can.source == config::CanSource::candump) {

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <numbers>
 
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
@@ -24,6 +25,7 @@
 #include "adit/sim/imu.hpp"
 #include "adit/sim/wheel_encoders.hpp"
 #include "adit/drivers/can/candump.hpp"
+#include "adit/slam/roll_pitch_yaw.hpp"
 
 namespace adit::sim {
 namespace {
@@ -33,12 +35,14 @@ void require(bool ok, const std::string& key, const std::string& reason) {
 }
 
 // Where the sensor sits: on the robot as in the VLP-16 robot template; on top
-// of the drone; 0.10 m above the walker's hand (about 1.5 m above the floor).
-Eigen::Isometry3d sensor_extrinsics(const std::string& platform) {
+// of the drone; 0.10 m above the walker's hand (about 1.5 m above the floor);
+// turned on its bracket by --mount-rpy-deg.
+Eigen::Isometry3d sensor_extrinsics(const SimOptions& o) {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.translation() = platform == "drone"      ? Eigen::Vector3d(0.0, 0.0, 0.12)
-                    : platform == "handheld" ? Eigen::Vector3d(0.0, 0.0, 0.10)
-                                             : Eigen::Vector3d(0.20, 0.0, 0.45);
+  e.translation() = o.platform == "drone"      ? Eigen::Vector3d(0.0, 0.0, 0.12)
+                    : o.platform == "handheld" ? Eigen::Vector3d(0.0, 0.0, 0.10)
+                                               : Eigen::Vector3d(0.20, 0.0, 0.45);
+  e.linear() = slam::rotation_from_rpy(o.mount_rpy_deg * std::numbers::pi / 180.0);
   return e;
 }
 
@@ -74,7 +78,7 @@ Scene simulated_scene(const SimOptions& o) {
   return make_mine(o.seed);
 }
 
-Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extrinsics(o.platform); }
+Eigen::Isometry3d simulated_extrinsics(const SimOptions& o) { return sensor_extrinsics(o); }
 
 People simulated_people(const Scene& scene, const SimOptions& o) { return make_people(scene, o.people, o.seed); }
 
@@ -105,13 +109,13 @@ ImuOptions simulated_imu(const SimOptions& o, SimImuSource source) {
       for (int k = 0; k < 3; ++k) imu_to_sensor.linear()(r, k) = m.imu_to_sensor[static_cast<std::size_t>(4 * r + k)];
       imu_to_sensor.translation()(r) = m.imu_to_sensor[static_cast<std::size_t>(4 * r + 3)] * 1e-3;
     }
-    imu.mount = sensor_extrinsics(o.platform) * imu_to_sensor;
+    imu.mount = sensor_extrinsics(o) * imu_to_sensor;
     imu.rate_hz = o.imu_rate_hz > 0.0 ? o.imu_rate_hz : 100.0;
     imu.time_offset_s = o.imu_time_offset_s;  // the LiDAR's and the IMU's stamps come from one clock
     imu.seed = o.seed ^ 0x4F5374496D75ULL;    // another unit than a CAN IMU's in the same session
   } else if (source == SimImuSource::livox) {
     // Inside the sensor (livox_lidar.hpp), at its 200 Hz.
-    imu.mount = sensor_extrinsics(o.platform) * livox_mid360_imu_in_sensor();
+    imu.mount = sensor_extrinsics(o) * livox_mid360_imu_in_sensor();
     imu.rate_hz = 200.0;
     imu.time_offset_s = o.imu_time_offset_s;  // stamped by the sensor's clock, as its points
     imu.seed = o.seed ^ 0x4C69766F78ULL;      // another unit than a CAN IMU's
@@ -166,6 +170,8 @@ void validate(const SimOptions& o) {
   require(std::isfinite(o.speed_mps) && o.speed_mps >= 0.0 && o.speed_mps <= fastest, "--speed",
           "the " + o.platform + " moves at (0, " + std::to_string(fastest) + "] m/s (0: its own pace)");
   require(std::isfinite(o.lateral_offset_m), "--lateral-offset-m", "must be a number");
+  require(o.mount_rpy_deg.allFinite() && o.mount_rpy_deg.cwiseAbs().maxCoeff() <= 180.0, "--mount-rpy-deg",
+          "must be three angles within ±180°");
   require(std::isfinite(o.ground_s) && o.ground_s >= 0.0 && o.ground_s <= 60.0, "--ground-s",
           "must be 0-60 s");
   require(std::isfinite(o.wheel_radius_error) && std::abs(o.wheel_radius_error) <= 0.1, "--wheel-radius-error",
@@ -234,7 +240,7 @@ SimSummary run_simulation(const SimOptions& o) {
   lidar.rpm = o.rpm;
   lidar.seed = o.seed;
   lidar.start_time_ns = o.start_time_ns;
-  lidar.extrinsics = sensor_extrinsics(o.platform);
+  lidar.extrinsics = sensor_extrinsics(o);
   lidar.threads = o.threads;
   const SimImuSource imu_source = simulated_imu_source(o);
   // An Ouster sends its IMU's packets beside the LiDAR's (to port 7503, from

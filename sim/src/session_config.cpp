@@ -8,16 +8,14 @@
 
 #include "adit/common/error.hpp"
 #include "adit/sim/imu_frames.hpp"
+#include "adit/slam/roll_pitch_yaw.hpp"
 
 namespace adit::sim {
 
 namespace {
 
-// Roll, pitch, yaw in degrees (z-y-x Euler angles), "+ 0.0": no "-0".
-Eigen::Vector3d rpy_deg(const Eigen::Matrix3d& r) {
-  const Eigen::Vector3d ypr = r.eulerAngles(2, 1, 0);
-  return Eigen::Vector3d(ypr.z() + 0.0, ypr.y() + 0.0, ypr.x() + 0.0) * 180.0 / std::numbers::pi;
-}
+// Roll, pitch, yaw in degrees as the config reads them.
+Eigen::Vector3d rpy_deg(const Eigen::Matrix3d& r) { return slam::rpy_of(r) * (180.0 / std::numbers::pi); }
 
 }  // namespace
 
@@ -33,7 +31,7 @@ void write_session_config(const std::filesystem::path& file, const SimOptions& o
       "log:\n  level: info\n\n"
       "lidar:\n  model: {}\n  source: pcap\n  pcap: lidar.pcap\n{}  replay_speed: 1.0\n"
       "  return_mode: strongest\n  min_range_m: {}\n  max_range_m: {}\n"
-      "  extrinsics:\n    xyz_m: [{}, {}, {}]\n    rpy_deg: [{}, {}, {}]\n\n",
+      "  extrinsics:\n    xyz_m: [{}, {}, {}]\n    rpy_deg: [{:.9g}, {:.9g}, {:.9g}]\n\n",
       o.scene, o.platform, o.sensor, o.duration_s, o.seed, o.scene, o.seed, o.sensor,
       calibration_file.empty() ? std::string() : "  calibration: " + calibration_file + "\n", o.min_range_m, o.max_range_m,
       t.x(), t.y(), t.z(), rpy.x() + 0.0, rpy.y() + 0.0, rpy.z() + 0.0);  // + 0.0: no "-0"

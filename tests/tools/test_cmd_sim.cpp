@@ -34,7 +34,8 @@ TEST(CmdSim, ImpossibleOptionsExitWithStatus2) {
   const auto out = adit::test::binary_dir() / "test-sessions" / "cmd-sim-bad";
   for (const auto& [options, key] : {std::pair{"--sensor HDL-64E", "--sensor"}, std::pair{"--duration -3", "--duration"},
                                      std::pair{"--platform boat", "--platform"}, std::pair{"--speed 2", "--speed"},
-                                     std::pair{"--lateral-offset-m 4", "--lateral-offset-m"}}) {
+                                     std::pair{"--lateral-offset-m 4", "--lateral-offset-m"},
+                                     std::pair{"--mount-rpy-deg 200 0 0", "--mount-rpy-deg"}}) {
     const CommandRun run = adit(std::string("sim ") + options + " --out " + out.string());
     EXPECT_EQ(run.status, 2) << options << ": " << run.output;
     EXPECT_NE(run.output.find(key), std::string::npos) << options << ": " << run.output;

@@ -65,6 +65,10 @@ void register_sim_commands(CLI::App& app, int& status) {
                   "σ of the accelerometer's turn-on bias per axis, m/s²")
       ->capture_default_str();
   cmd->add_option_function<std::vector<double>>(
+         "--mount-rpy-deg", [o](const std::vector<double>& v) { o->mount_rpy_deg = Eigen::Vector3d(v[0], v[1], v[2]); },
+         "The LiDAR's mounting rotation on the platform: roll pitch yaw, degrees, applied Z·Y·X (default 0 0 0)")
+      ->expected(3);
+  cmd->add_option_function<std::vector<double>>(
          "--imu-position-m", [o](const std::vector<double>& v) { o->imu_position_m = Eigen::Vector3d(v[0], v[1], v[2]); },
          "A CAN IMU's origin in the body frame x y z, metres (the lever arm; default 0 0 0)")
       ->expected(3);

@@ -41,6 +41,9 @@ struct SimOptions {
   double speed_mps = 0.0;  // 0: the platform's own pace (robot, drone 1.0 m/s; handheld 1.3 m/s)
   double lateral_offset_m = 0.0;
   double ground_s = 0.0;  // drone: s on the floor, rotors running, before the take-off
+  // The LiDAR's mounting rotation on the platform (roll, pitch, yaw in
+  // degrees, the config's Z·Y·X): a sensor tilted or turned on its bracket.
+  Eigen::Vector3d mount_rpy_deg = Eigen::Vector3d::Zero();
   // Wheels
   bool wheels = true;
   double wheel_radius_error = 0.004;
