@@ -80,6 +80,9 @@ class WheelHistory {
  public:
   explicit WheelHistory(std::size_t capacity) : samples_(capacity) {}
   void push(const WheelSample& sample) { samples_.push(sample); }
+  std::size_t size() const { return samples_.size(); }
+  // Oldest first; i < size().
+  const WheelSample& operator[](std::size_t i) const { return samples_[i]; }
   // Time of the newest sample; -infinity when empty.
   double latest() const { return samples_.latest(); }
   // Distance travelled at the newest sample (0 when empty).
