@@ -15,6 +15,7 @@ void register_lidar_commands(CLI::App& app, int& status);
 void register_eval_commands(CLI::App& app, int& status);
 void register_can_commands(CLI::App& app, int& status);
 void register_calibrate_wheels_commands(CLI::App& app, int& status);
+void register_calibrate_mounting_commands(CLI::App& app, int& status);
 
 // status, watch, start, stop, export, sessions, ping (the tablet protocol)
 void register_client_commands(CLI::App& app, int& status);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     adit::tools::register_eval_commands(app, status);
     adit::tools::register_can_commands(app, status);
     adit::tools::register_calibrate_wheels_commands(app, status);
+    adit::tools::register_calibrate_mounting_commands(app, status);
     adit::tools::register_client_commands(app, status);
     adit::tools::register_keygen_commands(app, status);
     adit::tools::register_faults_commands(app, status);
