@@ -384,7 +384,9 @@ void CanFeed::run() {
       stats_.untrusted.fetch_add(1, std::memory_order_relaxed);
     stats_.slip_episodes.store(i.odometry.stats().slip_episodes, std::memory_order_relaxed);
     if (step == slam::WheelStep::time_backwards) continue;
-    if (!hand_over(slam::WheelSample{t, i.odometry.pose(), i.odometry.distance(), step == slam::WheelStep::gap})) break;
+    const bool held = step == slam::WheelStep::slip || step == slam::WheelStep::impossible;
+    if (!hand_over(slam::WheelSample{t, i.odometry.pose(), i.odometry.distance(), step == slam::WheelStep::gap, held}))
+      break;
     stats_.samples.fetch_add(1, std::memory_order_relaxed);
   }
   stats_.dropped.store(samples_.dropped());

@@ -101,7 +101,9 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
 std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(double previous, double t) {
   if (!wheels_ || previous <= 0.0) return std::nullopt;
   std::optional<slam::MotionPrior> prior = can_->wheels().prior(previous, t);
-  ++(prior ? counts_.wheel_priors : counts_.scans_without_wheels);
+  if (prior) ++counts_.wheel_priors;
+  else if (can_->wheels().held(previous, t)) ++counts_.scans_wheels_held;
+  else ++counts_.scans_without_wheels;
   return prior;
 }
 

@@ -521,6 +521,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"relocalised", s.relocalised_poses.load()}, {"searches_cut", s.searches_cut.load()},
                    {"with_wheel_prior", s.wheel_priors.load()},
                    {"wheels_missing", s.scans_without_wheels.load()},
+                   {"wheels_held", s.scans_wheels_held.load()},
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},

@@ -37,7 +37,17 @@ std::optional<MotionPrior> WheelHistory::prior(double t0, double t1) const {
   // Newest first: the scans ask about the last few samples.
   for (std::size_t i = samples_.size(); i-- > 0 && samples_[i].t > t0;)
     if (samples_[i].after_gap && samples_[i].t <= t1) return std::nullopt;  // the wheels were silent in between
+  if (held(t0, t1)) return std::nullopt;
   return wheel_motion_prior(p0, p1, d1 - d0);
+}
+
+bool WheelHistory::held(double t0, double t1) const {
+  // Sample i covers (t[i-1], t[i]]: those after t0 up to the first at or after t1.
+  for (std::size_t i = samples_.size(); i-- > 0 && samples_[i].t > t0;) {
+    if (i > 0 && samples_[i - 1].t >= t1) continue;  // wholly after t1
+    if (samples_[i].held) return true;
+  }
+  return false;
 }
 
 std::optional<Eigen::Vector3d> WheelHistory::acceleration(double t0, double t1, double half_window) const {
@@ -52,7 +62,7 @@ std::optional<Eigen::Vector3d> WheelHistory::acceleration(double t0, double t1, 
     return true;
   };
   double v0 = 0.0, v1 = 0.0, h0 = 0.0, h1 = 0.0;
-  if (!speed(t0, v0, h0) || !speed(t1, v1, h1)) return std::nullopt;
+  if (!speed(t0, v0, h0) || !speed(t1, v1, h1) || held(t0 - half_window, t1 + half_window)) return std::nullopt;
   const double dt = t1 - t0;
   const double omega = wrap_angle(h1 - h0) / dt;
   return Eigen::Vector3d((v1 - v0) / dt, omega * 0.5 * (v0 + v1), 0.0);

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
 
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/scan_odometry.hpp"
@@ -56,6 +59,10 @@ TEST(ScanOdometry, PutsTheScanInTheBodyFrameWithItsFiringTimes) {
   EXPECT_EQ(odometry.counts().wheel_priors + odometry.counts().gravity_priors, 0U) << "no CAN bus configured";
 }
 
+std::filesystem::path binary_dir_log(const std::string& name) {
+  return test::binary_dir() / fmt::format("{}-{}.log", name, ::getpid());
+}
+
 // The odometry step on a replayed CAN log; the log is removed at the end.
 struct OnReplayedCan {
   explicit OnReplayedCan(const config::Config& config)
@@ -93,6 +100,28 @@ TEST(ScanOdometry, CountsScansTheCanLogDoesNotCover) {
   const MotionAidCounts& counts = replay.run(1'005'000'000'000, 3);
   EXPECT_EQ(counts.wheel_priors, 0U);
   EXPECT_EQ(counts.scans_without_wheels, 2U);
+}
+
+// The left wheel spins at 2 m/s for 0.3 s of a 1 m/s drive (from 1001.0 s):
+// the wheel odometry holds it (a slip), and the scans over which it is held
+// get no wheel prior (their motion is a guess), counted apart from scans the
+// log does not cover.
+TEST(ScanOdometry, TakesNoWheelPriorOverAWheelHeldForSlip) {
+  const std::filesystem::path log = binary_dir_log("scan-odometry-slip");
+  {
+    std::ofstream out(log);
+    for (int i = 0; i <= 300; ++i) {
+      const double t = 1000.0 + 0.01 * i;
+      const bool slipping = t >= 1001.0 && t < 1001.3;
+      out << fmt::format("({:.6f}) can0 300#{}E803\n", t, slipping ? "D007" : "E803");
+    }
+  }
+  OnReplayedCan replay(test::wheel_config(log));
+  const MotionAidCounts& counts = replay.run(1'000'500'000'000, 20);  // scans 1000.5-1002.4 s
+  EXPECT_GE(counts.scans_wheels_held, 3U) << "the scans from 1000.9 to 1001.3 s";
+  EXPECT_LE(counts.scans_wheels_held, 6U) << "and not those before or well after";
+  EXPECT_EQ(counts.scans_without_wheels, 0U);
+  EXPECT_EQ(counts.wheel_priors + counts.scans_wheels_held, 19U);
 }
 
 TEST(ScanOdometry, RunsOnACanImuWithoutWheelsAndKeepsItsReadingsForEachScan) {

@@ -39,6 +39,30 @@ TEST(WheelHistory, GivesNoPriorAcrossTheWheelsSilence) {
   EXPECT_NEAR(after->delta.translation().x(), 0.3, 1e-12);
 }
 
+// A wheel held for slip from 1.0 s to 1.3 s (samples 1.1-1.3 held): its
+// travel is a guess (in a turn's onset the held wheel assumes the turn rate
+// from before, decision 051), so no prior or acceleration covers it; before
+// and after, they are as before.
+TEST(WheelHistory, GivesNoPriorOverAWheelHeldForSlip) {
+  WheelHistory history(64);
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    WheelSample s{t, {t, 0.0, 0.0}, t};
+    s.held = i >= 11 && i <= 13;
+    history.push(s);
+  }
+  EXPECT_TRUE(history.prior(0.5, 1.0).has_value()) << "before the slip";
+  EXPECT_FALSE(history.held(0.5, 1.0));
+  EXPECT_FALSE(history.prior(0.95, 1.05).has_value()) << "into it (sample 1.1 covers (1.0, 1.1])";
+  EXPECT_TRUE(history.held(0.95, 1.05));
+  EXPECT_FALSE(history.prior(1.2, 1.6).has_value()) << "out of it";
+  EXPECT_FALSE(history.prior(0.5, 1.6).has_value()) << "across it";
+  EXPECT_TRUE(history.prior(1.3, 1.8).has_value()) << "after it (sample 1.4 covers (1.3, 1.4])";
+  EXPECT_FALSE(history.held(1.3, 1.8));
+  EXPECT_TRUE(history.acceleration(0.3, 0.6).has_value());
+  EXPECT_FALSE(history.acceleration(1.0, 1.2).has_value());
+}
+
 TEST(ImuHistory, AveragesTheReadingsJoinedByLinesOverAnyInterval) {
   ImuHistory history(64);
   // f_x = 2t: readings every 10 ms, 3 ms after each 10 ms mark (as a bus delays them).

@@ -38,6 +38,7 @@ slam::OdometryConfig odometry_config_of(const config::Config& config, slam::Odom
 struct MotionAidCounts {
   std::uint64_t wheel_priors = 0;           // scans registered with the wheels' prior
   std::uint64_t scans_without_wheels = 0;   // wheels configured, but no samples around the scan
+  std::uint64_t scans_wheels_held = 0;      // a wheel held for slip over the scan's interval: no wheel prior
   std::uint64_t gravity_priors = 0;         // scans registered with the accelerometer's up
   std::uint64_t scans_without_gravity = 0;  // IMU and wheels configured, but no readings or not gravity-sized
 };

@@ -27,6 +27,11 @@ struct WheelSample {
   // than WheelLimits::max_gap): how the body moved since the sample before is
   // not known, so no prior is interpolated across it.
   bool after_gap = false;
+  // A wheel was held over this sample's interval (slip, or a reading no
+  // vehicle can give: WheelStep::slip, impossible): the travel integrated is
+  // a guess at what the wheel would have done, which in a turn's onset can be
+  // tenths of a radian off (the held wheel assumes the turn rate from before).
+  bool held = false;
 };
 
 // Samples of one kind (with a time `t`): fixed capacity, the oldest dropped,
@@ -88,13 +93,17 @@ class WheelHistory {
   // Distance travelled at the newest sample (0 when empty).
   double latest_distance() const { return samples_.size() == 0 ? 0.0 : samples_.back().distance; }
   // The body motion from t0 to t1 by the wheels (interpolated,
-  // slam/wheel_prior.hpp), nullopt when the samples do not cover [t0, t1].
+  // slam/wheel_prior.hpp), nullopt when the samples do not cover [t0, t1],
+  // the wheels were silent in between, or a wheel was held (held()).
   std::optional<MotionPrior> prior(double t0, double t1) const;
+  // A sample whose interval overlaps (t0, t1] was held: its motion is a guess.
+  bool held(double t0, double t1) const;
   // The body's mean kinematic acceleration over [t0, t1] in the body frame
   // (x forward, y left), as a planar vehicle on its wheels moves: the change
   // of forward speed over the interval, v(t1) − v(t0) over t1 − t0, plus the
   // centripetal ω·v to the left (ω × v). The speeds are central differences
-  // over ±`half_window` s; nullopt when the samples do not cover that.
+  // over ±`half_window` s; nullopt when the samples do not cover that or a
+  // wheel was held within it.
   std::optional<Eigen::Vector3d> acceleration(double t0, double t1, double half_window = 0.05) const;
 
  private:
