@@ -3,6 +3,7 @@
 //   - the page loads with no console errors; poses advance; the health shows MAPPING;
 //   - a START without the passphrase is refused with a visible message and changes nothing;
 //   - unlocked, START and STOP by clicking work; two browsers watch at once;
+//   - a hint typed in the form reaches the payload, whose refusal (no prior map) shows;
 //   - the map renders (non-background pixels of the map canvas);
 //   - the payload's live 2D grid reaches the page cell for cell (the PNG of
 //     /api/grid decoded here and in the page) and shows in the top view; its
@@ -124,6 +125,25 @@ try {
   assert.ok(m1.lastSeq > m0.lastSeq + minPoses, `poses advance at scan rate: seq ${m0.lastSeq} -> ${m1.lastSeq} in 3 s`);
   const o1 = await metrics(other);
   assert.ok(o1.poses > 10, `the second browser gets poses too (${o1.poses})`);
+
+  step('A hint');
+  // A hint goes from the form to the payload and its answer comes back: this
+  // session has no prior map, so the payload refuses it and says why. A hint
+  // out of range is refused by the console, naming the field.
+  await page.type('#hint-x', '12.5');
+  await page.type('#hint-y', '-3');
+  await page.type('#hint-heading', '90');
+  await page.click('#send-hint');
+  await waitFor('the payload\'s answer to the hint', async () => (await text(page, '#command-message')).startsWith('HINT refused'));
+  assert.match(await text(page, '#command-message'), /no prior map/);
+  const outOfRange = await page.evaluate(async (token) => {
+    const r = await fetch('/api/command', { method: 'POST', headers: { 'Content-Type': 'application/json', 'X-Adit-Token': token },
+                                            body: JSON.stringify({ verb: 'HINT', x: 1, y: 2, radius: 500 }) });
+    return { status: r.status, body: await r.json() };
+  }, await page.evaluate(() => sessionStorage.getItem('adit-token')));
+  assert.equal(outOfRange.status, 400, JSON.stringify(outOfRange));
+  assert.match(outOfRange.body.error, /radius/);
+  assert.equal(await text(page, '#state'), 'MAPPING', 'a refused hint changed nothing');
 
   step('The map renders.');
   // The map renders.
@@ -293,8 +313,9 @@ try {
   assert.equal(await tail.text(), onDisk.slice(10));
 
   // Afterwards only the failures this test provokes: refused commands and a
-  // wrong passphrase (403), the stream cut by the console's restart.
-  const expected = /status of 403 \(Forbidden\)|ERR_INCOMPLETE_CHUNKED_ENCODING|ERR_CONNECTION_REFUSED|ERR_EMPTY_RESPONSE/;
+  // wrong passphrase (403), the hint the payload refused (409) and the one out
+  // of range (400), the stream cut by the console's restart.
+  const expected = /status of 40[039] \((Forbidden|Conflict|Bad Request)\)|ERR_INCOMPLETE_CHUNKED_ENCODING|ERR_CONNECTION_REFUSED|ERR_EMPTY_RESPONSE/;
   assert.deepEqual(errors.filter((e) => !expected.test(e)), [], 'no other console errors in the tablet page');
   // The live view's target (pose on LCM -> drawn <= 200 ms at p95) is a speed
   // figure: printed here and reported in docs/CONSOLE.md, not asserted on a

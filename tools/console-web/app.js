@@ -264,6 +264,7 @@ function updateControls(state) {
   currentState = state;
   el('start').disabled = state !== 'IDLE';
   el('stop').disabled = state !== 'MAPPING';
+  el('send-hint').disabled = state !== 'MAPPING';
   el('lock').hidden = !locked || !!token;
 }
 
@@ -273,11 +274,12 @@ function say(text, ok) {
   m.className = ok ? 'ok' : 'error';
 }
 
-async function command(verb) {
-  const body = { verb };
+// `fields`: the command's own (HINT: x, y, heading), checked by the console.
+async function command(verb, fields = {}) {
+  const body = { verb, ...fields };
   if (verb === 'START' && el('scan-name').value.trim()) body.name = el('scan-name').value.trim();
   say(`${verb}…`, true);
-  el('start').disabled = el('stop').disabled = true;
+  el('start').disabled = el('stop').disabled = el('send-hint').disabled = true;
   try {
     const r = await fetch('/api/command', { method: 'POST', body: JSON.stringify(body),
                                             headers: { 'Content-Type': 'application/json', 'X-Adit-Token': token } });
@@ -301,6 +303,14 @@ async function command(verb) {
 
 el('start').addEventListener('click', () => command('START'));
 el('stop').addEventListener('click', () => command('STOP'));
+// A hint for the search against the prior map: where the payload is in the
+// prior's frame, and the way it faces when given (docs/PRIOR-MAP.md).
+el('hint').addEventListener('submit', (e) => {
+  e.preventDefault();
+  const fields = { x: Number(el('hint-x').value), y: Number(el('hint-y').value) };
+  if (el('hint-heading').value.trim() !== '') fields.heading = Number(el('hint-heading').value);
+  command('HINT', fields);
+});
 el('lock').addEventListener('submit', async (e) => {
   e.preventDefault();
   const r = await fetch('/api/unlock', { method: 'POST', headers: { 'Content-Type': 'application/json' },

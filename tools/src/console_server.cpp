@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/common/log.hpp"
+#include "adit/protocol/localise_hint.hpp"
 #include "adit/protocol/session_state.hpp"
 #include "console_downloads.hpp"
 #include "console_events.hpp"
@@ -56,6 +57,18 @@ std::optional<nlohmann::json> body_json(const httplib::Request& req, httplib::Re
   }
   reply_error(res, 400, "the request body is not a JSON object");
   return std::nullopt;
+}
+
+// HINT's fields from the request, as the command's key=value arguments: a
+// number as written, anything else as text for parse_localise_hint to refuse.
+std::vector<std::string> hint_args_of(const nlohmann::json& j) {
+  std::vector<std::string> args;
+  for (const char* key : {"x", "y", "radius", "heading", "heading_tolerance"}) {
+    const auto it = j.find(key);
+    if (it == j.end() || it->is_null()) continue;
+    args.push_back(std::string(key) + "=" + (it->is_string() ? it->get<std::string>() : it->dump()));
+  }
+  return args;
 }
 
 std::string string_field(const nlohmann::json& j, const char* key) {
@@ -259,8 +272,8 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
       return;
     }
     const std::string verb = string_field(*body, "verb");
-    if (verb != "START" && verb != "STOP") {
-      reply_error(res, 400, fmt::format("verb '{}' is not START or STOP", verb));
+    if (verb != "START" && verb != "STOP" && verb != "HINT") {
+      reply_error(res, 400, fmt::format("verb '{}' is not START, STOP or HINT", verb));
       return;
     }
     const std::string name = string_field(*body, "name");
@@ -271,6 +284,16 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
         return;
       }
       args.push_back("name=" + name);
+    }
+    if (verb == "HINT") {
+      // The protocol's own parser checks the fields (names, numbers, ranges).
+      std::string error;
+      const auto hint = protocol::parse_localise_hint(hint_args_of(*body), error);
+      if (!hint) {
+        reply_error(res, 400, error);
+        return;
+      }
+      args = protocol::localise_hint_args(*hint);
     }
     const auto ack = payload_command(options.client, verb, args);
     if (!ack) {
