@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "adit/slam/roll_pitch_yaw.hpp"
+#include "adit/slam/trajectory_interpolate.hpp"
 
 namespace adit::eval {
 namespace {
@@ -42,20 +43,6 @@ Eigen::Matrix2d rot2(double a) {
   return r;
 }
 
-// The sensor's pose at t (translation linear, rotation slerp); nullopt outside.
-std::optional<Eigen::Isometry3d> sensor_at(std::span<const SensorPose> s, double t) {
-  if (s.empty() || t < s.front().t || t > s.back().t) return std::nullopt;
-  const auto it = std::lower_bound(s.begin(), s.end(), t, [](const SensorPose& p, double v) { return p.t < v; });
-  if (it == s.begin()) return it->pose;
-  const SensorPose& a = *(it - 1);
-  const SensorPose& b = *it;
-  const double f = (t - a.t) / (b.t - a.t);
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(a.pose.linear()).slerp(f, Eigen::Quaterniond(b.pose.linear())).toRotationMatrix();
-  out.translation() = (1.0 - f) * a.pose.translation() + f * b.pose.translation();
-  return out;
-}
-
 // The body's planar pose at t; nullopt outside or across a gap in the wheels.
 std::optional<slam::Pose2> body_at(std::span<const slam::WheelSample> w, double t) {
   if (w.empty() || t < w.front().t || t > w.back().t) return std::nullopt;
@@ -76,15 +63,15 @@ bool gap_within(std::span<const slam::WheelSample> w, double t0, double t1) {
   return false;
 }
 
-std::vector<Window> windows_of(std::span<const SensorPose> sensor, std::span<const slam::WheelSample> wheels,
+std::vector<Window> windows_of(const slam::Trajectory& sensor, std::span<const slam::WheelSample> wheels,
                                const MountingOptions& o) {
   std::vector<Window> out;
   if (sensor.empty() || wheels.empty()) return out;
-  const double start = std::max(sensor.front().t, wheels.front().t);
-  const double end = std::min(sensor.back().t, wheels.back().t);
+  const double start = std::max(sensor.stamps.front(), wheels.front().t);
+  const double end = std::min(sensor.stamps.back(), wheels.back().t);
   for (double t0 = start; t0 + o.window <= end; t0 += o.window) {
     const double t1 = t0 + o.window;
-    const auto s0 = sensor_at(sensor, t0), s1 = sensor_at(sensor, t1);
+    const auto s0 = slam::interpolate_pose(sensor, t0), s1 = slam::interpolate_pose(sensor, t1);
     const auto b0 = body_at(wheels, t0), b1 = body_at(wheels, t1);
     if (!s0 || !s1 || !b0 || !b1 || gap_within(wheels, t0, t1)) continue;
     Window w;
@@ -103,22 +90,23 @@ std::vector<Window> windows_of(std::span<const SensorPose> sensor, std::span<con
 // by axis_turn (within axis_span): a bump tilts the body by the same degree
 // over any span, so the longer turn sees the axis through it far better
 // than one window's.
-std::vector<Window> turn_spans(std::span<const SensorPose> sensor, std::span<const slam::WheelSample> wheels,
+std::vector<Window> turn_spans(const slam::Trajectory& sensor, std::span<const slam::WheelSample> wheels,
                                const MountingOptions& o) {
   std::vector<Window> out;
   if (sensor.empty() || wheels.empty()) return out;
   std::size_t i = 0, last_end = 0;
-  for (double t0 = std::max(sensor.front().t, wheels.front().t); i < sensor.size(); t0 += o.window) {
-    while (i < sensor.size() && sensor[i].t < t0) ++i;
+  const std::vector<double>& t = sensor.stamps;
+  for (double t0 = std::max(t.front(), wheels.front().t); i < sensor.size(); t0 += o.window) {
+    while (i < sensor.size() && t[i] < t0) ++i;
     if (i >= sensor.size()) break;
-    const auto b0 = body_at(wheels, sensor[i].t);
+    const auto b0 = body_at(wheels, t[i]);
     if (!b0) continue;
-    for (std::size_t j = i + 1; j < sensor.size() && sensor[j].t <= sensor[i].t + o.axis_span; ++j) {
-      const Eigen::Matrix3d rel = sensor[i].pose.linear().transpose() * sensor[j].pose.linear();
+    for (std::size_t j = i + 1; j < sensor.size() && t[j] <= t[i] + o.axis_span; ++j) {
+      const Eigen::Matrix3d rel = sensor.poses[i].linear().transpose() * sensor.poses[j].linear();
       if (Eigen::AngleAxisd(rel).angle() < o.axis_turn) continue;
-      const auto b1 = body_at(wheels, sensor[j].t);
+      const auto b1 = body_at(wheels, t[j]);
       // Each end once: spans sharing one are one turn (and one bump), not several.
-      if (b1 && j != last_end && !gap_within(wheels, sensor[i].t, sensor[j].t)) {
+      if (b1 && j != last_end && !gap_within(wheels, t[i], t[j])) {
         last_end = j;
         Window w;
         w.sensor_rotation = log_so3(rel);
@@ -250,7 +238,7 @@ constexpr double kMinTurnSquared = 0.25;  // rad^2: half a radian of turning in 
 
 }  // namespace
 
-MountingResult calibrate_mounting(std::span<const SensorPose> sensor, std::span<const slam::WheelSample> wheels,
+MountingResult calibrate_mounting(const slam::Trajectory& sensor, std::span<const slam::WheelSample> wheels,
                                   const MountingOptions& o, const std::optional<GroundSummary>& ground) {
   const std::vector<Window> ws = windows_of(sensor, wheels, o);
   if (ws.size() < kMinWindows)
@@ -274,7 +262,8 @@ MountingResult calibrate_mounting(std::span<const SensorPose> sensor, std::span<
     for (std::size_t i = 0; i < off.size(); ++i) off[i] = across(axis_source[i], axis.u);
     const double limit = o.outlier_sigmas * robust_sigma(off);
     for (std::size_t i = 0; i < off.size(); ++i) axis_weight[i] = off[i] <= limit ? 1.0 : 0.0;
-    if (fit_axis(axis_source, axis_weight).turn_squared >= kMinTurnSquared) axis = fit_axis(axis_source, axis_weight);
+    const AxisFit refit = fit_axis(axis_source, axis_weight);
+    if (refit.turn_squared >= kMinTurnSquared) axis = refit;
   }
   const Eigen::Vector3d turn_axis = axis.u;
   if (ground) axis.u = ground->normal;

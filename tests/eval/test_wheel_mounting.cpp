@@ -26,7 +26,7 @@ struct Leg {
 };
 
 struct Drive {
-  std::vector<SensorPose> sensor;
+  slam::Trajectory sensor;
   std::vector<slam::WheelSample> wheels;
 };
 
@@ -49,7 +49,7 @@ Drive drive(const std::vector<Leg>& legs, const Eigen::Isometry3d& mount, double
       Eigen::Isometry3d sensor = body * mount;
       sensor.translation() += pose_noise * Eigen::Vector3d(n(rng), n(rng), n(rng));
       sensor.linear() = sensor.linear() * slam::rotation_from_rpy(pose_noise * Eigen::Vector3d(n(rng), n(rng), n(rng)));
-      d.sensor.push_back({t, sensor});
+      d.sensor.push_back(t, sensor);
       d.wheels.push_back({t, wheel, distance, false});
 
       const double ds = leg.speed * dt, dth = leg.turn_rate * dt;
@@ -171,9 +171,9 @@ TEST(WheelMounting, StraightDrivingAloneIsRefusedWithTheReason) {
 
 TEST(WheelMounting, PosesThatDoNotOverlapTheWheelsAreRefused) {
   Drive d = drive(survey_drive(), mounting({0, 0, 0}, {0.2, 0, 0.4}));
-  for (SensorPose& p : d.sensor) p.t += 1000.0;  // another clock
+  for (double& t : d.sensor.stamps) t += 1000.0;  // another clock
   EXPECT_THROW(calibrate_mounting(d.sensor, d.wheels, {}), std::invalid_argument);
-  EXPECT_THROW(calibrate_mounting({}, d.wheels, {}), std::invalid_argument);
+  EXPECT_THROW(calibrate_mounting(slam::Trajectory{}, d.wheels, {}), std::invalid_argument);
 }
 
 TEST(WheelMounting, AGapInTheWheelsIsNotBridged) {

@@ -84,18 +84,16 @@ std::optional<eval::GroundSummary> floor_of(const config::Config& c, const Optio
 }
 
 // aditd's trajectory is the body's; the sensor is where the config put it.
-std::vector<eval::SensorPose> sensor_poses(const std::string& file, const Eigen::Isometry3d& body_from_sensor) {
-  const slam::Trajectory t = slam::read_tum(file);
-  std::vector<eval::SensorPose> out;
-  out.reserve(t.size());
-  for (std::size_t i = 0; i < t.size(); ++i) out.push_back({t.stamps[i], t.poses[i] * body_from_sensor});
-  return out;
+slam::Trajectory sensor_poses(const std::string& file, const Eigen::Isometry3d& body_from_sensor) {
+  slam::Trajectory t = slam::read_tum(file);
+  for (slam::Pose& pose : t.poses) pose = pose * body_from_sensor;
+  return t;
 }
 
 int run(const Options& o) {
   const config::Config c = config::load_config(o.config);
   const Eigen::Isometry3d configured = daemon::isometry_of(c.lidar.extrinsics);
-  const std::vector<eval::SensorPose> sensor = sensor_poses(o.trajectory, configured);
+  const slam::Trajectory sensor = sensor_poses(o.trajectory, configured);
   const std::vector<slam::WheelSample> wheels = wheel_poses(c, o.config);
   eval::MountingOptions options;
   options.window = o.window;

@@ -50,13 +50,9 @@
 
 #include "adit/eval/ground_plane.hpp"
 #include "adit/slam/motion_history.hpp"
+#include "adit/slam/trajectory.hpp"
 
 namespace adit::eval {
-
-struct SensorPose {
-  double t = 0.0;  // s, the LiDAR's clock
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the sensor in the odometry frame
-};
 
 struct MountingOptions {
   double window = 1.0;            // s per relative motion
@@ -97,8 +93,9 @@ struct MountingResult {
 
 // Throws std::invalid_argument naming what is missing: too few windows with
 // both poses and wheel samples, or a drive that never turns (no axis).
-// `ground`: the floor seen from the sensor over the drive, when known.
-MountingResult calibrate_mounting(std::span<const SensorPose> sensor, std::span<const slam::WheelSample> wheels,
+// `sensor`: the sensor's poses in the odometry frame, stamped on the LiDAR's
+// clock; `ground`: the floor seen from the sensor over the drive, when known.
+MountingResult calibrate_mounting(const slam::Trajectory& sensor, std::span<const slam::WheelSample> wheels,
                                   const MountingOptions& options, const std::optional<GroundSummary>& ground = std::nullopt);
 
 }  // namespace adit::eval
