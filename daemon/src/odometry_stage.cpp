@@ -61,6 +61,8 @@ void OdometryStage::loop() {
     stats_.wheel_priors.store(counts.wheel_priors, std::memory_order_relaxed);
     stats_.scans_without_wheels.store(counts.scans_without_wheels, std::memory_order_relaxed);
     stats_.scans_wheels_held.store(counts.scans_wheels_held, std::memory_order_relaxed);
+    stats_.gyro_priors.store(counts.gyro_priors, std::memory_order_relaxed);
+    stats_.gyro_still.store(counts.gyro_still, std::memory_order_relaxed);
     stats_.gravity_priors.store(counts.gravity_priors, std::memory_order_relaxed);
     stats_.scans_without_gravity.store(counts.scans_without_gravity, std::memory_order_relaxed);
     copy_imu_stats();

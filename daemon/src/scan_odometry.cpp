@@ -59,6 +59,17 @@ ScanOdometry::ScanOdometry(const config::Config& config, const slam::OdometryCon
   if (imu_ != nullptr && has_gyro(config.imu) && !wheels_) {
     imu_samples_.reserve(kImuHistoryCapacity);
   }
+  // With wheels, the gyroscope turns their prior (docs/decisions/052).
+  if (imu_ != nullptr && has_gyro(config.imu) && wheels_ && config.imu.gyro_with_wheels) {
+    gyrodometry_ = true;
+    gyro_noise_.rate_density = config.imu.gyro_noise_density;
+    gyro_noise_.bias_walk = config.imu.gyro_bias_walk;
+    gyro_noise_.model_error_density = odometry.inertial.gyro_model_error_density;
+    gyro_noise_.initial_bias_sigma = odometry.inertial.initial_gyro_bias_sigma_radps;
+    gyro_noise_.max_gap_s = odometry.inertial.max_sample_gap_s;
+    gyro_bias_ = slam::GyroBias(gyro_noise_);
+    gyro_samples_.reserve(kImuHistoryCapacity);
+  }
   body_points_.reserve(odometry.max_scan_points);
   body_times_.reserve(odometry.max_scan_points);
 }
@@ -83,7 +94,7 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
   const double t = 1e-9 * static_cast<double>(scan.start_time_ns);
   const double previous = previous_scan_s_;
   previous_scan_s_ = t;
-  const std::optional<slam::MotionPrior> prior = wheel_prior_for(previous, t);
+  wheel_prior_ = wheel_prior_for(previous, t);
   const std::optional<slam::UpMeasurement> up = up_for(scan.start_time_ns, sweep_s);
   // With a gyroscope: its readings from the previous scan's start to past
   // this sweep's end, for the LiDAR-inertial step.
@@ -91,7 +102,7 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
   if (imu_samples_.capacity() > 0)
     imu_->history().copy_covering(previous > 0.0 ? previous : t, t + sweep_s, imu_samples_);
   const std::int64_t t0 = monotonic_ns();
-  result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up, imu_samples_}, prior);
+  result_ = odometry_.process({scan.start_time_ns, body_points_, body_times_, up, imu_samples_}, wheel_prior_);
   registration_ms_ = 1e-6 * static_cast<double>(monotonic_ns() - t0);
   return result_;
 }
@@ -101,10 +112,35 @@ const slam::OdometryResult& ScanOdometry::process(const drivers::LidarScan& scan
 std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(double previous, double t) {
   if (!wheels_ || previous <= 0.0) return std::nullopt;
   std::optional<slam::MotionPrior> prior = can_->wheels().prior(previous, t);
+  if (prior && gyrodometry_) prior = turned_by_gyro(*prior, previous, t);
   if (prior) ++counts_.wheel_priors;
   else if (can_->wheels().held(previous, t)) ++counts_.scans_wheels_held;
   else ++counts_.scans_without_wheels;
   return prior;
+}
+
+// The wheels' prior from `previous` to `t` with the gyroscope's rotation over
+// the same interval, its bias removed; the wheels' own when the readings do
+// not cover it. Wheels that stood still teach the bias first: the mean rate
+// is then the bias, unless it is a turn (a body turned by hand on its wheels).
+slam::MotionPrior ScanOdometry::turned_by_gyro(const slam::MotionPrior& wheels, double previous, double t) {
+  constexpr double kStillM = 1e-3;         // wheel travel over the interval, m
+  constexpr double kStillRad = 1e-3;       // wheel turn over the interval, rad
+  constexpr double kMaxBiasRadps = 0.05;   // above this the body turned: not a bias
+  imu_->history().copy_covering(previous, t, gyro_samples_);
+  const double dt = t - previous;
+  if (wheels.delta.translation().norm() < kStillM && Eigen::AngleAxisd(wheels.delta.linear()).angle() < kStillRad) {
+    const auto raw = slam::gyro_rotation(gyro_samples_, previous, t, Eigen::Vector3d::Zero(), gyro_noise_.max_gap_s);
+    if (raw) {
+      const Eigen::AngleAxisd turn(*raw);
+      const Eigen::Vector3d mean_rate = turn.axis() * (turn.angle() / dt);
+      if (mean_rate.norm() < kMaxBiasRadps && gyro_bias_.still(mean_rate, previous, t)) ++counts_.gyro_still;
+    }
+  }
+  const auto rotation = slam::gyro_rotation(gyro_samples_, previous, t, gyro_bias_.bias(), gyro_noise_.max_gap_s);
+  if (!rotation) return wheels;
+  ++counts_.gyro_priors;
+  return slam::gyro_aided(wheels, *rotation, dt, gyro_bias_.sigma(t), gyro_noise_);
 }
 
 // After wheel_prior_for: gravity's up in the body frame over the sweep, from

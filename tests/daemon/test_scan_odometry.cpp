@@ -3,6 +3,7 @@
 // and gravity's up taken from the CAN feed for every scan they cover.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -122,6 +123,67 @@ TEST(ScanOdometry, TakesNoWheelPriorOverAWheelHeldForSlip) {
   EXPECT_LE(counts.scans_wheels_held, 6U) << "and not those before or well after";
   EXPECT_EQ(counts.scans_without_wheels, 0U);
   EXPECT_EQ(counts.wheel_priors + counts.scans_wheels_held, 19U);
+}
+
+// Gyrodometry (decision 052): a robot stands still for a second, then drives
+// straight at 1 m/s on wheels whose speeds differ by 2 % (a false turn of
+// 0.04 rad/s), with a gyroscope whose bias is (0.002, -0.001, 0.004) rad/s.
+// The standstill teaches the bias; the priors then turn as the gyroscope
+// turns, with its bias removed, not as the wheels do.
+std::filesystem::path drive_with_gyro_log(const std::string& name) {
+  const std::filesystem::path log = binary_dir_log(name);
+  std::ofstream out(log);
+  for (int i = 0; i <= 300; ++i) {
+    const double t = 1000.0 + 0.01 * i;
+    const double speed = std::clamp(2.0 * (t - 1001.0), 0.0, 1.0);  // 2 m/s² from 1001 s
+    const auto mm = [](double v) { return test::int16_le({static_cast<int>(std::lround(1000.0 * v)), 0, 0}).substr(0, 4); };
+    out << fmt::format("({:.6f}) can0 300#{}{}\n", t, mm(1.01 * speed), mm(0.99 * speed));
+    out << fmt::format("({:.6f}) can0 190#{}\n", t + 0.0003, test::int16_le({0, 0, 9807}));
+    out << fmt::format("({:.6f}) can0 191#{}\n", t + 0.0004, test::int16_le({10, -5, 20}));  // 0.0002 rad/s a count
+  }
+  return log;
+}
+
+config::Config wheels_and_gyro_config(const std::filesystem::path& log) {
+  config::Config c = test::wheel_config(log);
+  const config::Config imu = test::imu_only_config(log);
+  c.can.signals.insert(c.can.signals.end(), imu.can.signals.begin(), imu.can.signals.end());
+  c.imu = imu.imu;
+  return c;
+}
+
+TEST(ScanOdometry, TurnsTheWheelsPriorWithTheGyroscopeWhoseBiasItLearntStandingStill) {
+  OnReplayedCan replay(wheels_and_gyro_config(drive_with_gyro_log("scan-odometry-gyro")));
+  double largest_turn = 0.0;
+  for (int k = 0; k < 20; ++k) {  // scans 1000.5-1002.4 s
+    replay.odometry.process(room_scan(1'000'500'000'000 + k * 100'000'000LL));
+    const auto& prior = replay.odometry.wheel_prior();
+    if (k >= 12 && prior) largest_turn = std::max(largest_turn, Eigen::AngleAxisd(prior->delta.linear()).angle());
+  }
+  replay.can.stop();
+  const MotionAidCounts& counts = replay.odometry.counts();
+  EXPECT_EQ(counts.gyro_priors, counts.wheel_priors);
+  EXPECT_EQ(counts.wheel_priors, 19U);
+  EXPECT_GE(counts.gyro_still, 4U) << "the scans from 1000.5 to 1001.0 s";
+  EXPECT_LE(counts.gyro_still, 6U);
+  EXPECT_LT((replay.odometry.gyro_bias().bias() - Eigen::Vector3d(0.002, -0.001, 0.004)).norm(), 2e-5)
+      << replay.odometry.gyro_bias().bias().transpose();
+  // The wheels turn 0.02 m/s across 0.5 m: 0.004 rad a scan; the gyroscope, its bias removed, none.
+  EXPECT_LT(largest_turn, 1e-4) << "the wheels alone turn 0.004 rad a scan";
+}
+
+TEST(ScanOdometry, KeepsTheWheelsTurnWithoutGyrodometry) {
+  config::Config c = wheels_and_gyro_config(drive_with_gyro_log("scan-odometry-no-gyro"));
+  c.imu.gyro_with_wheels = false;
+  OnReplayedCan replay(c);
+  double last_yaw = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    replay.odometry.process(room_scan(1'000'500'000'000 + k * 100'000'000LL));
+    if (replay.odometry.wheel_prior()) last_yaw = Eigen::AngleAxisd(replay.odometry.wheel_prior()->delta.linear()).angle();
+  }
+  replay.can.stop();
+  EXPECT_EQ(replay.odometry.counts().gyro_priors, 0U);
+  EXPECT_NEAR(last_yaw, 0.02 / 0.5 * 0.1, 2e-4);
 }
 
 TEST(ScanOdometry, RunsOnACanImuWithoutWheelsAndKeepsItsReadingsForEachScan) {

@@ -24,6 +24,7 @@
 #include "adit/daemon/can_feed.hpp"
 #include "adit/daemon/imu_source.hpp"
 #include "adit/drivers/lidar/point.hpp"
+#include "adit/slam/gyrodometry.hpp"
 #include "adit/slam/motion_history.hpp"
 #include "adit/slam/odometry.hpp"
 
@@ -39,6 +40,8 @@ struct MotionAidCounts {
   std::uint64_t wheel_priors = 0;           // scans registered with the wheels' prior
   std::uint64_t scans_without_wheels = 0;   // wheels configured, but no samples around the scan
   std::uint64_t scans_wheels_held = 0;      // a wheel held for slip over the scan's interval: no wheel prior
+  std::uint64_t gyro_priors = 0;            // wheel priors turned by the gyroscope (gyrodometry)
+  std::uint64_t gyro_still = 0;             // scans over which the wheels stood still: the gyroscope's bias learnt
   std::uint64_t gravity_priors = 0;         // scans registered with the accelerometer's up
   std::uint64_t scans_without_gravity = 0;  // IMU and wheels configured, but no readings or not gravity-sized
 };
@@ -70,6 +73,10 @@ class ScanOdometry {
   const Eigen::Isometry3f& extrinsic() const { return extrinsic_; }  // the sensor in the body frame
   const slam::Odometry& odometry() const { return odometry_; }  // slam::Odometry::process, last scan
   const MotionAidCounts& counts() const { return counts_; }
+  // The wheels' prior the last scan was registered with (turned by the
+  // gyroscope with gyrodometry), or nullopt; and the gyroscope's bias learnt.
+  const std::optional<slam::MotionPrior>& wheel_prior() const { return wheel_prior_; }
+  const slam::GyroBias& gyro_bias() const { return gyro_bias_; }
   // The IMU the odometry reads (its readings, mounting and stats), or null.
   const ImuSource* imu() const { return imu_; }
   // The LiDAR-inertial filter's state after the last scan it corrected (result().inertial).
@@ -78,6 +85,7 @@ class ScanOdometry {
 
  private:
   std::optional<slam::MotionPrior> wheel_prior_for(double previous, double t);
+  slam::MotionPrior turned_by_gyro(const slam::MotionPrior& wheels, double previous, double t);
   std::optional<slam::UpMeasurement> up_for(std::int64_t stamp_ns, float sweep_s);
 
   static constexpr double kSpeedHalfWindow_s = 0.05;  // the wheels' speed: central differences over ±50 ms
@@ -91,11 +99,16 @@ class ScanOdometry {
   std::function<bool()> idle_;
   double previous_scan_s_ = 0.0;  // the last scan's start (s): the wheels' and the IMU's readings since
   std::vector<slam::ImuSample> imu_samples_;  // reserved only with a gyroscope
+  bool gyrodometry_ = false;                  // wheels and a gyroscope, imu.gyro_with_wheels
+  slam::GyroNoise gyro_noise_;
+  slam::GyroBias gyro_bias_{gyro_noise_};
+  std::vector<slam::ImuSample> gyro_samples_;  // reserved only for gyrodometry
   std::vector<Eigen::Vector3f> body_points_;
   std::vector<float> body_times_;
   slam::OdometryResult result_;
   double registration_ms_ = 0.0;
   MotionAidCounts counts_;
+  std::optional<slam::MotionPrior> wheel_prior_;
 };
 
 }  // namespace adit::daemon

@@ -138,6 +138,9 @@ struct ImuSection {
   double accel_range_mps2 = 0.0;
   double gyro_range_radps = 0.0;
   double gravity_sigma_deg = 0.2;        // the odometry's trust in the measured up, per scan
+  // With wheels and a gyroscope, the motion prior turns with the gyroscope
+  // and moves with the wheels (gyrodometry, docs/decisions/052).
+  bool gyro_with_wheels = true;
   double gyro_noise_density = 1.7e-4;    // rad/s/√Hz
   double accel_noise_density = 2.0e-3;   // m/s²/√Hz
   double gyro_bias_walk = 1.9e-5;        // rad/s²/√Hz

@@ -165,6 +165,7 @@ void describe(V& v, ImuSection& s) {
   v.optional("accel_range_mps2", s.accel_range_mps2, Range<double>{0.0, 10'000.0});
   v.optional("gyro_range_radps", s.gyro_range_radps, Range<double>{0.0, 1'000.0});
   v.optional("gravity_sigma_deg", s.gravity_sigma_deg, Range<double>{0.01, 10.0});
+  v.optional("gyro_with_wheels", s.gyro_with_wheels);
   v.optional("gyro_noise_density", s.gyro_noise_density, Range<double>{1e-6, 1.0});
   v.optional("accel_noise_density", s.accel_noise_density, Range<double>{1e-6, 10.0});
   v.optional("gyro_bias_walk", s.gyro_bias_walk, Range<double>{0.0, 1.0});
