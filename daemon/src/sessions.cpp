@@ -187,6 +187,7 @@ nlohmann::json live_grid_summary(const slam::LiveGrid* grid, double resolution_m
   if (grid == nullptr) return nullptr;
   return {{"patches", grid->patch_count()}, {"resolution_m", resolution_m},
           {"scans", grid->counts().scans}, {"memory_bytes", grid->memory_bytes()}, {"file_bytes", file_bytes},
+          {"patches_frozen", grid->frozen_count()}, {"freezes", grid->counts().freezes}, {"thaws", grid->counts().thaws},
           {"insert_ms_median", quantile(insert_ms, 0.5)}, {"insert_ms_p99", quantile(insert_ms, 0.99)}};
 }
 

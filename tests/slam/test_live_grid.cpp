@@ -186,3 +186,44 @@ TEST(LiveGrid, PointsOutOfTheBandOrRangeOrNotFiniteMakeNoObstacle) {
 
 }  // namespace
 }  // namespace adit::slam
+
+namespace adit::slam {
+namespace {
+
+// Down a 160 m drift and back (max range 20 m): the patches the sensor
+// leaves freeze, those it comes back to thaw, and the grid reads, reports and
+// versions exactly as one that never froze.
+TEST(LiveGrid, PatchesBeyondTheRaysFreezeAndThawExactlyAsTheyWere) {
+  LiveGridConfig config;
+  config.max_range_m = 20.0F;
+  LiveGridConfig whole = config;
+  whole.freeze_far_patches = false;
+  LiveGrid grid(config);
+  LiveGrid reference(whole);
+  std::size_t most_frozen = 0;
+  for (int k = 0; k <= 160; ++k) {
+    const float x = k <= 80 ? 2.0F * static_cast<float>(k) : 2.0F * static_cast<float>(160 - k);
+    const Eigen::Vector3f sensor(x, 0.3F, 0.0F);
+    const auto scan = drift_scan(sensor, kHalfWidth, -1.0F, 200.0F);
+    grid.insert(sensor, scan);
+    reference.insert(sensor, scan);
+    ASSERT_EQ(grid.take_changed(), reference.take_changed()) << "scan " << k;
+    most_frozen = std::max(most_frozen, grid.frozen_count());
+  }
+  EXPECT_GT(most_frozen, grid.patch_count() / 2) << "at the drift's far end most patches lie beyond 20 m";
+  EXPECT_GT(grid.counts().thaws, 0U) << "and the way back reached them again";
+  EXPECT_GT(grid.frozen_count(), 0U) << "the far end's patches stay frozen";
+  ASSERT_EQ(grid.patch_coords(), reference.patch_coords());
+  const auto cells = static_cast<std::size_t>(config.patch_cells) * static_cast<std::size_t>(config.patch_cells);
+  std::vector<std::int8_t> a(cells), b(cells);
+  for (const GridPatchCoord c : grid.patch_coords()) {
+    grid.read(c, a);
+    reference.read(c, b);
+    ASSERT_EQ(a, b) << c.x << ", " << c.y;
+    EXPECT_EQ(grid.version(c), reference.version(c));
+  }
+  EXPECT_LT(grid.memory_bytes(), reference.memory_bytes() / 2) << grid.frozen_count() << " of " << grid.patch_count() << " frozen";
+}
+
+}  // namespace
+}  // namespace adit::slam

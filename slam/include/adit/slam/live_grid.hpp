@@ -19,8 +19,12 @@
 //
 // The grid is cut into square patches that exist once touched; a patch whose
 // read values changed is reported by take_changed() with a new version, so
-// only those go to the tablet. Not thread-safe; allocates when the grid
-// grows (a patch at a time), not per point.
+// only those go to the tablet. A patch that no ray can reach any more (beyond
+// max_range and a patch's width from the sensor) is frozen: its log-odds
+// compressed (zstd), its scan stamps dropped, 64 kB down to a few; it thaws,
+// exactly as it was, when a ray reaches it again. Not thread-safe; allocates
+// when the grid grows or a patch freezes or thaws (a patch at a time), not
+// per point.
 
 #include <compare>
 #include <cstdint>
@@ -43,6 +47,7 @@ struct LiveGridConfig {
   float max_range_m = 40.0F;   // horizontal; farther points are left out
   int bearings = 1440;         // free rays per scan: the nearest obstacle per 0.25° (0.16-0.32°)
   int patch_cells = 128;       // a patch is patch_cells × patch_cells cells
+  bool freeze_far_patches = true;  // compress patches no ray can reach (false: all stay as they are)
 };
 
 // Patch (x, y) holds cells [x·n, (x+1)·n) × [y·n, (y+1)·n), n = patch_cells;
@@ -60,6 +65,8 @@ struct LiveGridCounts {
   std::uint64_t scans = 0;
   std::uint64_t hit_updates = 0;   // cells updated as hit (one per cell per scan)
   std::uint64_t miss_updates = 0;  // cells updated as passed
+  std::uint64_t freezes = 0;       // patches compressed as the sensor left them
+  std::uint64_t thaws = 0;         // frozen patches a ray reached again
 };
 
 class LiveGrid {
@@ -84,13 +91,15 @@ class LiveGrid {
 
   const LiveGridConfig& config() const { return config_; }
   std::size_t patch_count() const { return patches_.size(); }
+  std::size_t frozen_count() const { return frozen_; }
   std::size_t memory_bytes() const;
   const LiveGridCounts& counts() const { return counts_; }
 
  private:
   struct Patch {
-    std::vector<std::int16_t> log_odds;  // ×1000
-    std::vector<std::uint16_t> stamp;    // the last scan that updated the cell (wraps)
+    std::vector<std::int16_t> log_odds;  // ×1000; empty while frozen
+    std::vector<std::uint16_t> stamp;    // the last scan that updated the cell (wraps); empty while frozen
+    std::vector<std::uint8_t> frozen;    // the log-odds, zstd-compressed, while frozen
     std::int32_t version = 0;
     bool changed = false;
   };
@@ -107,6 +116,10 @@ class LiveGrid {
     return {static_cast<std::int32_t>(key >> 32), static_cast<std::int32_t>(static_cast<std::uint32_t>(key))};
   }
   Patch& patch_at(GridPatchCoord c);
+  void freeze(Patch& p);
+  void thaw_into(const std::vector<std::uint8_t>& frozen, std::vector<std::int16_t>& log_odds) const;
+  // Freezes the patches beyond every ray from `origin` (map xy).
+  void freeze_far(const Eigen::Vector2f& origin);
   // Updates a cell of `p` once this scan; false when it was updated already.
   bool update(Patch& p, std::size_t cell, std::int16_t delta);
   static float pseudo_angle(float x, float y);
@@ -118,6 +131,7 @@ class LiveGrid {
   std::unordered_map<std::int64_t, Patch> patches_;
   std::vector<Ray> rays_;  // one per bearing, reused each scan
   std::uint16_t scan_stamp_ = 0;
+  std::size_t frozen_ = 0;
   // The patch of the last update, so a ray's cells find theirs without a lookup.
   Patch* last_patch_ = nullptr;
   GridPatchCoord last_coord_{};
