@@ -63,6 +63,7 @@ void OdometryStage::loop() {
     stats_.scans_wheels_held.store(counts.scans_wheels_held, std::memory_order_relaxed);
     stats_.gyro_priors.store(counts.gyro_priors, std::memory_order_relaxed);
     stats_.gyro_still.store(counts.gyro_still, std::memory_order_relaxed);
+    stats_.gyro_refused.store(counts.gyro_refused, std::memory_order_relaxed);
     stats_.gravity_priors.store(counts.gravity_priors, std::memory_order_relaxed);
     stats_.scans_without_gravity.store(counts.scans_without_gravity, std::memory_order_relaxed);
     copy_imu_stats();

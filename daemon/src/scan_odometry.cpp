@@ -121,14 +121,20 @@ std::optional<slam::MotionPrior> ScanOdometry::wheel_prior_for(double previous, 
 
 // The wheels' prior from `previous` to `t` with the gyroscope's rotation over
 // the same interval, its bias removed; the wheels' own when the readings do
-// not cover it. Wheels that stood still teach the bias first: the mean rate
-// is then the bias, unless it is a turn (a body turned by hand on its wheels).
+// not cover it, an axis is stuck, or the two disagree beyond their
+// covariances (a failed gyroscope). Wheels that stood still teach the bias
+// first: the mean rate is then the bias, unless it is a turn (a body turned
+// by hand on its wheels).
 slam::MotionPrior ScanOdometry::turned_by_gyro(const slam::MotionPrior& wheels, double previous, double t) {
   constexpr double kStillM = 1e-3;         // wheel travel over the interval, m
   constexpr double kStillRad = 1e-3;       // wheel turn over the interval, rad
   constexpr double kMaxBiasRadps = 0.05;   // above this the body turned: not a bias
   imu_->history().copy_covering(previous, t, gyro_samples_);
   const double dt = t - previous;
+  if (slam::gyro_stuck(gyro_samples_, previous, t)) {
+    ++counts_.gyro_refused;
+    return wheels;
+  }
   if (wheels.delta.translation().norm() < kStillM && Eigen::AngleAxisd(wheels.delta.linear()).angle() < kStillRad) {
     const auto raw = slam::gyro_rotation(gyro_samples_, previous, t, Eigen::Vector3d::Zero(), gyro_noise_.max_gap_s);
     if (raw) {
@@ -139,8 +145,9 @@ slam::MotionPrior ScanOdometry::turned_by_gyro(const slam::MotionPrior& wheels, 
   }
   const auto rotation = slam::gyro_rotation(gyro_samples_, previous, t, gyro_bias_.bias(), gyro_noise_.max_gap_s);
   if (!rotation) return wheels;
-  ++counts_.gyro_priors;
-  return slam::gyro_aided(wheels, *rotation, dt, gyro_bias_.sigma(t), gyro_noise_);
+  const std::optional<slam::MotionPrior> turned = slam::gyro_aided(wheels, *rotation, dt, gyro_bias_.sigma(t), gyro_noise_);
+  ++(turned ? counts_.gyro_priors : counts_.gyro_refused);
+  return turned.value_or(wheels);
 }
 
 // After wheel_prior_for: gravity's up in the body frame over the sweep, from

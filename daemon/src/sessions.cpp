@@ -525,6 +525,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                    {"wheels_held", s.scans_wheels_held.load()},
                    {"turned_by_gyro", s.gyro_priors.load()},
                    {"gyro_bias_still", s.gyro_still.load()},
+                   {"gyro_refused", s.gyro_refused.load()},
                    {"with_gravity_prior", s.gravity_priors.load()},
                    {"gravity_missing", s.scans_without_gravity.load()}}},
         {"imu", imu_summary(s.imu)},

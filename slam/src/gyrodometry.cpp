@@ -1,7 +1,10 @@
 #include "adit/slam/gyrodometry.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include <Eigen/Dense>
 
 namespace adit::slam {
 
@@ -28,6 +31,19 @@ std::optional<Eigen::Matrix3d> gyro_rotation(std::span<const ImuSample> readings
   return rotation;
 }
 
+bool gyro_stuck(std::span<const ImuSample> readings, double t0, double t1, std::size_t min_readings) {
+  const ImuSample* first = nullptr;
+  std::size_t count = 0;
+  std::array<bool, 3> same{true, true, true};
+  for (const ImuSample& r : readings) {
+    if (r.t < t0 || r.t > t1 || !r.has_gyro) continue;
+    if (first == nullptr) first = &r;
+    for (int a = 0; a < 3; ++a) same[static_cast<std::size_t>(a)] = same[static_cast<std::size_t>(a)] && r.angular_rate[a] == first->angular_rate[a];
+    ++count;
+  }
+  return count >= min_readings && (same[0] || same[1] || same[2]);
+}
+
 bool GyroBias::still(const Eigen::Vector3d& mean_rate, double t0, double t1) {
   if (!(t1 > t0) || !mean_rate.allFinite()) return false;
   // The mean of white rate noise over T has variance density²/T.
@@ -48,14 +64,24 @@ double GyroBias::sigma(double t) const {
   return std::sqrt(variance_ + noise_.bias_walk * noise_.bias_walk * std::max(t - at_, 0.0));
 }
 
-MotionPrior gyro_aided(const MotionPrior& wheels, const Eigen::Matrix3d& rotation, double dt, double bias_sigma,
-                       const GyroNoise& noise) {
+std::optional<MotionPrior> gyro_aided(const MotionPrior& wheels, const Eigen::Matrix3d& rotation, double dt,
+                                      double bias_sigma, const GyroNoise& noise) {
   MotionPrior prior = wheels;
   prior.delta.linear() = rotation;
   const double turn = Eigen::AngleAxisd(rotation).angle();
-  const double density2 = noise.rate_density * noise.rate_density + noise.model_error_density * noise.model_error_density;
-  const double variance = density2 * dt + (bias_sigma * dt) * (bias_sigma * dt) +
-                          (noise.scale_error * turn) * (noise.scale_error * turn);
+  // What the gyroscope itself gets wrong (its datasheet's noise, the bias's
+  // σ, its scale), and what the prior allows besides: the model error, so
+  // that over many scans the map, not the gyroscope's bias, holds the heading.
+  const double own = noise.rate_density * noise.rate_density * dt + (bias_sigma * dt) * (bias_sigma * dt) +
+                     (noise.scale_error * turn) * (noise.scale_error * turn);
+  const double variance = own + noise.model_error_density * noise.model_error_density * dt;
+  // Do the gyroscope and the wheels agree, within the wheels' σ (5 % of the
+  // turn) and the gyroscope's own? A stuck one reads a corner as straight.
+  const Eigen::AngleAxisd apart(wheels.delta.linear().transpose() * rotation);
+  const Eigen::Vector3d difference = apart.axis() * apart.angle();
+  const Eigen::Matrix3d together = wheels.covariance.block<3, 3>(3, 3) + own * Eigen::Matrix3d::Identity();
+  constexpr double kChi2Three999 = 16.27;
+  if (!(difference.dot(together.ldlt().solve(difference)) <= kChi2Three999)) return std::nullopt;
   prior.covariance.block<3, 3>(3, 3) = variance * Eigen::Matrix3d::Identity();
   prior.covariance.block<3, 3>(0, 3).setZero();
   prior.covariance.block<3, 3>(3, 0).setZero();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -130,7 +131,8 @@ TEST(ScanOdometry, TakesNoWheelPriorOverAWheelHeldForSlip) {
 // 0.04 rad/s), with a gyroscope whose bias is (0.002, -0.001, 0.004) rad/s.
 // The standstill teaches the bias; the priors then turn as the gyroscope
 // turns, with its bias removed, not as the wheels do.
-std::filesystem::path drive_with_gyro_log(const std::string& name) {
+// `stuck_z` (counts of 0.0002 rad/s) replaces the gyroscope's z from 1001.5 s when given.
+std::filesystem::path drive_with_gyro_log(const std::string& name, std::optional<int> stuck_z = std::nullopt) {
   const std::filesystem::path log = binary_dir_log(name);
   std::ofstream out(log);
   for (int i = 0; i <= 300; ++i) {
@@ -139,7 +141,9 @@ std::filesystem::path drive_with_gyro_log(const std::string& name) {
     const auto mm = [](double v) { return test::int16_le({static_cast<int>(std::lround(1000.0 * v)), 0, 0}).substr(0, 4); };
     out << fmt::format("({:.6f}) can0 300#{}{}\n", t, mm(1.01 * speed), mm(0.99 * speed));
     out << fmt::format("({:.6f}) can0 190#{}\n", t + 0.0003, test::int16_le({0, 0, 9807}));
-    out << fmt::format("({:.6f}) can0 191#{}\n", t + 0.0004, test::int16_le({10, -5, 20}));  // 0.0002 rad/s a count
+    const int noise = i % 2 == 0 ? 1 : -1;  // a count either way: a real gyroscope's axes never read one value
+    const int z = stuck_z && t >= 1001.5 ? *stuck_z : 20 + noise;
+    out << fmt::format("({:.6f}) can0 191#{}\n", t + 0.0004, test::int16_le({10 + noise, -5 - noise, z}));  // 0.0002 rad/s a count
   }
   return log;
 }
@@ -166,10 +170,26 @@ TEST(ScanOdometry, TurnsTheWheelsPriorWithTheGyroscopeWhoseBiasItLearntStandingS
   EXPECT_EQ(counts.wheel_priors, 19U);
   EXPECT_GE(counts.gyro_still, 4U) << "the scans from 1000.5 to 1001.0 s";
   EXPECT_LE(counts.gyro_still, 6U);
-  EXPECT_LT((replay.odometry.gyro_bias().bias() - Eigen::Vector3d(0.002, -0.001, 0.004)).norm(), 2e-5)
+  EXPECT_LT((replay.odometry.gyro_bias().bias() - Eigen::Vector3d(0.002, -0.001, 0.004)).norm(), 5e-5)
       << replay.odometry.gyro_bias().bias().transpose();
   // The wheels turn 0.02 m/s across 0.5 m: 0.004 rad a scan; the gyroscope, its bias removed, none.
   EXPECT_LT(largest_turn, 1e-4) << "the wheels alone turn 0.004 rad a scan";
+}
+
+// From 1001.5 s the gyroscope's z reads 0.3 rad/s, one value (stuck), while
+// the wheels turn 0.004 rad a scan: the wheels' turn stands.
+TEST(ScanOdometry, KeepsTheWheelsTurnWhenTheGyroscopeDisagreesWithThem) {
+  OnReplayedCan replay(wheels_and_gyro_config(drive_with_gyro_log("scan-odometry-stuck-gyro", 1500)));
+  double last_yaw = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    replay.odometry.process(room_scan(1'000'500'000'000 + k * 100'000'000LL));
+    if (replay.odometry.wheel_prior()) last_yaw = Eigen::AngleAxisd(replay.odometry.wheel_prior()->delta.linear()).angle();
+  }
+  replay.can.stop();
+  const MotionAidCounts& counts = replay.odometry.counts();
+  EXPECT_GE(counts.gyro_refused, 8U) << "the scans from 1001.6 s";
+  EXPECT_EQ(counts.gyro_refused + counts.gyro_priors, counts.wheel_priors);
+  EXPECT_NEAR(last_yaw, 0.02 / 0.5 * 0.1, 2e-4) << "the wheels' turn, not the gyroscope's 0.03 rad";
 }
 
 TEST(ScanOdometry, KeepsTheWheelsTurnWithoutGyrodometry) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -52,6 +53,19 @@ TEST(GyroRotation, RefusesReadingsThatDoNotCoverTheIntervalOrHaveAGap) {
   EXPECT_FALSE(gyro_rotation(accelerometer_only, 100.0, 100.1, Eigen::Vector3d::Zero(), 0.05).has_value());
 }
 
+TEST(GyroStuck, FindsAnAxisThatReadsOneValueThroughTheInterval) {
+  auto r = readings(100.0, 100.2, Eigen::Vector3d(0.01, -0.02, 0.3), Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < r.size(); ++i)  // a MEMS unit's noise: every axis moves
+    r[i].angular_rate += 1e-4 * Eigen::Vector3d(static_cast<double>(i % 3), static_cast<double>(i % 2),
+                                                static_cast<double>(i % 4));
+  EXPECT_FALSE(gyro_stuck(r, 100.0, 100.1));
+  for (auto& s : r)
+    if (s.t > 100.05) s.angular_rate.z() = 0.0;  // z stuck at zero from 100.05 s
+  EXPECT_FALSE(gyro_stuck(r, 100.0, 100.1)) << "it moved within the interval";
+  EXPECT_TRUE(gyro_stuck(r, 100.1, 100.2));
+  EXPECT_FALSE(gyro_stuck(r, 100.1, 100.125)) << "too few readings to tell";
+}
+
 TEST(GyroBias, LearnsTheBiasFromStandstillsAndGrowsUncertainBetweenThem) {
   GyroNoise noise;
   noise.rate_density = 1.7e-4;
@@ -89,17 +103,32 @@ TEST(GyroAided, TakesTheWheelsTranslationAndTheGyroscopesRotationWithItsCovarian
   const MotionPrior wheels = wheel_motion_prior({0.0, 0.0, 0.0}, {0.0999, 0.007, 0.14 * 0.996}, 0.1);
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.14, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   GyroNoise noise;
-  const MotionPrior prior = gyro_aided(wheels, rotation, 0.1, 2e-4, noise);
-  EXPECT_TRUE(prior.delta.linear().isApprox(rotation, 1e-12));
-  EXPECT_TRUE(prior.delta.translation().isApprox(wheels.delta.translation(), 1e-12));
-  EXPECT_TRUE((prior.covariance.topLeftCorner<3, 3>().isApprox(wheels.covariance.topLeftCorner<3, 3>())));
+  const std::optional<MotionPrior> prior = gyro_aided(wheels, rotation, 0.1, 2e-4, noise);
+  ASSERT_TRUE(prior.has_value());
+  EXPECT_TRUE(prior->delta.linear().isApprox(rotation, 1e-12));
+  EXPECT_TRUE(prior->delta.translation().isApprox(wheels.delta.translation(), 1e-12));
+  EXPECT_TRUE((prior->covariance.topLeftCorner<3, 3>().isApprox(wheels.covariance.topLeftCorner<3, 3>())));
   const double density2 = noise.rate_density * noise.rate_density + noise.model_error_density * noise.model_error_density;
   const double variance = density2 * 0.1 + std::pow(2e-4 * 0.1, 2) + std::pow(noise.scale_error * 0.14, 2);
-  EXPECT_TRUE((prior.covariance.bottomRightCorner<3, 3>().isApprox(variance * Eigen::Matrix3d::Identity(), 1e-12)));
-  EXPECT_TRUE((prior.covariance.topRightCorner<3, 3>().isZero()));
+  EXPECT_TRUE((prior->covariance.bottomRightCorner<3, 3>().isApprox(variance * Eigen::Matrix3d::Identity(), 1e-12)));
+  EXPECT_TRUE((prior->covariance.topRightCorner<3, 3>().isZero()));
   // Tighter than the wheels' yaw in a turn, and it now bounds roll and pitch as well.
-  EXPECT_LT(prior.covariance(5, 5), wheels.covariance(5, 5));
-  EXPECT_LT(prior.covariance(3, 3), wheels.covariance(3, 3));
+  EXPECT_LT(prior->covariance(5, 5), wheels.covariance(5, 5));
+  EXPECT_LT(prior->covariance(3, 3), wheels.covariance(3, 3));
+}
+
+TEST(GyroAided, KeepsTheWheelsTurnWhenTheGyroscopeReadsAFastCornerAsStraight) {
+  // A gyroscope stuck at zero while the robot turns 0.14 rad in a scan: the
+  // wheels' σ is 0.012 rad there, the difference over ten of it.
+  const MotionPrior wheels = wheel_motion_prior({0.0, 0.0, 0.0}, {0.0999, 0.007, 0.14}, 0.1);
+  EXPECT_FALSE(gyro_aided(wheels, Eigen::Matrix3d::Identity(), 0.1, 2e-4, GyroNoise{}).has_value());
+  // Stuck at 0.3 rad/s on a straight: 0.03 rad against the wheels' 0.0055.
+  const MotionPrior straight = wheel_motion_prior({0.0, 0.0, 0.0}, {0.1, 0.0, 0.0}, 0.1);
+  const Eigen::Matrix3d turning = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_FALSE(gyro_aided(straight, turning, 0.1, 2e-4, GyroNoise{}).has_value());
+  // A wheel slip's 0.01 rad of false turn in a scan is within both.
+  const Eigen::Matrix3d slip = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_TRUE(gyro_aided(straight, slip, 0.1, 2e-4, GyroNoise{}).has_value());
 }
 
 }  // namespace

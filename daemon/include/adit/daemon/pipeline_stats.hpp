@@ -95,6 +95,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
   std::atomic<std::uint64_t> scans_wheels_held{0};     // a wheel held for slip over the scan's interval: no wheel prior
   std::atomic<std::uint64_t> gyro_priors{0};           // wheel priors turned by the gyroscope (gyrodometry)
+  std::atomic<std::uint64_t> gyro_refused{0};          // the gyroscope disagreed with the wheels: their turn kept
   std::atomic<std::uint64_t> gyro_still{0};            // scans whose standstill taught the gyroscope's bias
   std::atomic<std::uint64_t> gravity_priors{0};        // scans registered with the accelerometer's up
   std::atomic<std::uint64_t> scans_without_gravity{0}; // IMU and wheels configured, but no readings or not gravity-sized

@@ -41,6 +41,7 @@ struct MotionAidCounts {
   std::uint64_t scans_without_wheels = 0;   // wheels configured, but no samples around the scan
   std::uint64_t scans_wheels_held = 0;      // a wheel held for slip over the scan's interval: no wheel prior
   std::uint64_t gyro_priors = 0;            // wheel priors turned by the gyroscope (gyrodometry)
+  std::uint64_t gyro_refused = 0;           // a gyroscope axis stuck, or its turn far from the wheels': the wheels' turn kept
   std::uint64_t gyro_still = 0;             // scans over which the wheels stood still: the gyroscope's bias learnt
   std::uint64_t gravity_priors = 0;         // scans registered with the accelerometer's up
   std::uint64_t scans_without_gravity = 0;  // IMU and wheels configured, but no readings or not gravity-sized

@@ -8,6 +8,7 @@
 // The roll and pitch the wheels cannot see come from the gyroscope too.
 // (docs/decisions/052-gyrodometry.md)
 
+#include <cstddef>
 #include <optional>
 #include <span>
 
@@ -33,6 +34,12 @@ struct GyroNoise {
 // gyroscope, and none are further apart than max_gap_s.
 std::optional<Eigen::Matrix3d> gyro_rotation(std::span<const ImuSample> readings, double t0, double t1,
                                              const Eigen::Vector3d& bias, double max_gap_s);
+
+// Whether an axis of the gyroscope read one value in every reading within
+// [t0, t1], at least `min_readings` of them: stuck (daemon::ImuMonitor counts
+// an axis stuck after 100 such readings; a MEMS unit's noise moves every axis
+// by several steps per reading, so even a still one does not repeat).
+bool gyro_stuck(std::span<const ImuSample> readings, double t0, double t1, std::size_t min_readings = 8);
 
 // The gyroscope's bias, the same on each axis in its uncertainty: a Kalman
 // filter on a random walk, measured by the mean rate over each stretch the
@@ -61,7 +68,11 @@ class GyroBias {
 // The wheels' prior with its rotation replaced by the gyroscope's over the
 // same interval `dt` and that rotation's covariance: white noise, the bias's
 // σ, and the scale-factor error, per axis. Translation as the wheels had it.
-MotionPrior gyro_aided(const MotionPrior& wheels, const Eigen::Matrix3d& rotation, double dt, double bias_sigma,
-                       const GyroNoise& noise);
+// nullopt when the two rotations differ by more than the wheels' covariance
+// and the gyroscope's own error (without the model error) together allow (χ²
+// with 3 degrees of freedom beyond its 99.9 % point, 16.27): a gyroscope stuck
+// or failed, or a slip far beyond the wheels' σ; the wheels' prior stands.
+std::optional<MotionPrior> gyro_aided(const MotionPrior& wheels, const Eigen::Matrix3d& rotation, double dt,
+                                      double bias_sigma, const GyroNoise& noise);
 
 }  // namespace adit::slam
