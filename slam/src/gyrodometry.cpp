@@ -6,28 +6,20 @@
 
 #include <Eigen/Dense>
 
+#include "inertial_kinematics.hpp"
+
 namespace adit::slam {
 
 std::optional<Eigen::Matrix3d> gyro_rotation(std::span<const ImuSample> readings, double t0, double t1,
                                              const Eigen::Vector3d& bias, double max_gap_s) {
-  if (!(t1 > t0) || readings.size() < 2 || readings.front().t > t0 || readings.back().t < t1) return std::nullopt;
-  const auto rate_at = [](const ImuSample& a, const ImuSample& b, double t) {
-    return Eigen::Vector3d(a.angular_rate + (b.angular_rate - a.angular_rate) * ((t - a.t) / (b.t - a.t)));
-  };
+  if (!(t1 > t0) || !kinematics::covers(readings, t0, t1, max_gap_s)) return std::nullopt;
+  for (const ImuSample& r : readings)
+    if (!r.has_gyro) return std::nullopt;
+  // The filter's midpoint rule (inertial_kinematics.hpp), the rotation alone.
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  for (std::size_t i = 0; i + 1 < readings.size(); ++i) {
-    const ImuSample& a = readings[i];
-    const ImuSample& b = readings[i + 1];
-    if (a.t >= t1) break;
-    if (b.t <= t0) continue;
-    if (!a.has_gyro || !b.has_gyro || !(b.t > a.t) || b.t - a.t > max_gap_s) return std::nullopt;
-    const double from = std::max(a.t, t0);
-    const double to = std::min(b.t, t1);
-    if (!(to > from)) continue;
-    const Eigen::Vector3d step = (0.5 * (rate_at(a, b, from) + rate_at(a, b, to)) - bias) * (to - from);
-    const double angle = step.norm();
-    if (angle > 0.0) rotation = rotation * Eigen::AngleAxisd(angle, step / angle).toRotationMatrix();
-  }
+  kinematics::for_each_piece(readings, t0, t1, [&](const kinematics::Reading& a, const kinematics::Reading& b, double dt) {
+    rotation = rotation * kinematics::exp_so3((0.5 * (a.gyro + b.gyro) - bias) * dt);
+  });
   return rotation;
 }
 

@@ -8,7 +8,9 @@
 namespace adit::slam {
 namespace {
 
+using kinematics::covers;
 using kinematics::exp_so3;
+using kinematics::for_each_piece;
 using kinematics::integrate;
 using kinematics::Reading;
 
@@ -18,47 +20,6 @@ using kinematics::kG;
 using kinematics::kP;
 using kinematics::kTheta;
 using kinematics::kV;
-
-// The samples at `tau`: linear between the two around it, the nearest held
-// beyond the ends. `j` walks forward with tau (samples[j].t <= tau).
-Reading reading_at(std::span<const ImuSample> samples, std::size_t& j, double tau) {
-  while (j + 1 < samples.size() && samples[j + 1].t <= tau) ++j;
-  const ImuSample& a = samples[j];
-  if (tau <= a.t || j + 1 == samples.size()) return {a.angular_rate, a.specific_force};
-  const ImuSample& b = samples[j + 1];
-  const double s = (tau - a.t) / (b.t - a.t);
-  return {a.angular_rate + s * (b.angular_rate - a.angular_rate), a.specific_force + s * (b.specific_force - a.specific_force)};
-}
-
-// Whether the samples reach [t0, t1] with no gap over max_gap.
-bool covers(std::span<const ImuSample> samples, double t0, double t1, double max_gap) {
-  if (samples.empty() || samples.front().t > t0 + max_gap || samples.back().t < t1 - max_gap) return false;
-  for (std::size_t i = 1; i < samples.size(); ++i) {
-    if (samples[i].t <= t0 || samples[i - 1].t >= t1) continue;
-    if (!(samples[i].t > samples[i - 1].t) || samples[i].t - samples[i - 1].t > max_gap) return false;
-  }
-  return true;
-}
-
-// Calls step(a, b, dt) for each piece of [t0, t1] between sample times.
-template <typename Step>
-void for_each_piece(std::span<const ImuSample> samples, double t0, double t1, Step&& step) {
-  std::size_t j = 0;
-  double tau = t0;
-  Reading a = reading_at(samples, j, tau);
-  while (tau < t1) {
-    double next = t1;
-    for (std::size_t k = j; k < samples.size(); ++k)
-      if (samples[k].t > tau) {
-        next = std::min(next, samples[k].t);
-        break;
-      }
-    const Reading b = reading_at(samples, j, next);
-    step(a, b, next - tau);
-    a = b;
-    tau = next;
-  }
-}
 
 }  // namespace
 

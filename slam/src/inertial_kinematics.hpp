@@ -1,10 +1,14 @@
 #pragma once
 // The kinematics of an IMU-driven body, shared by the filter's propagation
 // (inertial_filter.cpp) and the pose extrapolated at the IMU's rate between
-// scans (imu_extrapolator.cpp): one midpoint step of pose and velocity from
-// two readings (Solà 2017, §5.3, the nominal-state kinematics), and the
-// error state's covariance carried through it (§5.3.3).
+// scans (imu_extrapolator.cpp), and the gyroscope's rotation for a wheeled
+// robot's prior (gyrodometry.cpp): readings interpolated over an interval, one
+// midpoint step of pose and velocity from two readings (Solà 2017, §5.3, the
+// nominal-state kinematics), and the error state's covariance carried through
+// it (§5.3.3).
 
+#include <algorithm>
+#include <span>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -24,6 +28,47 @@ inline Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) {
   const double angle = w.norm();
   if (angle < 1e-12) return Eigen::Matrix3d::Identity() + skew(w);
   return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+// The samples at `tau`: linear between the two around it, the nearest held
+// beyond the ends. `j` walks forward with tau (samples[j].t <= tau).
+inline Reading reading_at(std::span<const ImuSample> samples, std::size_t& j, double tau) {
+  while (j + 1 < samples.size() && samples[j + 1].t <= tau) ++j;
+  const ImuSample& a = samples[j];
+  if (tau <= a.t || j + 1 == samples.size()) return {a.angular_rate, a.specific_force};
+  const ImuSample& b = samples[j + 1];
+  const double s = (tau - a.t) / (b.t - a.t);
+  return {a.angular_rate + s * (b.angular_rate - a.angular_rate), a.specific_force + s * (b.specific_force - a.specific_force)};
+}
+
+// Whether the samples reach [t0, t1] with no gap over max_gap.
+inline bool covers(std::span<const ImuSample> samples, double t0, double t1, double max_gap) {
+  if (samples.empty() || samples.front().t > t0 + max_gap || samples.back().t < t1 - max_gap) return false;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    if (samples[i].t <= t0 || samples[i - 1].t >= t1) continue;
+    if (!(samples[i].t > samples[i - 1].t) || samples[i].t - samples[i - 1].t > max_gap) return false;
+  }
+  return true;
+}
+
+// Calls step(a, b, dt) for each piece of [t0, t1] between sample times.
+template <typename Step>
+void for_each_piece(std::span<const ImuSample> samples, double t0, double t1, Step&& step) {
+  std::size_t j = 0;
+  double tau = t0;
+  Reading a = reading_at(samples, j, tau);
+  while (tau < t1) {
+    double next = t1;
+    for (std::size_t k = j; k < samples.size(); ++k)
+      if (samples[k].t > tau) {
+        next = std::min(next, samples[k].t);
+        break;
+      }
+    const Reading b = reading_at(samples, j, next);
+    step(a, b, next - tau);
+    a = b;
+    tau = next;
+  }
 }
 
 // Specific force at the body origin from the IMU's at `r`: a point at r on

@@ -29,9 +29,10 @@ struct GyroNoise {
 };
 
 // The body's rotation from t0 to t1 (R_t0⁻¹·R_t1) integrated from gyroscope
-// readings in the body frame (midpoint rule, the ends interpolated) with
-// `bias` removed; nullopt unless the readings cover [t0, t1], all carry a
-// gyroscope, and none are further apart than max_gap_s.
+// readings in the body frame (the LiDAR-inertial filter's midpoint rule, the
+// ends interpolated) with `bias` removed; nullopt unless the readings cover
+// [t0, t1] as the filter requires (none further apart than max_gap_s, nor
+// further than that from either end) and all carry a gyroscope.
 std::optional<Eigen::Matrix3d> gyro_rotation(std::span<const ImuSample> readings, double t0, double t1,
                                              const Eigen::Vector3d& bias, double max_gap_s);
 
