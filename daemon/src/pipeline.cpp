@@ -72,7 +72,8 @@ std::unique_ptr<PriorLocaliser> prior_localiser_of(const config::Config& c, cons
       return nullptr;
     }
     if (from_session) log::info("prior map: the previous session's map {} ({} points kept)", source, prior.points.size());
-    return std::make_unique<PriorLocaliser>(std::move(prior), kPriorScansPerTry, kPriorCloudPoints, stop);
+    return std::make_unique<PriorLocaliser>(std::move(prior), kPriorScansPerTry, kPriorCloudPoints, stop,
+                                            c.prior_map.confirm);
   } catch (const std::exception& e) {
     log::error("prior map {}: {}; mapping without it", source, e.what());
     source.clear();

@@ -27,11 +27,16 @@ constexpr std::uint64_t kMaxBackoff = 10;  // tries' spacing grows to at most 11
 
 }  // namespace
 
+int scans_passed_over(std::uint64_t failures, int scans_per_try) {
+  return scans_per_try * static_cast<int>(std::min<std::uint64_t>(failures, kMaxBackoff));
+}
+
 PriorLocaliser::PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::size_t max_points,
-                               const std::atomic<bool>& stop)
+                               const std::atomic<bool>& stop, bool confirm)
     : prior_(std::move(prior)),
       index_(slam::index_prior_map(prior_)),
       scans_per_try_(std::max(1, scans_per_try)),
+      confirm_(confirm),
       thread_("prior", config::ThreadSettings{}, stop) {
   cloud_.reserve(max_points);
 }
@@ -51,10 +56,7 @@ void PriorLocaliser::join() {
 void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Isometry3d& sensor,
                               const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
   if (state_.load(std::memory_order_acquire) != kFilling) return;
-  if (const std::uint64_t failures = stats_.failures.load(std::memory_order_relaxed); failures != failures_seen_) {
-    failures_seen_ = failures;
-    skip_ = scans_per_try_ * static_cast<int>(std::min<std::uint64_t>(failures, kMaxBackoff));
-  }
+  if (const int n = pass_over_.exchange(0, std::memory_order_relaxed); n > 0) skip_ = n;
   if (hint_arrived_.exchange(false, std::memory_order_relaxed)) skip_ = 0;  // a new hint is tried at once
   if (skip_ > 0) {
     --skip_;
@@ -109,16 +111,28 @@ void PriorLocaliser::loop() {
     cloud_.clear();
     if (!found.success) {
       log::info("prior: not localised yet ({}); trying again with later scans", found.failure);
-      // Counted, then handed back: the odometry thread sees the count with the buffer.
-      stats_.failures.fetch_add(1, std::memory_order_relaxed);
+      // Counted, then handed back: the odometry thread sees the count and the
+      // scans to pass over with the buffer. None while a found pose waits.
+      const std::uint64_t failures = stats_.failures.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (!confirmation_.waiting()) pass_over_.store(scans_passed_over(failures, scans_per_try_), std::memory_order_relaxed);
       state_.store(kFilling, std::memory_order_release);
       continue;
     }
-    anchor_ = found.pose * level_from_odometry_;
+    const Eigen::Isometry3d anchor = found.pose * level_from_odometry_;
     const Eigen::Vector3d t = found.pose.translation();
+    const bool disagrees = confirmation_.waiting();
+    if (confirm_ && !confirmation_.agrees(anchor, level_from_odometry_.inverse())) {
+      log::info("prior: found ({:.2f}, {:.2f}, {:.2f}) m in the prior's frame, overlap {:.2f}{}; taken once the next "
+                "try agrees",
+                t.x(), t.y(), t.z(), found.overlap, disagrees ? ", not where the try before found" : "");
+      stats_.unconfirmed.fetch_add(1, std::memory_order_relaxed);
+      state_.store(kFilling, std::memory_order_release);  // not a failure: the next scans at once
+      continue;
+    }
+    anchor_ = anchor;
     log::info("prior: localised at ({:.2f}, {:.2f}, {:.2f}) m in the prior's frame, overlap {:.2f}, position sigma "
-              "{:.3f} m; the odometry registers against the prior from its next scan",
-              t.x(), t.y(), t.z(), found.overlap, found.position_sigma_m);
+              "{:.3f} m{}; the odometry registers against the prior from its next scan",
+              t.x(), t.y(), t.z(), found.overlap, found.position_sigma_m, confirm_ ? ", where the try before found" : "");
     write_frame(anchor_);
     state_.store(kFound, std::memory_order_release);
     break;  // one anchor a session

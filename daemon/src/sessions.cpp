@@ -85,7 +85,8 @@ nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& sou
   return {{"enabled", true}, {"source", source}, {"anchored", anchored},
           {"anchored_after_s", anchored ? nlohmann::json(s.anchored_after_s.load()) : nlohmann::json(nullptr)},
           {"tries", s.tries.load()}, {"failed_tries", s.failures.load()},
-          {"scans_without_up", s.scans_without_up.load()}, {"hinted_tries", s.hinted_tries.load()}};
+          {"scans_without_up", s.scans_without_up.load()}, {"hinted_tries", s.hinted_tries.load()},
+          {"unconfirmed_tries", s.unconfirmed.load()}};
 }
 
 // The running session's map frame for frame_t: the prior's once found.

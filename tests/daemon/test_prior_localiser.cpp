@@ -1,6 +1,7 @@
 // The live localisation against a prior map (daemon/prior_localiser.hpp): the
 // odometry thread's scans, in an odometry frame that is neither the prior's
-// nor level, are localised on thread "prior" and the anchor handed back once;
+// nor level, are localised on thread "prior" and the anchor handed back once,
+// after a second try agreed with the first (prior_map.confirm);
 // a prior of another building is never anchored to, and the buffer comes back
 // for another try; scans without an up are not used. Runs under TSan in CI.
 #include <gtest/gtest.h>
@@ -65,6 +66,13 @@ TEST(PriorLocaliser, AnchorsTheOdometryFrameInThePriorOnceAndWritesIt) {
   const Feed f = feed_at(4.0, 5.0);
   EXPECT_FALSE(localiser.take_anchor(0));
   for (int k = 0; k < 3; ++k) localiser.add_scan(f.points, f.sensor, f.up, 1'000'000'000LL + k * 100'000'000LL);
+  // Found, but not taken until the next try agrees.
+  ASSERT_TRUE(wait_for([&] { return localiser.stats().unconfirmed.load() == 1U; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the buffer is handed back just after
+  EXPECT_FALSE(localiser.take_anchor(1'300'000'000LL));
+  // A second later, a metre on and turned: the same anchor.
+  const Feed g = feed_at(5.0, 5.6, 0.7);
+  for (int k = 0; k < 3; ++k) localiser.add_scan(g.points, g.sensor, g.up, 1'300'000'000LL + k * 100'000'000LL);
   std::optional<Eigen::Isometry3d> anchor;
   ASSERT_TRUE(wait_for([&] { return (anchor = localiser.take_anchor(1'500'000'000LL)).has_value(); }));
   const Eigen::Isometry3d e = world_from_odometry().inverse() * *anchor;
@@ -73,13 +81,23 @@ TEST(PriorLocaliser, AnchorsTheOdometryFrameInThePriorOnceAndWritesIt) {
   EXPECT_FALSE(localiser.take_anchor(1'600'000'000LL));  // once
   EXPECT_TRUE(localiser.stats().anchored.load());
   EXPECT_NEAR(localiser.stats().anchored_after_s.load(), 0.5, 1e-9);
-  EXPECT_EQ(localiser.stats().tries.load(), 1U);
+  EXPECT_EQ(localiser.stats().tries.load(), 2U);
+  EXPECT_EQ(localiser.stats().unconfirmed.load(), 1U);
   localiser.join();
   std::ifstream in(dir.path() / "prior_frame.json");
   ASSERT_TRUE(in.good());
   const auto j = nlohmann::json::parse(in);
   EXPECT_NEAR(j["prior_from_odometry"][0][3].get<double>(), anchor->translation().x(), 1e-9);
   EXPECT_NEAR(j["prior_from_odometry"][2][2].get<double>(), anchor->linear()(2, 2), 1e-9);
+}
+
+TEST(PriorLocaliser, ScansPassedOverGrowWithFailuresUpToTenTries) {
+  EXPECT_EQ(scans_passed_over(0, 10), 0);
+  EXPECT_EQ(scans_passed_over(1, 10), 10);
+  EXPECT_EQ(scans_passed_over(3, 10), 30);
+  EXPECT_EQ(scans_passed_over(10, 10), 100);
+  EXPECT_EQ(scans_passed_over(1000, 10), 100);
+  EXPECT_EQ(scans_passed_over(2, 4), 8);
 }
 
 TEST(PriorLocaliser, AnotherBuildingIsNeverAnchoredToAndTriesComeLessOften) {
@@ -122,13 +140,14 @@ TEST(PriorLocaliser, ScansWithoutAnUpAreNotUsed) {
 // narrows the search: the right one anchors as before, the sensor's heading
 // turned into the levelled frame's (the odometry frame is turned 0.9 rad, the
 // sensor here 2.5 rad: a hint taken as the frame's heading would search 92°
-// off); one in the wrong room never anchors.
+// off); one in the wrong room never anchors. Without confirmation
+// (prior_map.confirm: false) the first try found is taken.
 TEST(PriorLocaliser, ARightHintAnchorsAndAWrongOneNever) {
   const std::atomic<bool> stop{false};
   const double sensor_yaw = 2.5;
   const Feed f = feed_at(4.0, 5.0, sensor_yaw);
   {
-    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop);
+    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop, false);
     localiser.start({});
     protocol::LocaliseHint hint;
     hint.x_m = 5.0;  // a metre off
@@ -144,11 +163,12 @@ TEST(PriorLocaliser, ARightHintAnchorsAndAWrongOneNever) {
     EXPECT_LT(e.translation().norm(), 0.05) << e.translation().transpose();
     EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 0.5 * M_PI / 180.0);
     EXPECT_EQ(localiser.stats().hinted_tries.load(), 1U);
+    EXPECT_EQ(localiser.stats().unconfirmed.load(), 0U);
     EXPECT_NE(localiser.set_hint(hint), "");  // already localised
     localiser.join();
   }
   {
-    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop);
+    PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(office(), 24, 16, 0.1)), 3, 200'000, stop, false);
     localiser.start({});
     protocol::LocaliseHint wrong;
     wrong.x_m = 18.0;  // another room

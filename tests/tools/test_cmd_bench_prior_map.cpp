@@ -33,6 +33,15 @@ TEST(CmdBenchPriorMap, LocalisesAndRunsTheOdometryAnchoredToThePrior) {
   const auto j = nlohmann::json::parse(run.output.substr(run.output.find('{')));
   EXPECT_EQ(j["starts"].get<int>(), 3);
   EXPECT_EQ(j["false_localisations"].get<int>(), 0) << run.output;
+  // Trying again as aditd does can only add starts found, never lose one.
+  EXPECT_DOUBLE_EQ(j["retry_s"].get<double>(), 10.0);
+  EXPECT_GE(j["localisation_success_rate_retrying"].get<double>(), j["localisation_success_rate"].get<double>());
+  EXPECT_EQ(j["false_localisations_retrying"].get<int>(), 0) << run.output;
+  if (j["localisation_success_rate_retrying"].get<double>() > 0.0) {
+    // At least the second of scans and the search itself.
+    EXPECT_GT(j["median_time_to_localise_s"].get<double>(), 0.9);
+    EXPECT_LE(j["median_time_to_localise_s"].get<double>(), j["max_time_to_localise_s"].get<double>());
+  }
   const auto& with = j["with_prior"];
   const auto& without = j["without_prior"];
   ASSERT_TRUE(with["anchored"].get<bool>()) << run.output;
@@ -52,6 +61,22 @@ TEST(CmdBenchPriorMap, NoDriftSkipsTheOdometryAndSaysSo) {
   const CommandRun run = adit("bench prior-map --session " + simulated_building().string() + " --starts 1 --no-drift");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("drift_percent_with_prior not measured (--no-drift)"), std::string::npos) << run.output;
+}
+
+// One try (--retry-s 0): taken at once (--no-confirm), the rates agree; a
+// found pose waiting for a second try to agree is never taken.
+TEST(CmdBenchPriorMap, RetryZeroTriesOnceSoOnlyAnUnconfirmedTryIsTaken) {
+  const std::string args = "bench prior-map --session " + simulated_building().string() + " --starts 2 --no-drift --retry-s 0 --json";
+  const CommandRun once = adit(args + " --no-confirm");
+  ASSERT_EQ(once.status, 0) << once.output;
+  const auto j = nlohmann::json::parse(once.output.substr(once.output.find('{')));
+  EXPECT_DOUBLE_EQ(j["localisation_success_rate_retrying"].get<double>(), j["localisation_success_rate"].get<double>());
+  EXPECT_EQ(j["false_localisations_retrying"].get<int>(), j["false_localisations"].get<int>());
+  const CommandRun confirmed = adit(args);
+  ASSERT_EQ(confirmed.status, 0) << confirmed.output;
+  const auto k = nlohmann::json::parse(confirmed.output.substr(confirmed.output.find('{')));
+  EXPECT_GT(k["localisation_success_rate"].get<double>(), 0.0) << confirmed.output;
+  EXPECT_DOUBLE_EQ(k["localisation_success_rate_retrying"].get<double>(), 0.0);
 }
 
 TEST(CmdBenchPriorMap, AFolderWithoutASessionExitsWithStatus2) {

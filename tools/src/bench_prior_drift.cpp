@@ -18,6 +18,7 @@
 #include "adit/eval/path.hpp"
 #include "adit/eval/pose_error.hpp"
 #include "adit/eval/trajectory_io.hpp"
+#include "adit/slam/anchor_confirmation.hpp"
 #include "adit/slam/global_localisation.hpp"
 #include "adit/slam/trajectory.hpp"
 #include "bench_scans.hpp"
@@ -77,6 +78,7 @@ DriftRun run_odometry(const std::filesystem::path& session, std::span<const Benc
   std::vector<double> ms;
   std::vector<Eigen::Vector3f> cloud;  // the scans since the last try, odometry frame
   int since_try = 0;
+  slam::AnchorConfirmation confirmation;
   Eigen::Isometry3d prior_from_odometry = Eigen::Isometry3d::Identity();
   const double t0 = scans.empty() ? 0.0 : 1e-9 * static_cast<double>(scans.front().stamp_ns);
   for (const BenchScan& scan : scans) {
@@ -103,6 +105,11 @@ DriftRun run_odometry(const std::filesystem::path& session, std::span<const Benc
     since_try = 0;
     if (!found.success) {
       run.failure = found.failure;
+      continue;
+    }
+    // As aditd with prior_map.confirm (its default): taken once the next try agrees.
+    if (!confirmation.agrees(found.pose * level_from_odometry, level_from_odometry.inverse())) {
+      run.failure = "found, waiting for the next try to agree";
       continue;
     }
     prior_from_odometry = found.pose * level_from_odometry;

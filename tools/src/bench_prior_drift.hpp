@@ -4,7 +4,8 @@
 // CAN log) run twice, without the prior and anchored to it. Anchored: the
 // odometry localises itself against the prior (slam::localise) from its own
 // first second of scans, levelled by its own up, tries again a second later
-// until it succeeds, then registers every scan against the prior as well
+// until it succeeds and the next try agrees (slam/anchor_confirmation.hpp, as
+// aditd's prior_map.confirm), then registers every scan against the prior as well
 // (slam::Odometry::anchor_to_prior). Both trajectories are scored against the
 // truth with no fit: without the prior its first pose is placed on the
 // truth's; anchored, its frame is where its localisation put it.

@@ -6,6 +6,12 @@
 // accelerometer's; slam::localise sees the cloud and the prior only. A start
 // counts as localised when it is reported found and lies within 0.05 m and
 // 0.5° of the truth; a start reported found beyond that is a false localisation.
+// A start goes on as aditd would (prior_localiser.hpp) until --retry-s of
+// sensor time have passed: after a failed try, later scans are tried; a found
+// pose is taken once the next try agrees (slam/anchor_confirmation.hpp;
+// --no-confirm: at once). localisation_success_rate counts the first try
+// alone, localisation_success_rate_retrying what aditd would take within the
+// budget. With --hint-m, one try (the hint is given once, where the crew stood).
 
 #include "bench_prior_map.hpp"
 
@@ -21,10 +27,12 @@
 #include "adit/common/error.hpp"
 #include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
+#include "adit/daemon/prior_localiser.hpp"
 #include "adit/eval/align.hpp"
 #include "adit/eval/associate.hpp"
 #include "adit/eval/interpolate.hpp"
 #include "adit/eval/trajectory_io.hpp"
+#include "adit/slam/anchor_confirmation.hpp"
 #include "adit/slam/global_localisation.hpp"
 #include "bench_prior_drift.hpp"
 #include "bench_scans.hpp"
@@ -47,6 +55,8 @@ struct Options {
   bool drift = true;             // the odometry with and without the prior (bench_prior_drift.hpp)
   double prior_sigma_m = 0.0;    // > 0: the odometry's prior_map_sigma_m for the anchored run
   int prior_stride = 0;          // > 0: its prior_map_stride
+  bool confirm = true;           // a found try counts once the next found one agrees (aditd's prior_map.confirm)
+  double retry_s = 10.0;         // try again as aditd does for this long (sensor time from the start); 0: one try
 };
 
 struct Start {
@@ -57,6 +67,21 @@ struct Start {
   double error_deg = 0.0;
   double seconds = 0.0;
   std::string failure;
+  // Trying again as aditd does, within Options::retry_s of sensor time.
+  int tries = 0;
+  bool retry_reported = false;
+  bool retry_within = false;
+  double time_to_localise_s = 0.0;  // from the start's first scan to the found try's result (its CPU time included)
+};
+
+struct Try {
+  slam::LocalisationResult result;
+  double cpu_s = 0.0;
+  double error_m = 0.0;
+  double error_deg = 0.0;
+  bool within = false;
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();             // the cloud's frame in the world (the odometry's here)
+  Eigen::Isometry3d prior_from_world = Eigen::Isometry3d::Identity();  // the anchor it implies
 };
 
 Eigen::Isometry3d yaw_only(const Eigen::Isometry3d& pose) {
@@ -97,28 +122,35 @@ int run(const Options& o) {
   std::uniform_int_distribution<std::size_t> pick(0, scans.size() - static_cast<std::size_t>(o.scans) - 1);
   std::normal_distribution<double> tilt(0.0, o.tilt_sigma_deg * std::numbers::pi / 180.0);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto stamp_s = [&](std::size_t j) { return 1e-9 * static_cast<double>(scans[j].stamp_ns); };
+  const double period_s = (stamp_s(scans.size() - 1) - stamp_s(0)) / static_cast<double>(scans.size() - 1);
+  // When the window of scans from `first` is all in: the next scan's stamp.
+  const auto window_end_s = [&](std::size_t first) {
+    const std::size_t next = first + static_cast<std::size_t>(o.scans);
+    return next < scans.size() ? stamp_s(next) : stamp_s(scans.size() - 1) + period_s;
+  };
   std::vector<Start> starts;
   std::vector<Eigen::Vector3f> cloud;
-  for (int s = 0; s < o.starts; ++s) {
-    Start start;
-    start.scan = pick(rng);
-    const double t0 = 1e-9 * static_cast<double>(scans[start.scan].stamp_ns);
-    const auto sensor0 = eval::interpolate_pose(truth, t0);
-    if (!sensor0) throw InputError(dir / "truth_sensor.tum", "", fmt::format("no truth at {:.3f} s", t0));
+  // One try: the window of o.scans scans from `first`, levelled at its first
+  // scan with the start's tilt error (an accelerometer's error changes slowly).
+  const auto try_window = [&](std::size_t first, double tilt_x, double tilt_y, bool hinted) {
+    Try attempt;
+    const auto sensor0 = eval::interpolate_pose(truth, stamp_s(first));
+    if (!sensor0) throw InputError(dir / "truth_sensor.tum", "", fmt::format("no truth at {:.3f} s", stamp_s(first)));
     // The levelled frame: the sensor's position and heading, tilted by the levelling's error.
     Eigen::Isometry3d level = yaw_only(*sensor0);
-    level.linear() = level.linear() * (Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitX()) *
-                                       Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitY())).toRotationMatrix();
+    level.linear() = level.linear() * (Eigen::AngleAxisd(tilt_x, Eigen::Vector3d::UnitX()) *
+                                       Eigen::AngleAxisd(tilt_y, Eigen::Vector3d::UnitY())).toRotationMatrix();
     const Eigen::Isometry3d level_inv = level.inverse();
     cloud.clear();
-    for (std::size_t j = start.scan; j < start.scan + static_cast<std::size_t>(o.scans); ++j) {
+    for (std::size_t j = first; j < first + static_cast<std::size_t>(o.scans); ++j) {
       const BenchScan& scan = scans[j];
       const bool timed = scan.time_offsets_ns.size() == scan.points.size();
       // The motion within a sweep, at 1 ms steps (a sensor moves under 2 mm in one).
       double cached_t = -1.0;
       Eigen::Isometry3f to_level = Eigen::Isometry3f::Identity();
       for (std::size_t k = 0; k < scan.points.size(); ++k) {
-        const double t = 1e-9 * static_cast<double>(scan.stamp_ns) + (timed ? std::floor(1e3 * scan.time_s(k)) * 1e-3 : 0.0);
+        const double t = stamp_s(j) + (timed ? std::floor(1e3 * scan.time_s(k)) * 1e-3 : 0.0);
         if (t != cached_t) {
           const auto pose = eval::interpolate_pose(truth, t);
           if (!pose) continue;
@@ -129,7 +161,7 @@ int run(const Options& o) {
       }
     }
     std::optional<slam::LocalisationHint> hint;
-    if (o.hint_m > 0.0) {
+    if (hinted) {
       const Eigen::Isometry3d prior_level = world_from_prior.inverse() * level;
       slam::LocalisationHint h;
       h.position = prior_level.translation().head<2>() + o.hint_m * Eigen::Vector2d(unit(rng), unit(rng)) / std::sqrt(2.0);
@@ -140,19 +172,72 @@ int run(const Options& o) {
       hint = h;
     }
     const std::int64_t c0 = thread_cpu_ns();
-    const slam::LocalisationResult r = slam::localise(cloud, prior.map, index, hint);
-    start.seconds = 1e-9 * static_cast<double>(thread_cpu_ns() - c0);
-    const Eigen::Isometry3d error = (world_from_prior * r.pose).inverse() * level;
-    start.error_m = error.translation().norm();
-    start.error_deg = Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
+    attempt.result = slam::localise(cloud, prior.map, index, hint);
+    attempt.cpu_s = 1e-9 * static_cast<double>(thread_cpu_ns() - c0);
+    const Eigen::Isometry3d error = (world_from_prior * attempt.result.pose).inverse() * level;
+    attempt.error_m = error.translation().norm();
+    attempt.error_deg = Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
+    attempt.within = attempt.error_m <= 0.05 && attempt.error_deg <= 0.5;
+    attempt.level = level;
+    attempt.prior_from_world = attempt.result.pose * level_inv;
+    return attempt;
+  };
+  for (int s = 0; s < o.starts; ++s) {
+    Start start;
+    start.scan = pick(rng);
+    const double tilt_x = tilt(rng);
+    const double tilt_y = tilt(rng);
+    const double t0 = stamp_s(start.scan);
+    Try attempt = try_window(start.scan, tilt_x, tilt_y, o.hint_m > 0.0);
+    const slam::LocalisationResult& r = attempt.result;
+    start.seconds = attempt.cpu_s;
+    start.error_m = attempt.error_m;
+    start.error_deg = attempt.error_deg;
     start.reported = r.success;
-    start.within = start.error_m <= 0.05 && start.error_deg <= 0.5;
+    start.within = attempt.within;
     start.failure = r.failure;
     if (!o.json)
       fmt::print("start {:2d} scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, weakest {:.3f} sigma {:.3f} m {:.3f} deg, {:.2f} s{}{}\n", s,
                  start.scan, r.success ? (start.within ? "found " : "FALSE ") : "failed", start.error_m,
                  start.error_deg, r.overlap, r.rival_overlap, r.rival_distance_m, r.weakest_eigenvalue, r.position_sigma_m, r.yaw_sigma_rad * 180 / std::numbers::pi, start.seconds, r.success ? "" : ": ",
                  r.success ? "" : r.failure);
+    // As aditd goes on after a failed try (prior_localiser.hpp): the scans
+    // that arrive while a try runs are not gathered, then
+    // scans_passed_over(k) after the k-th failure, then the next window;
+    // until one is reported found or the budget's sensor time has passed.
+    // Without a hint only (a crew's hint is given once, where they stood).
+    std::size_t first = start.scan;
+    std::uint64_t failures = 0;
+    slam::AnchorConfirmation confirmation;  // --confirm: a found anchor waits for the next try to agree
+    for (;;) {
+      ++start.tries;
+      const double done_s = window_end_s(first) + attempt.cpu_s;
+      if (attempt.result.success && (!o.confirm || confirmation.agrees(attempt.prior_from_world, attempt.level))) {
+        start.retry_reported = true;
+        start.retry_within = attempt.within;
+        start.time_to_localise_s = done_s - t0;
+        break;
+      }
+      if (o.hint_m > 0.0 || o.retry_s <= 0.0) break;
+      std::size_t next = first + static_cast<std::size_t>(o.scans);
+      while (next < scans.size() && stamp_s(next) < done_s) ++next;
+      // After a failure, scans are passed over, unless a found pose waits to
+      // be confirmed (the prior matches there); after a found one, none.
+      if (!attempt.result.success) {
+        ++failures;
+        if (!(o.confirm && confirmation.waiting()))
+          next += static_cast<std::size_t>(daemon::scans_passed_over(failures, o.scans));
+      }
+      if (next + static_cast<std::size_t>(o.scans) > scans.size() || window_end_s(next) - t0 > o.retry_s) break;
+      first = next;
+      attempt = try_window(first, tilt_x, tilt_y, false);
+      if (!o.json)
+        fmt::print("         try {} at scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, {:.2f} s{}{}\n",
+                   start.tries + 1, first, attempt.result.success ? (attempt.within ? "found " : "FALSE ") : "failed",
+                   attempt.error_m, attempt.error_deg, attempt.result.overlap, attempt.result.rival_overlap,
+                   attempt.result.rival_distance_m, attempt.cpu_s, attempt.result.success ? "" : ": ",
+                   attempt.result.success ? "" : attempt.result.failure);
+    }
     starts.push_back(start);
   }
   const auto count = [&](auto pred) { return static_cast<int>(std::count_if(starts.begin(), starts.end(), pred)); };
@@ -160,6 +245,18 @@ int run(const Options& o) {
   const int wrong = count([](const Start& s) { return s.reported && !s.within; });
   const int failed = count([](const Start& s) { return !s.reported; });
   const int failed_near = count([](const Start& s) { return !s.reported && s.within; });
+  // Within the budget (with --retry-s 0, one try, whatever it took).
+  const int found_retrying = count([&](const Start& s) {
+    return s.retry_reported && s.retry_within && (o.retry_s <= 0.0 || s.time_to_localise_s <= o.retry_s);
+  });
+  const int wrong_retrying = count([](const Start& s) { return s.retry_reported && !s.retry_within; });
+  std::vector<double> times_to_localise;
+  for (const Start& s : starts)
+    if (s.retry_reported && s.retry_within) times_to_localise.push_back(s.time_to_localise_s);
+  const double rate_retrying = static_cast<double>(found_retrying) / static_cast<double>(starts.size());
+  const double median_time_s = times_to_localise.empty() ? 0.0 : quantile(times_to_localise, 0.5);
+  const double max_time_s =
+      times_to_localise.empty() ? 0.0 : *std::max_element(times_to_localise.begin(), times_to_localise.end());
   std::vector<double> seconds;
   std::vector<double> err_m, err_deg;
   for (const Start& s : starts) {
@@ -214,6 +311,11 @@ int run(const Options& o) {
     j["median_error_m"] = err_m.empty() ? 0.0 : quantile(err_m, 0.5);
     j["median_error_deg"] = err_deg.empty() ? 0.0 : quantile(err_deg, 0.5);
     j["failure_reasons"] = reasons;
+    j["retry_s"] = o.retry_s;
+    j["localisation_success_rate_retrying"] = rate_retrying;
+    j["false_localisations_retrying"] = wrong_retrying;
+    j["median_time_to_localise_s"] = median_time_s;
+    j["max_time_to_localise_s"] = max_time_s;
     // Null when not measured (--no-drift), or when the odometry never localised against the prior.
     j["drift_percent_with_prior"] = drift && drift->with_prior.anchored ? nlohmann::json(drift->with_prior.drift_percent) : nlohmann::json();
     j["drift_percent_without_prior"] = drift ? nlohmann::json(drift->without_prior.drift_percent) : nlohmann::json();
@@ -233,6 +335,11 @@ int run(const Options& o) {
   fmt::print("failed {} ({} of them were near the truth)\n", failed, failed_near);
   for (const auto& [why, n] : reasons) fmt::print("  {} x {}\n", n, why);
   fmt::print("median_localisation_s {:.2f} (max {:.2f}, one core, CPU time)\n", median_s, max_s);
+  fmt::print("localisation_success_rate_retrying {:.3f} ({} of {} found within {:.0f} s of the start, trying again as aditd does)\n",
+             rate_retrying, found_retrying, starts.size(), o.retry_s);
+  fmt::print("false_localisations_retrying {}\n", wrong_retrying);
+  fmt::print("time_to_localise_s median {:.2f} (max {:.2f}; sensor time to the found try's result, its CPU included)\n",
+             median_time_s, max_time_s);
   if (!err_m.empty())
     fmt::print("error of the localised: median {:.3f} m {:.3f} deg, max {:.3f} m {:.3f} deg\n", quantile(err_m, 0.5),
                quantile(err_deg, 0.5), *std::max_element(err_m.begin(), err_m.end()),
@@ -280,6 +387,12 @@ void add_bench_prior_map_command(CLI::App& bench, int& status) {
   cmd->add_option("--seed", o->seed, "Seed of the starts")->capture_default_str();
   cmd->add_option("--hint-m", o->hint_m, "Give a hint up to this far off (heading within 10 deg); 0: none")->capture_default_str();
   cmd->add_option("--tilt-sigma-deg", o->tilt_sigma_deg, "σ of the levelling error")->capture_default_str();
+  cmd->add_option("--retry-s", o->retry_s,
+                  "After a failed try, try again as aditd does for this long from the start (sensor time); 0: one try")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("!--no-confirm", o->confirm,
+                "Take the first found try, as aditd with prior_map.confirm: false (default: once the next found one agrees)");
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
   cmd->add_option("--prior-sigma-m", o->prior_sigma_m,
                   "σ of a residual against the prior in the anchored odometry (0: the odometry's default)")

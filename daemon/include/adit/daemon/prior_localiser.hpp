@@ -6,9 +6,13 @@
 // anchor (prior_from_odometry) and registers every later scan against the
 // prior as well (slam::Odometry::anchor_to_prior). A try that fails hands the
 // buffer back and later scans are gathered for another: after the k-th failure
-// k·scans_per_try scans are passed over first (at most 10×), so a prior that
+// k·scans_per_try scans are passed over first (at most 10×; none while a
+// found pose waits to be confirmed: the prior matches there), so a prior that
 // never matches (another building, a start outside it) costs a search every
-// ~11 s at most, not one every second for the whole session. A crew's hint
+// ~11 s at most, not one every second for the whole session. With `confirm`,
+// a try that finds a pose is taken only once the next try that finds one
+// agrees with it (slam::same_place, the sensor placed by both anchors); one
+// that disagrees waits for the next in its turn. A crew's hint
 // (HINT: set_hint, on the endpoint's thread) narrows the tries after it and
 // starts the next at once; it is held under a mutex the odometry thread never takes.
 //
@@ -30,6 +34,7 @@
 
 #include "adit/daemon/stage_thread.hpp"
 #include "adit/protocol/localise_hint.hpp"
+#include "adit/slam/anchor_confirmation.hpp"
 #include "adit/slam/global_localisation.hpp"
 #include "adit/slam/prior_map.hpp"
 #include "adit/slam/voxel_hash_map.hpp"
@@ -43,15 +48,25 @@ struct PriorLocaliserStats {
   // not yet): they cannot be levelled, so they are not used.
   std::atomic<std::uint64_t> scans_without_up{0};
   std::atomic<std::uint64_t> hinted_tries{0};  // tries narrowed by a hint (HINT)
+  // Tries that found a pose not yet taken: waiting for the next to agree, or
+  // disagreeing with the one before (confirm).
+  std::atomic<std::uint64_t> unconfirmed{0};
   std::atomic<bool> anchored{false};
   std::atomic<double> anchored_after_s{0.0};  // sensor time from the first scan handed over to the scan anchored from
 };
 
+// The scans passed over after the `failures`-th failed try before the next
+// is gathered: failures × scans_per_try, at most 10 × (the tries' spacing
+// grows to 11 tries' worth). `adit bench prior-map` retries by the same rule.
+int scans_passed_over(std::uint64_t failures, int scans_per_try);
+
 class PriorLocaliser {
  public:
   // `scans_per_try`: scans gathered for one try; `max_points`: the buffer's
-  // room (a try with fewer points goes ahead when the scans are in).
-  PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::size_t max_points, const std::atomic<bool>& stop);
+  // room (a try with fewer points goes ahead when the scans are in);
+  // `confirm`: a found pose waits for the next try to agree (prior_map.confirm).
+  PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::size_t max_points, const std::atomic<bool>& stop,
+                 bool confirm = true);
   ~PriorLocaliser();
   PriorLocaliser(const PriorLocaliser&) = delete;
   PriorLocaliser& operator=(const PriorLocaliser&) = delete;
@@ -89,6 +104,8 @@ class PriorLocaliser {
   const slam::PriorMap prior_;
   const slam::VoxelHashMap index_;
   const int scans_per_try_;
+  const bool confirm_;
+  slam::AnchorConfirmation confirmation_;  // prior thread: a found anchor waiting for the next try to agree
   std::filesystem::path frame_file_;
   std::atomic<int> state_{kFilling};
   std::atomic<bool> finished_{false};  // join(): the pipeline has drained
@@ -98,8 +115,10 @@ class PriorLocaliser {
   double sensor_heading_rad_ = 0.0;  // the sensor's x in the levelled frame
   Eigen::Isometry3d anchor_ = Eigen::Isometry3d::Identity();
   int scans_ = 0;
+  // Scans to pass over before the next try: set by the prior thread before
+  // it hands the buffer back (released with state_), taken by the odometry thread.
+  std::atomic<int> pass_over_{0};
   int skip_ = 0;                         // odometry thread: scans still to pass over before the next try
-  std::uint64_t failures_seen_ = 0;      // odometry thread: stats_.failures when skip_ was last set
   std::int64_t first_stamp_ns_ = 0;  // odometry thread only
   mutable std::mutex hint_mutex_;  // the endpoint's thread sets, the prior thread reads: never the odometry's
   std::optional<protocol::LocaliseHint> hint_;

@@ -265,6 +265,11 @@ struct PriorMapSection {
   // prior, so a survey carried on after a stop (a battery swap) continues in
   // the frame of the one before (docs/PRIOR-MAP.md, "The previous session").
   bool previous_session = false;
+  // A found pose is taken once the next try finds the same (within 0.3 m and
+  // 2°, localise()'s distinct-rival distances): a floor nearly symmetric under
+  // a half turn can fit one try better where it was not built as designed
+  // (docs/decisions/053-prior-localisation-confirmed.md).
+  bool confirm = true;
 };
 
 struct LcmSection {

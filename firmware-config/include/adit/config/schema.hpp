@@ -228,6 +228,7 @@ template <typename V>
 void describe(V& v, PriorMapSection& s) {
   v.optional("dir", s.dir);
   v.optional("previous_session", s.previous_session);
+  v.optional("confirm", s.confirm);
 }
 
 template <typename V>
