@@ -37,6 +37,7 @@ PriorLocaliser::PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::siz
       index_(slam::index_prior_map(prior_)),
       scans_per_try_(std::max(1, scans_per_try)),
       confirm_(confirm),
+      localisation_(confirm ? slam::confirmed_localisation() : slam::LocalisationConfig{}),
       thread_("prior", config::ThreadSettings{}, stop) {
   cloud_.reserve(max_points);
 }
@@ -105,7 +106,7 @@ void PriorLocaliser::loop() {
     const Eigen::Isometry3f to_level = level_from_odometry_.cast<float>();
     for (Eigen::Vector3f& p : cloud_) p = to_level * p;
     const std::optional<slam::LocalisationHint> hint = search_hint();
-    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_, hint);
+    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_, hint, localisation_);
     if (hint) stats_.hinted_tries.fetch_add(1, std::memory_order_relaxed);
     stats_.tries.fetch_add(1, std::memory_order_relaxed);
     cloud_.clear();

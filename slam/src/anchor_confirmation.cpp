@@ -2,6 +2,11 @@
 
 namespace adit::slam {
 
+LocalisationConfig confirmed_localisation(LocalisationConfig base) {
+  base.min_overlap = 0.85;
+  return base;
+}
+
 bool AnchorConfirmation::agrees(const Eigen::Isometry3d& anchor, const Eigen::Isometry3d& cloud_in_odometry) {
   if (candidate_) {
     const Eigen::Isometry3d apart = (*candidate_ * cloud_in_odometry).inverse() * (anchor * cloud_in_odometry);

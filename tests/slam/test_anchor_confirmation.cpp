@@ -54,5 +54,17 @@ TEST(AnchorConfirmation, OneAnswerIsWithinTheRivalDistances) {
   EXPECT_FALSE(second_agrees(pose(0.0, 0.0, 2.2)));
 }
 
+// Each try of a confirmed pair accepts a lower overlap than a lone try; the
+// other checks stay as given.
+TEST(AnchorConfirmation, AConfirmedPairsTriesAcceptALowerOverlap) {
+  LocalisationConfig base;
+  base.min_rival_miss_ratio = 1.7;
+  const LocalisationConfig c = confirmed_localisation(base);
+  EXPECT_DOUBLE_EQ(c.min_overlap, 0.85);
+  EXPECT_LT(c.min_overlap, LocalisationConfig{}.min_overlap);
+  EXPECT_DOUBLE_EQ(c.min_rival_miss_ratio, 1.7);
+  EXPECT_DOUBLE_EQ(c.rival_m, base.rival_m);
+}
+
 }  // namespace
 }  // namespace adit::slam

@@ -99,7 +99,7 @@ DriftRun run_odometry(const std::filesystem::path& session, std::span<const Benc
     const Eigen::Isometry3d level_from_odometry =
         slam::levelled_frame_at(up.value_or(Eigen::Vector3d::UnitZ()), sensor);
     for (Eigen::Vector3f& p : cloud) p = level_from_odometry.cast<float>() * p;
-    const slam::LocalisationResult found = slam::localise(cloud, *prior, *index);
+    const slam::LocalisationResult found = slam::localise(cloud, *prior, *index, std::nullopt, slam::confirmed_localisation());
     ++run.localisation_tries;
     cloud.clear();
     since_try = 0;

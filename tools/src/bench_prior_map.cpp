@@ -6,7 +6,9 @@
 // accelerometer's; slam::localise sees the cloud and the prior only. A start
 // counts as localised when it is reported found and lies within 0.05 m and
 // 0.5° of the truth; a start reported found beyond that is a false localisation.
-// A start goes on as aditd would (prior_localiser.hpp) until --retry-s of
+// Each try accepts as aditd's: with confirmation, at a confirmed pair's
+// overlap threshold (slam::confirmed_localisation), so the first try's figures
+// are those of one such try. A start goes on as aditd would (prior_localiser.hpp) until --retry-s of
 // sensor time have passed: after a failed try, later scans are tried; a found
 // pose is taken once the next try agrees (slam/anchor_confirmation.hpp;
 // --no-confirm: at once). localisation_success_rate counts the first try
@@ -56,7 +58,8 @@ struct Options {
   double prior_sigma_m = 0.0;    // > 0: the odometry's prior_map_sigma_m for the anchored run
   int prior_stride = 0;          // > 0: its prior_map_stride
   bool confirm = true;           // a found try counts once the next found one agrees (aditd's prior_map.confirm)
-  double retry_s = 10.0;         // try again as aditd does for this long (sensor time from the start); 0: one try
+  double retry_s = 10.0;
+  double min_overlap = 0.0;      // > 0: the acceptance's overlap threshold instead of slam's default         // try again as aditd does for this long (sensor time from the start); 0: one try
 };
 
 struct Start {
@@ -129,6 +132,9 @@ int run(const Options& o) {
     const std::size_t next = first + static_cast<std::size_t>(o.scans);
     return next < scans.size() ? stamp_s(next) : stamp_s(scans.size() - 1) + period_s;
   };
+  // Each try as aditd makes it: a confirmed pair's acceptance with --confirm.
+  slam::LocalisationConfig localisation = o.confirm ? slam::confirmed_localisation() : slam::LocalisationConfig{};
+  if (o.min_overlap > 0.0) localisation.min_overlap = o.min_overlap;
   std::vector<Start> starts;
   std::vector<Eigen::Vector3f> cloud;
   // One try: the window of o.scans scans from `first`, levelled at its first
@@ -172,7 +178,7 @@ int run(const Options& o) {
       hint = h;
     }
     const std::int64_t c0 = thread_cpu_ns();
-    attempt.result = slam::localise(cloud, prior.map, index, hint);
+    attempt.result = slam::localise(cloud, prior.map, index, hint, localisation);
     attempt.cpu_s = 1e-9 * static_cast<double>(thread_cpu_ns() - c0);
     const Eigen::Isometry3d error = (world_from_prior * attempt.result.pose).inverse() * level;
     attempt.error_m = error.translation().norm();
@@ -311,6 +317,8 @@ int run(const Options& o) {
     j["median_error_m"] = err_m.empty() ? 0.0 : quantile(err_m, 0.5);
     j["median_error_deg"] = err_deg.empty() ? 0.0 : quantile(err_deg, 0.5);
     j["failure_reasons"] = reasons;
+    j["min_overlap"] = localisation.min_overlap;
+    j["confirm"] = o.confirm;
     j["retry_s"] = o.retry_s;
     j["localisation_success_rate_retrying"] = rate_retrying;
     j["false_localisations_retrying"] = wrong_retrying;
@@ -330,7 +338,8 @@ int run(const Options& o) {
              1e-6 * static_cast<double>(memory),
              prior.prepared_now ? fmt::format(", read and prepared in {:.1f} s", prior.prepare_s) : "");
   fmt::print("starts: {} of {} scans each\n", starts.size(), o.scans);
-  fmt::print("localisation_success_rate {:.3f} ({} of {} within 0.05 m and 0.5 deg)\n", rate, found, starts.size());
+  fmt::print("localisation_success_rate {:.3f} ({} of {} within 0.05 m and 0.5 deg; one try, overlap >= {:.2f})\n", rate,
+             found, starts.size(), localisation.min_overlap);
   fmt::print("false_localisations {}\n", wrong);
   fmt::print("failed {} ({} of them were near the truth)\n", failed, failed_near);
   for (const auto& [why, n] : reasons) fmt::print("  {} x {}\n", n, why);
@@ -393,6 +402,9 @@ void add_bench_prior_map_command(CLI::App& bench, int& status) {
       ->capture_default_str();
   cmd->add_flag("!--no-confirm", o->confirm,
                 "Take the first found try, as aditd with prior_map.confirm: false (default: once the next found one agrees)");
+  cmd->add_option("--min-overlap", o->min_overlap,
+                  "The acceptance's overlap threshold (0: slam::LocalisationConfig's default)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
   cmd->add_option("--prior-sigma-m", o->prior_sigma_m,
                   "σ of a residual against the prior in the anchored odometry (0: the odometry's default)")

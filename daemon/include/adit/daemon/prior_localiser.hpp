@@ -105,6 +105,7 @@ class PriorLocaliser {
   const slam::VoxelHashMap index_;
   const int scans_per_try_;
   const bool confirm_;
+  const slam::LocalisationConfig localisation_;  // a confirmed pair's acceptance with confirm_
   slam::AnchorConfirmation confirmation_;  // prior thread: a found anchor waiting for the next try to agree
   std::filesystem::path frame_file_;
   std::atomic<int> state_{kFilling};

@@ -16,6 +16,12 @@
 
 namespace adit::slam {
 
+// The acceptance for each try of a confirmed pair: `base` with its overlap
+// threshold at 0.85 instead of a lone try's 0.9. Two tries that must agree
+// guard against a wrong pose together; a lone try's 0.9 refused most of the
+// right hand-held poses (overlap 0.87-0.90: furniture, doors) (decision 053).
+LocalisationConfig confirmed_localisation(LocalisationConfig base = {});
+
 class AnchorConfirmation {
  public:
   explicit AnchorConfirmation(const LocalisationConfig& config = {}) : config_(config) {}
