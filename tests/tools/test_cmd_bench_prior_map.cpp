@@ -79,6 +79,17 @@ TEST(CmdBenchPriorMap, RetryZeroTriesOnceSoOnlyAnUnconfirmedTryIsTaken) {
   EXPECT_DOUBLE_EQ(k["localisation_success_rate_retrying"].get<double>(), 0.0);
 }
 
+// A crew's hint, given once at the start, narrows every try (aditd keeps it):
+// later tries can still find the pose, never a wrong one here.
+TEST(CmdBenchPriorMap, AHintGivenOnceNarrowsEveryTry) {
+  const CommandRun run =
+      adit("bench prior-map --session " + simulated_building().string() + " --starts 2 --no-drift --hint-m 3 --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const auto j = nlohmann::json::parse(run.output.substr(run.output.find('{')));
+  EXPECT_EQ(j["false_localisations_retrying"].get<int>(), 0) << run.output;
+  EXPECT_GT(j["localisation_success_rate_retrying"].get<double>(), 0.0) << run.output;
+}
+
 TEST(CmdBenchPriorMap, AFolderWithoutASessionExitsWithStatus2) {
   const adit::test::TempFolder empty;
   const CommandRun run = adit("bench prior-map --session " + empty.path().string());

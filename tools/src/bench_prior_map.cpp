@@ -13,7 +13,8 @@
 // pose is taken once the next try agrees (slam/anchor_confirmation.hpp;
 // --no-confirm: at once). localisation_success_rate counts the first try
 // alone, localisation_success_rate_retrying what aditd would take within the
-// budget. With --hint-m, one try (the hint is given once, where the crew stood).
+// budget. With --hint-m, a crew's hint given once at the start narrows every
+// try, its heading turned with the payload as aditd turns it.
 
 #include "bench_prior_map.hpp"
 
@@ -58,8 +59,8 @@ struct Options {
   double prior_sigma_m = 0.0;    // > 0: the odometry's prior_map_sigma_m for the anchored run
   int prior_stride = 0;          // > 0: its prior_map_stride
   bool confirm = true;           // a found try counts once the next found one agrees (aditd's prior_map.confirm)
-  double retry_s = 10.0;
-  double min_overlap = 0.0;      // > 0: the acceptance's overlap threshold instead of slam's default         // try again as aditd does for this long (sensor time from the start); 0: one try
+  double retry_s = 10.0;         // try again as aditd does for this long (sensor time from the start); 0: one try
+  double min_overlap = 0.0;      // > 0: the acceptance's overlap threshold instead of slam's default
 };
 
 struct Start {
@@ -75,6 +76,13 @@ struct Start {
   bool retry_reported = false;
   bool retry_within = false;
   double time_to_localise_s = 0.0;  // from the start's first scan to the found try's result (its CPU time included)
+};
+
+// A crew's hint (--hint-m), given once at the start: where they stood, off by
+// up to hint_m, and the way the payload faced, off by up to 10°.
+struct CrewHint {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // prior frame
+  double heading_error_rad = 0.0;
 };
 
 struct Try {
@@ -139,7 +147,7 @@ int run(const Options& o) {
   std::vector<Eigen::Vector3f> cloud;
   // One try: the window of o.scans scans from `first`, levelled at its first
   // scan with the start's tilt error (an accelerometer's error changes slowly).
-  const auto try_window = [&](std::size_t first, double tilt_x, double tilt_y, bool hinted) {
+  const auto try_window = [&](std::size_t first, double tilt_x, double tilt_y, std::optional<CrewHint>& crew) {
     Try attempt;
     const auto sensor0 = eval::interpolate_pose(truth, stamp_s(first));
     if (!sensor0) throw InputError(dir / "truth_sensor.tum", "", fmt::format("no truth at {:.3f} s", stamp_s(first)));
@@ -166,14 +174,22 @@ int run(const Options& o) {
         cloud.push_back(to_level * scan.points[k]);
       }
     }
+    // The hint stays where the crew gave it; its heading turns with the
+    // payload, as aditd turns it by the odometry (PriorLocaliser::search_hint).
     std::optional<slam::LocalisationHint> hint;
-    if (hinted) {
+    if (o.hint_m > 0.0) {
       const Eigen::Isometry3d prior_level = world_from_prior.inverse() * level;
+      if (!crew) {
+        CrewHint c;
+        c.position = prior_level.translation().head<2>() + o.hint_m * Eigen::Vector2d(unit(rng), unit(rng)) / std::sqrt(2.0);
+        c.heading_error_rad = unit(rng) * 10.0 * std::numbers::pi / 180.0;
+        crew = c;
+      }
       slam::LocalisationHint h;
-      h.position = prior_level.translation().head<2>() + o.hint_m * Eigen::Vector2d(unit(rng), unit(rng)) / std::sqrt(2.0);
+      h.position = crew->position;
       h.radius_m = 2.0 * o.hint_m;
       const Eigen::Vector3d x = prior_level.linear().col(0);
-      h.yaw_rad = std::atan2(x.y(), x.x()) + unit(rng) * 10.0 * std::numbers::pi / 180.0;
+      h.yaw_rad = std::atan2(x.y(), x.x()) + crew->heading_error_rad;
       h.yaw_tolerance_rad = 20.0 * std::numbers::pi / 180.0;
       hint = h;
     }
@@ -194,7 +210,8 @@ int run(const Options& o) {
     const double tilt_x = tilt(rng);
     const double tilt_y = tilt(rng);
     const double t0 = stamp_s(start.scan);
-    Try attempt = try_window(start.scan, tilt_x, tilt_y, o.hint_m > 0.0);
+    std::optional<CrewHint> crew;
+    Try attempt = try_window(start.scan, tilt_x, tilt_y, crew);
     const slam::LocalisationResult& r = attempt.result;
     start.seconds = attempt.cpu_s;
     start.error_m = attempt.error_m;
@@ -211,7 +228,6 @@ int run(const Options& o) {
     // that arrive while a try runs are not gathered, then
     // scans_passed_over(k) after the k-th failure, then the next window;
     // until one is reported found or the budget's sensor time has passed.
-    // Without a hint only (a crew's hint is given once, where they stood).
     std::size_t first = start.scan;
     std::uint64_t failures = 0;
     slam::AnchorConfirmation confirmation;  // --confirm: a found anchor waits for the next try to agree
@@ -224,7 +240,7 @@ int run(const Options& o) {
         start.time_to_localise_s = done_s - t0;
         break;
       }
-      if (o.hint_m > 0.0 || o.retry_s <= 0.0) break;
+      if (o.retry_s <= 0.0) break;
       std::size_t next = first + static_cast<std::size_t>(o.scans);
       while (next < scans.size() && stamp_s(next) < done_s) ++next;
       // After a failure, scans are passed over, unless a found pose waits to
@@ -236,7 +252,7 @@ int run(const Options& o) {
       }
       if (next + static_cast<std::size_t>(o.scans) > scans.size() || window_end_s(next) - t0 > o.retry_s) break;
       first = next;
-      attempt = try_window(first, tilt_x, tilt_y, false);
+      attempt = try_window(first, tilt_x, tilt_y, crew);
       if (!o.json)
         fmt::print("         try {} at scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, {:.2f} s{}{}\n",
                    start.tries + 1, first, attempt.result.success ? (attempt.within ? "found " : "FALSE ") : "failed",
