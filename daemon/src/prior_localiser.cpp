@@ -27,7 +27,8 @@ constexpr std::uint64_t kMaxBackoff = 10;  // tries' spacing grows to at most 11
 
 }  // namespace
 
-int scans_passed_over(std::uint64_t failures, int scans_per_try) {
+int scans_passed_over(std::uint64_t failures, int scans_per_try, bool found_waiting) {
+  if (found_waiting) return 0;
   return scans_per_try * static_cast<int>(std::min<std::uint64_t>(failures, kMaxBackoff));
 }
 
@@ -38,6 +39,7 @@ PriorLocaliser::PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::siz
       scans_per_try_(std::max(1, scans_per_try)),
       confirm_(confirm),
       localisation_(confirm ? slam::confirmed_localisation() : slam::LocalisationConfig{}),
+      confirmation_(localisation_),
       thread_("prior", config::ThreadSettings{}, stop) {
   cloud_.reserve(max_points);
 }
@@ -115,7 +117,7 @@ void PriorLocaliser::loop() {
       // Counted, then handed back: the odometry thread sees the count and the
       // scans to pass over with the buffer. None while a found pose waits.
       const std::uint64_t failures = stats_.failures.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (!confirmation_.waiting()) pass_over_.store(scans_passed_over(failures, scans_per_try_), std::memory_order_relaxed);
+      pass_over_.store(scans_passed_over(failures, scans_per_try_, confirmation_.waiting()), std::memory_order_relaxed);
       state_.store(kFilling, std::memory_order_release);
       continue;
     }

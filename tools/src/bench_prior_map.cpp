@@ -91,8 +91,7 @@ struct Try {
   double error_m = 0.0;
   double error_deg = 0.0;
   bool within = false;
-  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();             // the cloud's frame in the world (the odometry's here)
-  Eigen::Isometry3d prior_from_world = Eigen::Isometry3d::Identity();  // the anchor it implies
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();  // the cloud's frame in the world (the odometry's here)
 };
 
 Eigen::Isometry3d yaw_only(const Eigen::Isometry3d& pose) {
@@ -201,7 +200,6 @@ int run(const Options& o) {
     attempt.error_deg = Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
     attempt.within = attempt.error_m <= 0.05 && attempt.error_deg <= 0.5;
     attempt.level = level;
-    attempt.prior_from_world = attempt.result.pose * level_inv;
     return attempt;
   };
   for (int s = 0; s < o.starts; ++s) {
@@ -230,11 +228,13 @@ int run(const Options& o) {
     // until one is reported found or the budget's sensor time has passed.
     std::size_t first = start.scan;
     std::uint64_t failures = 0;
-    slam::AnchorConfirmation confirmation;  // --confirm: a found anchor waits for the next try to agree
+    slam::AnchorConfirmation confirmation(localisation);  // a found anchor waits for the next try to agree
     for (;;) {
       ++start.tries;
       const double done_s = window_end_s(first) + attempt.cpu_s;
-      if (attempt.result.success && (!o.confirm || confirmation.agrees(attempt.prior_from_world, attempt.level))) {
+      // The anchor a try implies: prior ← world (the odometry's frame here).
+      const Eigen::Isometry3d anchor = attempt.result.pose * attempt.level.inverse();
+      if (attempt.result.success && (!o.confirm || confirmation.agrees(anchor, attempt.level))) {
         start.retry_reported = true;
         start.retry_within = attempt.within;
         start.time_to_localise_s = done_s - t0;
@@ -243,13 +243,9 @@ int run(const Options& o) {
       if (o.retry_s <= 0.0) break;
       std::size_t next = first + static_cast<std::size_t>(o.scans);
       while (next < scans.size() && stamp_s(next) < done_s) ++next;
-      // After a failure, scans are passed over, unless a found pose waits to
-      // be confirmed (the prior matches there); after a found one, none.
-      if (!attempt.result.success) {
-        ++failures;
-        if (!(o.confirm && confirmation.waiting()))
-          next += static_cast<std::size_t>(daemon::scans_passed_over(failures, o.scans));
-      }
+      // After a failure, scans are passed over by aditd's rule; after a found one, none.
+      if (!attempt.result.success)
+        next += static_cast<std::size_t>(daemon::scans_passed_over(++failures, o.scans, confirmation.waiting()));
       if (next + static_cast<std::size_t>(o.scans) > scans.size() || window_end_s(next) - t0 > o.retry_s) break;
       first = next;
       attempt = try_window(first, tilt_x, tilt_y, crew);

@@ -11,7 +11,7 @@
 // never matches (another building, a start outside it) costs a search every
 // ~11 s at most, not one every second for the whole session. With `confirm`,
 // a try that finds a pose is taken only once the next try that finds one
-// agrees with it (slam::same_place, the sensor placed by both anchors); one
+// agrees with it (slam::AnchorConfirmation, the sensor placed by both anchors); one
 // that disagrees waits for the next in its turn. A crew's hint
 // (HINT: set_hint, on the endpoint's thread) narrows the tries after it and
 // starts the next at once; it is held under a mutex the odometry thread never takes.
@@ -57,8 +57,9 @@ struct PriorLocaliserStats {
 
 // The scans passed over after the `failures`-th failed try before the next
 // is gathered: failures × scans_per_try, at most 10 × (the tries' spacing
-// grows to 11 tries' worth). `adit bench prior-map` retries by the same rule.
-int scans_passed_over(std::uint64_t failures, int scans_per_try);
+// grows to 11 tries' worth); none while a found pose waits to be confirmed
+// (the prior matches there). `adit bench prior-map` retries by the same rule.
+int scans_passed_over(std::uint64_t failures, int scans_per_try, bool found_waiting = false);
 
 class PriorLocaliser {
  public:

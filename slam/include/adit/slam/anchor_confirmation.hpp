@@ -6,7 +6,7 @@
 // (docs/decisions/053-prior-localisation-confirmed.md). Another second later,
 // seen from elsewhere, a wrong pose rarely repeats; two tries agreeing is the
 // pairwise consistency the loop closer asks of its loops too. Used by aditd's
-// prior localiser and `adit bench prior-map --confirm`.
+// prior localiser and `adit bench prior-map` (unless --no-confirm).
 
 #include <optional>
 
