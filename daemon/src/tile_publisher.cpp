@@ -200,7 +200,7 @@ void TilePublisher::send_chunks(Clock::time_point now) {
       continue;
     }
     m.utime = tile->utime;
-    m.schema = 2;
+    m.schema = tile->params.centred ? 3 : 2;  // 3: the origin centred on the tile (tile_codec.hpp)
     m.payload_id = options_.payload_id;
     m.session_id = session_id_;
     m.tile_id = tile->id;

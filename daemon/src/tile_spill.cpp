@@ -85,7 +85,8 @@ std::string TileSpill::read_into(const slam::TileCoord& coord, std::vector<slam:
   points.reserve(protocol::kMaxSegmentPoints);
   for (std::size_t s = 0; s < segments.size(); ++s) {
     points.clear();
-    if (std::string problem = protocol::decode_segment(segments[s].frame, key, params.tile_size_m, params.quantum_m, points);
+    if (std::string problem = protocol::decode_segment(segments[s].frame, key, params.tile_size_m, params.quantum_m,
+                                                                params.centred, points);
         !problem.empty()) {
       out.clear();
       return fmt::format("{}: tile's segment {}: {}", file.string(), s, problem);

@@ -191,13 +191,14 @@ std::string TileStore::insert_file(std::int64_t id, const std::filesystem::path&
   if (in.bad()) return fmt::format("{}: cannot read the tile", file.string());
   // The whole file is checked as before (every frame's size against its
   // point count), one tile at a time.
-  const bool format2 = blob.size() >= protocol::kTileHeaderBytesFormat2 && blob[4] == 2 && blob[5] == 0;
+  // Formats 2 and 3 (segments; 3 with the origin centred) index alike.
+  const bool segmented = blob.size() >= protocol::kTileHeaderBytesFormat2 && (blob[4] == 2 || blob[4] == 3) && blob[5] == 0;
   // A format-1 tile is re-cut into new frames: those go to the spool, if any.
-  if (std::string problem = insert_blob(id, blob, utime, !format2); !problem.empty())
+  if (std::string problem = insert_blob(id, blob, utime, !segmented); !problem.empty())
     return fmt::format("{}: {}", file.string(), problem);
-  if (!format2) return {};
+  if (!segmented) return {};
   EncodedTile& tile = tiles_.at(id);
-  // Format 2: the frames lie at known offsets of the file; only those stay.
+  // Formats 2 and 3: the frames lie at known offsets of the file; only those stay.
   const auto index = static_cast<std::uint32_t>(files_.size());
   files_.push_back(file);
   std::uint64_t at = protocol::kTileHeaderBytesFormat2 + 4 * tile.segments.size();

@@ -42,6 +42,7 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
                               m.tile_id, m.version, m.segment, m.n_segments, m.base_version, m.first_segment, m.size);
     return count(SegmentOutcome::malformed);
   }
+  const bool centred = m.schema >= 3;  // the segment's origin (tile_codec.hpp)
   Tile& tile = tiles_[m.tile_id];
   if (m.version <= tile.done_version || m.version < tile.pending_version) return count(SegmentOutcome::stale);
   if (m.version > tile.wanted_version) {  // the live stream ran ahead of the index
@@ -75,7 +76,7 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
   if (tile.have[index]) return count(finish_if_complete(tile) == SegmentOutcome::completed ? SegmentOutcome::completed
                                                                                           : SegmentOutcome::duplicate);
   scratch_.clear();
-  if (const std::string error = decode_segment(m.data, tile_key(m.tile_id), m.tile_size_m, m.quantum_m, scratch_);
+  if (const std::string error = decode_segment(m.data, tile_key(m.tile_id), m.tile_size_m, m.quantum_m, centred, scratch_);
       !error.empty()) {
     // Not kept: it is asked for again (a datagram damaged on the way is
     // likely; a daemon serving bad bytes shows as this error repeating).
@@ -83,7 +84,8 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
     return count(SegmentOutcome::corrupt);
   }
   tile.parts[index] = HeldSegment{std::vector<std::uint8_t>(m.data.begin(), m.data.end()),
-                                  static_cast<std::uint32_t>(scratch_.size()), m.tile_id, m.tile_size_m, m.quantum_m, m.utime};
+                                  static_cast<std::uint32_t>(scratch_.size()), m.tile_id, m.tile_size_m, m.quantum_m, centred,
+                                  m.utime};
   tile.have[index] = true;
   return count(finish_if_complete(tile));
 }
@@ -175,7 +177,7 @@ std::size_t TileAssembler::HeldTile::points() const {
 void HeldSegment::decode_into(std::vector<MapPoint>& out) const {
   const std::size_t first = out.size();
   // Decoded once already, on arrival: an error here is not expected (the frame is unchanged since).
-  if (frame.empty() || !decode_segment(frame, tile_key(tile_id), tile_size_m, quantum_m, out).empty()) {
+  if (frame.empty() || !decode_segment(frame, tile_key(tile_id), tile_size_m, quantum_m, centred, out).empty()) {
     out.resize(first);
     return;
   }

@@ -57,6 +57,16 @@ TileKey tile_of(double x, double y, double z, double tile_size_m) {
   return {clamp_coordinate(x / tile_size_m), clamp_coordinate(y / tile_size_m), clamp_coordinate(z / tile_size_m)};
 }
 
+double quantisation_origin(std::int32_t c, const TileParams& params) {
+  const double corner = c * params.tile_size_m;
+  if (!params.centred) return corner;
+  // Whole steps, from the rounded step count: an encoder's double and a
+  // decoder's float parameters give the same origin.
+  const long long steps = std::llround(params.tile_size_m / params.quantum_m);
+  const long long margin = std::max(0LL, (65535LL - steps) / 2);
+  return corner - static_cast<double>(margin) * params.quantum_m;
+}
+
 std::string tile_params_problem(const TileParams& params) {
   if (!(params.tile_size_m > 0) || !(params.quantum_m > 0)) return "tile size and quantum must be positive";
   if (params.tile_size_m / params.quantum_m > 65535.0)
@@ -74,9 +84,9 @@ namespace {
 using Quantised = std::array<std::uint16_t, 4>;  // qx, qy, qz, intensity
 
 std::vector<Quantised> quantise_tile(TileKey key, std::span<const MapPoint> points, const TileParams& params) {
-  const double ox = key.x * params.tile_size_m;
-  const double oy = key.y * params.tile_size_m;
-  const double oz = key.z * params.tile_size_m;
+  const double ox = quantisation_origin(key.x, params);
+  const double oy = quantisation_origin(key.y, params);
+  const double oz = quantisation_origin(key.z, params);
   std::vector<Quantised> out(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const MapPoint& p = points[i];
@@ -134,8 +144,9 @@ std::vector<std::uint8_t> compress_points(std::vector<Quantised> points, ZSTD_CC
 }
 
 // Decompresses a frame of exactly `n` quantised points (columns) into `out` (appended).
-std::string decompress_points(std::span<const std::uint8_t> frame, std::size_t n, TileKey key, double tile_size_m,
-                              double quantum_m, std::vector<MapPoint>& out) {
+std::string decompress_points(std::span<const std::uint8_t> frame, std::size_t n, TileKey key, const TileParams& params,
+                              std::vector<MapPoint>& out) {
+  const double quantum_m = params.quantum_m;
   const std::size_t raw_size = n * kBytesPerQuantisedPoint;
   const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (content != raw_size) return "zstd frame size does not match its point count";
@@ -143,9 +154,9 @@ std::string decompress_points(std::span<const std::uint8_t> frame, std::size_t n
   const std::size_t got = ZSTD_decompress(columns.data(), raw_size, frame.data(), frame.size());
   if (ZSTD_isError(got)) return std::string("zstd: ") + ZSTD_getErrorName(got);
   if (got != raw_size) return "zstd frame is short";
-  const double ox = key.x * tile_size_m;
-  const double oy = key.y * tile_size_m;
-  const double oz = key.z * tile_size_m;
+  const double ox = quantisation_origin(key.x, params);
+  const double oy = quantisation_origin(key.y, params);
+  const double oz = quantisation_origin(key.z, params);
   const std::size_t base = out.size();
   out.resize(base + n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -162,19 +173,21 @@ std::size_t segment_count(std::size_t n_points, std::uint32_t segment_points) {
   return std::max<std::size_t>(1, (n_points + segment_points - 1) / segment_points);
 }
 
-// Reads the 20 bytes common to both formats; "" or why the header is unusable.
+// Reads the 20 bytes common to every format (and format 2's and 3's 8 more);
+// "" or why the header is unusable.
 std::string read_header(std::span<const std::uint8_t> blob, std::uint16_t& format, std::uint32_t& n,
                         TileParams& params) {
   if (blob.size() < kTileHeaderBytes) return "tile shorter than its header";
   if (std::memcmp(blob.data(), "ADT1", 4) != 0) return "tile does not start with ADT1";
   format = get<std::uint16_t>(blob, 4);
-  if (format != 1 && format != 2) return fmt::format("tile format {} is not 1 or 2", format);
+  if (format < 1 || format > 3) return fmt::format("tile format {} is not 1, 2 or 3", format);
+  params.centred = format == 3;
   n = get<std::uint32_t>(blob, 8);
   params.tile_size_m = get<float>(blob, 12);
   params.quantum_m = get<float>(blob, 16);
   if (n > kMaxTilePoints) return fmt::format("tile claims {} points (limit {})", n, kMaxTilePoints);
-  if (format == 2) {
-    if (blob.size() < kTileHeaderBytesFormat2) return "tile shorter than its format-2 header";
+  if (format >= 2) {
+    if (blob.size() < kTileHeaderBytesFormat2) return fmt::format("tile shorter than its format-{} header", format);
     params.segment_points = get<std::uint32_t>(blob, 20);
   }
   return tile_params_problem(params);
@@ -220,16 +233,17 @@ std::size_t first_segment_after(std::span<const TileSegment> segments, std::int3
 }
 
 std::string decode_segment(std::span<const std::uint8_t> frame, TileKey key, double tile_size_m, double quantum_m,
-                           std::vector<MapPoint>& out) {
+                           bool centred, std::vector<MapPoint>& out) {
   TileParams params;
   params.tile_size_m = tile_size_m;
   params.quantum_m = quantum_m;
+  params.centred = centred;
   if (const std::string problem = tile_params_problem(params); !problem.empty()) return problem;
   const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR) return "not a zstd frame of known size";
   if (content % kBytesPerQuantisedPoint != 0 || content > kMaxSegmentPoints * kBytesPerQuantisedPoint)
     return fmt::format("segment of {} bytes is not whole points of at most {}", content, kMaxSegmentPoints);
-  return decompress_points(frame, content / kBytesPerQuantisedPoint, key, tile_size_m, quantum_m, out);
+  return decompress_points(frame, content / kBytesPerQuantisedPoint, key, params, out);
 }
 
 std::vector<std::uint8_t> pack_tile(const TileParams& params, std::span<const TileSegment> segments) {
@@ -241,7 +255,7 @@ std::vector<std::uint8_t> pack_tile(const TileParams& params, std::span<const Ti
   }
   std::vector<std::uint8_t> blob(bytes);
   std::memcpy(blob.data(), "ADT1", 4);
-  put<std::uint16_t>(blob, 4, kTileFormat);
+  put<std::uint16_t>(blob, 4, params.centred ? kTileFormat : std::uint16_t{2});
   put<std::uint16_t>(blob, 6, 0);
   put<std::uint32_t>(blob, 8, static_cast<std::uint32_t>(n_points));
   put<float>(blob, 12, static_cast<float>(params.tile_size_m));
@@ -269,8 +283,10 @@ std::vector<std::uint8_t> encode_tile(TileKey key, std::span<const MapPoint> poi
 std::vector<std::uint8_t> encode_tile_format1(TileKey key, std::span<const MapPoint> points, const TileParams& params) {
   if (const std::string problem = tile_params_problem(params); !problem.empty()) throw std::invalid_argument(problem);
   if (points.size() > kMaxTilePoints) throw std::invalid_argument("too many points for one tile");
+  TileParams corner = params;  // format 1 knew only the corner origin
+  corner.centred = false;
   const CompressionContext context = make_context(params);
-  const std::vector<std::uint8_t> frame = compress_points(quantise_tile(key, points, params), context.get());
+  const std::vector<std::uint8_t> frame = compress_points(quantise_tile(key, points, corner), context.get());
   std::vector<std::uint8_t> blob(kTileHeaderBytes + frame.size());
   std::memcpy(blob.data(), "ADT1", 4);
   put<std::uint16_t>(blob, 4, 1);
@@ -291,8 +307,7 @@ std::string unpack_tile(std::span<const std::uint8_t> blob, TileKey key, TilePar
   if (std::string problem = read_header(blob, format, n, read); !problem.empty()) return problem;
   if (format == 1) {  // one frame of every point: decode, then cut into segments
     std::vector<MapPoint> points;
-    if (std::string problem = decompress_points(blob.subspan(kTileHeaderBytes), n, key, read.tile_size_m,
-                                                read.quantum_m, points);
+    if (std::string problem = decompress_points(blob.subspan(kTileHeaderBytes), n, key, read, points);
         !problem.empty())
       return "tile: " + problem;
     read.segment_points = params.segment_points;
@@ -333,8 +348,7 @@ std::string decode_tile(std::span<const std::uint8_t> blob, TileKey key, std::ve
   TileParams params;
   if (std::string problem = read_header(blob, format, n, params); !problem.empty()) return problem;
   if (format == 1) {
-    std::string problem = decompress_points(blob.subspan(kTileHeaderBytes), n, key, params.tile_size_m,
-                                            params.quantum_m, out);
+    std::string problem = decompress_points(blob.subspan(kTileHeaderBytes), n, key, params, out);
     if (!problem.empty()) out.clear();
     return problem.empty() ? problem : "tile's " + problem;
   }
@@ -342,8 +356,7 @@ std::string decode_tile(std::span<const std::uint8_t> blob, TileKey key, std::ve
   if (std::string problem = unpack_tile(blob, key, params, segments); !problem.empty()) return problem;
   out.reserve(n);
   for (std::size_t s = 0; s < segments.size(); ++s) {
-    if (std::string problem = decompress_points(segments[s].frame, segments[s].n_points, key, params.tile_size_m,
-                                                params.quantum_m, out);
+    if (std::string problem = decompress_points(segments[s].frame, segments[s].n_points, key, params, out);
         !problem.empty()) {
       out.clear();
       return fmt::format("tile's segment {}: {}", s, problem);

@@ -246,8 +246,8 @@ TEST(TilePublisherStored, AnotherSessionIsServedFromTheLoaderOrRefusedWithItsRea
     EXPECT_EQ(into.insert_encoded(protocol::tile_id({1, 0, 0}), std::vector<std::uint8_t>{1, 2, 3}, 1),
               "tile shorter than its header");
     auto future = blob;
-    future[4] = 3;  // a format this daemon does not know
-    EXPECT_EQ(into.insert_encoded(protocol::tile_id({3, 0, 0}), future, 1), "tile format 3 is not 1 or 2");
+    future[4] = 4;  // a format this daemon does not know
+    EXPECT_EQ(into.insert_encoded(protocol::tile_id({3, 0, 0}), future, 1), "tile format 4 is not 1, 2 or 3");
     return "";
   };
   TilePublisher publisher(options, sink);

@@ -28,6 +28,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   adit::protocol::TileParams params;
   std::vector<adit::protocol::TileSegment> segments;
   (void)adit::protocol::unpack_tile(std::span(data, size), key, params, segments);
-  (void)adit::protocol::decode_segment(std::span(data, size), key, 20.0, 0.001, points);
+  (void)adit::protocol::decode_segment(std::span(data, size), key, 20.0, 0.001, size % 2 == 0, points);
   return 0;
 }

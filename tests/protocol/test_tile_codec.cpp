@@ -134,7 +134,7 @@ TEST(TileSegments, DecodeToTheTilesPointsInAnyCombination) {
   update_segments(key, points, params, 1, segments);
   std::vector<MapPoint> back;
   for (const TileSegment& s : segments)
-    ASSERT_EQ(decode_segment(s.frame, key, params.tile_size_m, params.quantum_m, back), "");
+    ASSERT_EQ(decode_segment(s.frame, key, params.tile_size_m, params.quantum_m, true, back), "");
   ASSERT_EQ(back.size(), points.size());
   const auto a = sorted_by_mm(points);
   const auto b = sorted_by_mm(back);
@@ -142,9 +142,9 @@ TEST(TileSegments, DecodeToTheTilesPointsInAnyCombination) {
   auto bad = segments[0].frame;
   bad[bad.size() / 2] ^= 0xff;
   std::vector<MapPoint> out;
-  EXPECT_NE(decode_segment(bad, key, params.tile_size_m, params.quantum_m, out), "");  // zstd's checksum
-  EXPECT_NE(decode_segment(std::span(segments[0].frame).first(3), key, 20.0, 0.001, out), "");
-  EXPECT_NE(decode_segment(segments[0].frame, key, 100.0, 0.001, out), "");  // 100 m / 1 mm > uint16
+  EXPECT_NE(decode_segment(bad, key, params.tile_size_m, params.quantum_m, true, out), "");  // zstd's checksum
+  EXPECT_NE(decode_segment(std::span(segments[0].frame).first(3), key, 20.0, 0.001, true, out), "");
+  EXPECT_NE(decode_segment(segments[0].frame, key, 100.0, 0.001, true, out), "");  // 100 m / 1 mm > uint16
 }
 
 TEST(TileCodec, StoredTilesOfTheOldFormatStillLoad) {
@@ -160,18 +160,61 @@ TEST(TileCodec, StoredTilesOfTheOldFormatStillLoad) {
   const auto a = sorted_by_mm(from_old);
   const auto b = sorted_by_mm(from_new);
   ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(b[i].x, a[i].x);
-  // Served to clients as segments (re-cut on load).
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(b[i].x, a[i].x, 1e-9);
+  // Served to clients as segments (re-cut on load), with the corner origin.
   TileParams read = params;
   std::vector<TileSegment> segments;
   ASSERT_EQ(unpack_tile(old_blob, key, read, segments), "");
   EXPECT_EQ(segments.size(), 3u);
+  EXPECT_FALSE(read.centred);
   std::vector<MapPoint> joined;
-  for (const TileSegment& s : segments) ASSERT_EQ(decode_segment(s.frame, key, 20.0, 0.001, joined), "");
+  for (const TileSegment& s : segments) ASSERT_EQ(decode_segment(s.frame, key, 20.0, 0.001, false, joined), "");
+  EXPECT_NEAR(sorted_by_mm(joined).front().x, a.front().x, 1e-9);
   EXPECT_EQ(joined.size(), points.size());
   auto future = old_blob;
-  future[4] = 3;
-  EXPECT_EQ(decode_tile(future, key, from_old), "tile format 3 is not 1 or 2");
+  future[4] = 4;
+  EXPECT_EQ(decode_tile(future, key, from_old), "tile format 4 is not 1, 2 or 3");
+}
+
+// Format 2 (the corner origin, sessions stored before format 3) still loads;
+// format 3 keeps points the loop closure moved out of their tile (up to
+// 22.7 m for 20 m at 1 mm), where format 2 clamps them to the tile's faces.
+TEST(TileCodec, PointsMovedOutOfTheirTileKeepTheirPlaceFromFormat3) {
+  const TileKey key{-2, 5, 0};
+  TileParams params;
+  std::vector<MapPoint> points = random_points(key, params.tile_size_m, 2000, 4);
+  for (std::size_t i = 0; i < points.size(); i += 2) {  // half of them moved up to 22 m out, either way
+    const double shift = (i % 4 == 0 ? 1.0 : -1.0) * (21.0 + 0.001 * static_cast<double>(i % 1000));
+    points[i].x += shift;
+    points[i].z -= shift;
+  }
+  const auto blob = encode_tile(key, points, params);
+  ASSERT_EQ(blob[4], 3);
+  std::vector<MapPoint> back;
+  ASSERT_EQ(decode_tile(blob, key, back), "");
+  const auto a = sorted_by_mm(points);
+  const auto b = sorted_by_mm(back);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(b[i].x, a[i].x, 0.5 * params.quantum_m + 1e-6);
+    EXPECT_NEAR(b[i].z, a[i].z, 0.5 * params.quantum_m + 1e-6);
+  }
+  // The origin is the same from a decoder's float parameters.
+  TileParams f = params;
+  f.tile_size_m = static_cast<float>(params.tile_size_m);
+  f.quantum_m = static_cast<float>(params.quantum_m);
+  EXPECT_NEAR(quantisation_origin(key.x, f), quantisation_origin(key.x, params), 1e-6);
+  EXPECT_NEAR(quantisation_origin(key.x, params), -40.0 - 22.767, 1e-9);
+
+  params.centred = false;  // format 2
+  const auto old_blob = encode_tile(key, points, params);
+  ASSERT_EQ(old_blob[4], 2);
+  ASSERT_EQ(decode_tile(old_blob, key, back), "");
+  // The points moved below the tile's corner in x (a quarter of them) are on its face.
+  const double lo = key.x * params.tile_size_m;
+  EXPECT_EQ(std::count_if(back.begin(), back.end(), [&](const MapPoint& p) { return p.x < lo - 1e-9; }), 0);
+  EXPECT_EQ(std::count_if(back.begin(), back.end(), [&](const MapPoint& p) { return std::abs(p.x - lo) < 1e-9; }),
+            static_cast<long>(points.size() / 4));
 }
 
 TEST(TileCodec, RejectsParametersThatDoNotFitUint16) {

@@ -43,6 +43,7 @@ struct HeldSegment {
   std::int64_t tile_id = 0;
   double tile_size_m = 0.0;
   double quantum_m = 0.0;
+  bool centred = true;     // schema 3: its origin (tile_codec.hpp)
   std::int64_t utime = 0;  // the segment message's: each point's time
   // Appends its points to `out` (checked on arrival: it decodes).
   void decode_into(std::vector<MapPoint>& out) const;

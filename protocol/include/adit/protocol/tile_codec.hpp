@@ -14,10 +14,16 @@
 // Segment frame: zstd frame (with its content checksum) holding
 //   u16 qx[n], u16 qy[n], u16 qz[n], u16 intensity[n], sorted by (qx, qy, qz);
 // n = segment_points except for the last segment. A point is
-// origin + q * quantum, origin = tile coordinate * tile_size.
+// origin + q * quantum. From format 3 (segments: tile_segment_t schema 3) the
+// uint16 span is centred on the tile: origin = tile coordinate * tile_size −
+// m * quantum, m = (65535 − tile_size / quantum) / 2 whole steps (22 767 for
+// 20 m at 1 mm), so a point the loop closure moved out of its tile by up to
+// m * quantum (22.7 m) keeps its place (docs/LOOPS.md, "Live tiles"). Formats
+// 1 and 2 (schema 2) put the origin at the tile's lowest corner.
 //
-// Encoded tile ("blob", tiles/<id>.adt), little-endian, format 2:
-//   char[4] "ADT1", u16 format (2), u16 flags (0), u32 n_points,
+// Encoded tile ("blob", tiles/<id>.adt), little-endian, format 3 (2: the
+// same bytes with the origin at the corner):
+//   char[4] "ADT1", u16 format (3), u16 flags (0), u32 n_points,
 //   f32 tile_size_m, f32 quantum_m, u32 segment_points, u32 n_segments,
 //   u32 frame_bytes[n_segments], then the segments' frames in order.
 // Format 1 (before segments; still decoded): the same first 20 bytes with
@@ -62,13 +68,18 @@ struct TileParams {
   // whole, so smaller is cheaper per update, larger compresses better
   // (bench_tile_stream measures the trade-off; 1024 was the cheapest).
   std::uint32_t segment_points = 1024;
+  // The uint16 span centred on the tile (format 3), else from its corner
+  // (formats 1 and 2, read from stored sessions).
+  bool centred = true;
 };
+// The corner of the quantisation grid of tile coordinate `c` (one axis).
+double quantisation_origin(std::int32_t c, const TileParams& params);
 // "" when usable, else why not (tile_size / quantum must fit uint16, segment size in range).
 std::string tile_params_problem(const TileParams& params);
 
 inline constexpr std::size_t kTileHeaderBytes = 20;        // format 1 and the start of format 2
 inline constexpr std::size_t kTileHeaderBytesFormat2 = 28;  // + segment_points, n_segments
-inline constexpr std::uint16_t kTileFormat = 2;
+inline constexpr std::uint16_t kTileFormat = 3;  // 2 when !TileParams::centred
 // A 20 m tile of 5 cm voxels holds ~1 M surface points; 4 M bounds the memory
 // a hostile or corrupt header can make a decoder allocate (32 MB).
 inline constexpr std::uint32_t kMaxTilePoints = 4'000'000;
@@ -92,7 +103,8 @@ struct TileSegment {
 // changed one on, every segment is re-encoded and stamped `version`, so the
 // segments changed after any version form a suffix (what a client lacks is
 // always segments [first, n)). Returns that first changed index (== size when
-// nothing changed). Points outside the tile are clamped to its faces.
+// nothing changed). Points beyond the quantisation span are clamped to its
+// faces.
 // `params` must be valid; throws std::invalid_argument for too many points.
 std::size_t update_segments(TileKey key, std::span<const MapPoint> points, const TileParams& params,
                             std::int32_t version, std::vector<TileSegment>& segments);
@@ -101,14 +113,15 @@ std::size_t update_segments(TileKey key, std::span<const MapPoint> points, const
 // complete at that version lacks exactly segments [first, size).
 std::size_t first_segment_after(std::span<const TileSegment> segments, std::int32_t held_version);
 
-// Decodes one segment frame of tile `key` and appends its points to `out`.
+// Decodes one segment frame of tile `key` and appends its points to `out`;
+// `centred`: the segment's origin (tile_segment_t schema 3, format 3).
 // Returns "" or the reason the frame is unusable; never throws on bad bytes.
 std::string decode_segment(std::span<const std::uint8_t> frame, TileKey key, double tile_size_m, double quantum_m,
-                           std::vector<MapPoint>& out);
+                           bool centred, std::vector<MapPoint>& out);
 
-// The blob of a tile (format 2) from its segments.
+// The blob of a tile (format 3, or 2 when !params.centred) from its segments.
 std::vector<std::uint8_t> pack_tile(const TileParams& params, std::span<const TileSegment> segments);
-// Encodes the points of tile `key` (append order) as a format-2 blob.
+// Encodes the points of tile `key` (append order) as a blob (pack_tile's format).
 std::vector<std::uint8_t> encode_tile(TileKey key, std::span<const MapPoint> points, const TileParams& params);
 // The old whole-tile format 1 (one frame of every point sorted): kept to test
 // that stored sessions of that format still load, and as the bandwidth baseline.
@@ -121,7 +134,7 @@ std::vector<std::uint8_t> encode_tile_format1(TileKey key, std::span<const MapPo
 std::string unpack_tile(std::span<const std::uint8_t> blob, TileKey key, TileParams& params,
                         std::vector<TileSegment>& segments);
 
-// Decodes a blob (format 1 or 2) of tile `key` into `out` (replaced).
+// Decodes a blob (format 1, 2 or 3) of tile `key` into `out` (replaced).
 // Returns "" or the reason the blob is unusable; never throws on bad bytes.
 std::string decode_tile(std::span<const std::uint8_t> blob, TileKey key, std::vector<MapPoint>& out);
 
