@@ -431,12 +431,14 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   void send_frame(std::int64_t utime) {
     frame_t f;
     f.utime = utime;
-    f.schema = 1;
+    f.schema = 2;
     f.payload_id = options.payload_id;
     f.session_id = session_id;
     f.source = frame.source;
     std::copy(frame.position.begin(), frame.position.end(), f.position);
     std::copy(frame.orientation.begin(), frame.orientation.end(), f.orientation);
+    std::copy(frame.tiles_position.begin(), frame.tiles_position.end(), f.tiles_position);
+    std::copy(frame.tiles_orientation.begin(), frame.tiles_orientation.end(), f.tiles_orientation);
     send(Channel::frame, f);
     ++counters.frames_published;
   }

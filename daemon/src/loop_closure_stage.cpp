@@ -71,6 +71,7 @@ void LoopClosureStage::loop() {
       log::info("loops: keyframe {}: {} loop(s) accepted, graph optimised in {:.3f} s; correction {:.3f} m",
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,
                 closer_.stats().last_optimization_s, c.translation().norm());
+      if (closer_.stats().accepted > 0) live_.post(closer_.correction_track());
     }
     if (closer_.scans().read_errors() + closer_.scans().write_errors() > file_errors_before)
       log::warn("loops: {}", closer_.scans().last_error());

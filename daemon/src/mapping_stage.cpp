@@ -128,7 +128,7 @@ void MappingStage::loop() {
   }
   if (have_pending_ && !thread_.stopping()) map_scan(pending_, velocity_);  // the last sweep: the last motion known
   have_pending_ = false;
-  flush_tiles();
+  flush_tiles(true);
   flush_grid();
   map_trajectory_.flush();
   stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);
@@ -257,7 +257,7 @@ void MappingStage::compact_tiles(const std::vector<slam::TileCoord>& coords) {
       tile_file_error(problem);
       continue;
     }
-    if (map_.evict(coord).changed && sink_) sink_(coord, tile_buffer);
+    if (map_.evict(coord).changed && sink_) send_tile(coord, tile_buffer);
     journaled_.erase(coord);
     map_.restore(coord, tile_buffer);
     stats_.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
@@ -297,27 +297,84 @@ void MappingStage::evict_tiles(const std::vector<slam::TileCoord>& coords) {
       }
     }
     if (map_.evict(coord).changed && sink_ && spill_->whole_tile(map_, coord, tile_buffer).empty())
-      sink_(coord, tile_buffer);
+      send_tile(coord, tile_buffer);
     journaled_.erase(coord);
     stats_.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
   }
   stats_.lost_candidates.store(map_.lost_candidates(), std::memory_order_relaxed);
 }
 
-// A restored tile's whole content is its stored part (read back) and what is
-// new: decoding it costs a few ms per changed tile and period.
-void MappingStage::flush_tiles() {
+// The whole content of a tile: what the map holds, or with a stored part
+// (compacted or evicted) read back into `buffer`: its stored part and what is
+// new, decoding it costs a few ms per changed tile and period; "" or why not.
+std::string MappingStage::whole_tile(const slam::TileCoord& coord, std::vector<slam::MapSample>& buffer,
+                                     std::span<const slam::MapSample>& samples) const {
+  if (!spill_ || (map_.stored_points(coord) == 0 && !map_.is_evicted(coord))) {
+    samples = map_.tile(coord);
+    return {};
+  }
+  std::string problem = spill_->whole_tile(map_, coord, buffer);
+  samples = buffer;
+  return problem;
+}
+
+// A tile's whole content to the sink, placed by the graph's correction when
+// following it (each sample by the correction at its scan's time).
+void MappingStage::send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
+  if (graph_ != nullptr) sent_with_[coord] = placement_;
+  if (placement_ == nullptr) {
+    sink_(coord, samples);
+    return;
+  }
+  std::vector<slam::MapSample> placed;
+  slam::correct_samples(samples, placement_.get(), Eigen::Isometry3d::Identity(), placed);
+  sink_(coord, placed);
+}
+
+void MappingStage::flush_tiles(bool final) {
   const std::vector<slam::TileCoord> changed = map_.take_changed();
   if (!sink_) return;
-  std::vector<slam::MapSample> tile_buffer;
-  for (const slam::TileCoord& coord : changed) {
-    if (!spill_ || map_.stored_points(coord) == 0) {
-      sink_(coord, map_.tile(coord));
-    } else if (const std::string problem = spill_->whole_tile(map_, coord, tile_buffer); problem.empty()) {
-      sink_(coord, tile_buffer);
-    } else {
-      tile_file_error(problem);
+  if (graph_ != nullptr) {
+    std::shared_ptr<const slam::CorrectionTrack> latest = graph_->latest();
+    if (latest != placement_) {  // a new optimisation: every tile sent is checked against it
+      placement_ = std::move(latest);
+      recheck_.clear();
+      for (const auto& [coord, track] : sent_with_) recheck_.push_back(coord);
     }
+  }
+  std::vector<slam::MapSample> tile_buffer;
+  std::span<const slam::MapSample> samples;
+  for (const slam::TileCoord& coord : changed) {
+    if (const std::string problem = whole_tile(coord, tile_buffer, samples); problem.empty())
+      send_tile(coord, samples);
+    else
+      tile_file_error(problem);
+  }
+  replace_moved_tiles(final);
+}
+
+// Tiles sent placed by an earlier correction go again when the latest moves
+// any of their points by more than kTileMoveM; at most kReplaceBudgetMs of
+// the mapping thread per flush (all at the session's end), so a closure on a
+// long session's map does not hold the scans back.
+void MappingStage::replace_moved_tiles(bool all) {
+  const std::int64_t deadline = monotonic_ns() + kReplaceBudgetMs * 1'000'000;
+  std::vector<slam::MapSample> tile_buffer;
+  std::span<const slam::MapSample> samples;
+  while (!recheck_.empty() && (all || monotonic_ns() < deadline)) {
+    const slam::TileCoord coord = recheck_.front();
+    recheck_.pop_front();
+    const auto sent = sent_with_.find(coord);
+    if (sent == sent_with_.end() || sent->second == placement_) continue;  // sent since, placed by the latest
+    if (const std::string problem = whole_tile(coord, tile_buffer, samples); !problem.empty()) {
+      tile_file_error(problem);
+      continue;
+    }
+    stats_.tiles_checked_for_loops.fetch_add(1, std::memory_order_relaxed);
+    if (!slam::correction_moves(samples, sent->second.get(), placement_.get(), kTileMoveM)) continue;
+    send_tile(coord, samples);
+    stats_.tiles_moved_by_loops.fetch_add(1, std::memory_order_relaxed);
+    stats_.points_moved_by_loops.fetch_add(samples.size(), std::memory_order_relaxed);
   }
 }
 

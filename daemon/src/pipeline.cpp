@@ -101,6 +101,8 @@ struct Pipeline::Impl {
     if (mapping && c.map.loop_closure) {
       loops.emplace(c, stats, stop);
       mapping->feed_loops(&loops->input());
+      // The live tiles follow the graph as the exported map does (docs/LOOPS.md, "Live tiles").
+      if (c.map.loops_move_map) mapping->follow_graph(&loops->live());
     }
     open_files(o.trajectory_file, o.map_trajectory_file, o.record_file);
     if (ImuSource* imu = imu_source_of(c, can.get(), source); imu != nullptr && c.imu.pose_horizon_s > 0.0) {

@@ -43,8 +43,9 @@ namespace adit::daemon {
 
 namespace {
 
-// frame_t.SOURCE_PRIOR_MAP, as a number: this file needs no LCM header.
+// frame_t.SOURCE_PRIOR_MAP and SOURCE_LOOPS, as numbers: this file needs no LCM header.
 constexpr std::int8_t kFrameSourcePriorMap = 1;
+constexpr std::int8_t kFrameSourceLoops = 2;
 
 // summary.json's "imu": the IMU source's figures (imu_stats.hpp).
 // The CAN feed's frames and its bus's health; null without a CAN feed.
@@ -89,15 +90,27 @@ nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& sou
           {"unconfirmed_tries", s.unconfirmed.load()}};
 }
 
-// The running session's map frame for frame_t: the prior's once found.
-MapFrame session_frame(const PriorLocaliser* prior) {
+// The running session's map frame for frame_t: the prior's once found. When
+// the live tiles follow the graph (`loops`: map.loops_move_map), they are in
+// the graph's frame and the poses in the odometry's, which the latest
+// correction C places in it: map <- tiles = A, map <- odometry = A·C
+// (docs/LOOPS.md, "Live tiles").
+MapFrame session_frame(const PriorLocaliser* prior, const LoopClosureStage* loops) {
   MapFrame f;
   const std::optional<Eigen::Isometry3d> anchor = prior != nullptr ? prior->anchor() : std::nullopt;
-  if (!anchor) return f;
-  const Eigen::Quaterniond q(anchor->linear());
-  f.source = kFrameSourcePriorMap;
-  f.position = {anchor->translation().x(), anchor->translation().y(), anchor->translation().z()};
-  f.orientation = {q.w(), q.x(), q.y(), q.z()};
+  const std::shared_ptr<const slam::CorrectionTrack> track = loops != nullptr ? loops->live().latest() : nullptr;
+  const bool corrected = track != nullptr && !track->empty();
+  if (!anchor && !corrected) return f;
+  const Eigen::Isometry3d tiles = anchor.value_or(Eigen::Isometry3d::Identity());
+  const Eigen::Isometry3d odometry = corrected ? tiles * track->corrections().back() : tiles;
+  const auto put = [](const Eigen::Isometry3d& t, std::array<double, 3>& p, std::array<double, 4>& q) {
+    const Eigen::Quaterniond r(t.linear());
+    p = {t.translation().x(), t.translation().y(), t.translation().z()};
+    q = {r.w(), r.x(), r.y(), r.z()};
+  };
+  f.source = anchor ? kFrameSourcePriorMap : kFrameSourceLoops;
+  put(odometry, f.position, f.orientation);
+  put(tiles, f.tiles_position, f.tiles_orientation);
   return f;
 }
 
@@ -199,19 +212,6 @@ nlohmann::json journal_summary(const JournalWriter* journal) {
   const JournalStats& j = journal->stats();
   return {{"enabled", true}, {"records", j.records.load()}, {"bytes", j.bytes.load()}, {"syncs", j.syncs.load()},
           {"lost_records", j.lost_records.load()}, {"fault", journal->fault()}};
-}
-
-// The map follows the graph: each sample moves by the correction at its
-// scan's time (slam/correction_track.hpp), when `track` is given; then into
-// the session's frame, `placed_by` (session_frame.hpp).
-void move_samples(std::span<const slam::MapSample> in, const slam::CorrectionTrack* track,
-                  const Eigen::Isometry3d& placed_by, std::vector<slam::MapSample>& out) {
-  out.assign(in.begin(), in.end());
-  for (slam::MapSample& s : out) {
-    const Eigen::Isometry3d c =
-        track != nullptr ? placed_by * track->at(static_cast<std::int64_t>(std::llround(s.time_s * 1e9))) : placed_by;
-    s.position = (c * s.position.cast<double>()).cast<float>();
-  }
 }
 
 }  // namespace
@@ -471,7 +471,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         samples = read_back;
       }
       if (corrected || anchor) {
-        move_samples(samples, corrected ? &track : nullptr, placed_by, moved);
+        slam::correct_samples(samples, corrected ? &track : nullptr, placed_by, moved);
         samples = moved;
       }
       points = map_points_of(samples);
@@ -541,6 +541,9 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
                  {"evicted_tiles", s.evicted_tiles.load()}, {"restored_tiles", s.restored_tiles.load()},
                  {"compacted_tiles", s.compacted_tiles.load()},
+                 {"tiles_checked_for_loops", s.tiles_checked_for_loops.load()},
+                 {"tiles_moved_by_loops", s.tiles_moved_by_loops.load()},
+                 {"points_moved_by_loops", s.points_moved_by_loops.load()},
                  {"spilled_keyframes", s.spilled_keyframes.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},
@@ -753,7 +756,7 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
-  sample.frame = session_frame(pipeline_->prior_localiser());
+  sample.frame = session_frame(pipeline_->prior_localiser(), config_.map.loops_move_map ? pipeline_->loop_closure() : nullptr);
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;
 }

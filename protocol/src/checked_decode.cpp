@@ -109,7 +109,8 @@ const std::vector<Field>& layout(LcmType type) {
   static const std::vector<Field> file_chunk{I64, I16, I64, STR, STR, STR, STR, I64, I32, I32, I32, counted(Kind::i8, 10)};
   static const std::vector<Field> grid_patch{I64, I16, STR, STR, F32, I32, I32, I32, I32, I32, I32,
                                              counted(Kind::i8, 10)};
-  static const std::vector<Field> frame{I64, I16, STR, STR, I8, {Kind::f64, 3}, {Kind::f64, 4}};
+  static const std::vector<Field> frame{I64,           I16,           STR,           STR,          I8,
+                                        {Kind::f64, 3}, {Kind::f64, 4}, {Kind::f64, 3}, {Kind::f64, 4}};
   switch (type) {
     case LcmType::pose: return pose;
     case LcmType::status: return status;

@@ -2,6 +2,8 @@
 #include "adit/slam/correction_track.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace adit::slam {
 
@@ -24,6 +26,51 @@ Eigen::Isometry3d CorrectionTrack::at(std::int64_t stamp_ns) const {
   const std::size_t a = b - 1;
   const double s = static_cast<double>(stamp_ns - stamps_[a]) / static_cast<double>(stamps_[b] - stamps_[a]);
   return corrections_[a] * exp_se3(s * steps_[a]);
+}
+
+namespace {
+
+std::int64_t stamp_of(const MapSample& s) { return static_cast<std::int64_t>(std::llround(s.time_s * 1e9)); }
+
+}  // namespace
+
+void correct_samples(std::span<const MapSample> in, const CorrectionTrack* track, const Eigen::Isometry3d& placed_by,
+                     std::vector<MapSample>& out) {
+  out.assign(in.begin(), in.end());
+  if (track == nullptr || track->empty()) {
+    for (MapSample& s : out) s.position = (placed_by * s.position.cast<double>()).cast<float>();
+    return;
+  }
+  double time = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Isometry3d c = placed_by;
+  for (MapSample& s : out) {
+    if (s.time_s != time) {
+      time = s.time_s;
+      c = placed_by * track->at(stamp_of(s));
+    }
+    s.position = (c * s.position.cast<double>()).cast<float>();
+  }
+}
+
+bool correction_moves(std::span<const MapSample> samples, const CorrectionTrack* a, const CorrectionTrack* b,
+                      double min_move_m) {
+  if (a == b) return false;
+  const auto at = [](const CorrectionTrack* t, std::int64_t ns) {
+    return t == nullptr ? Eigen::Isometry3d::Identity() : t->at(ns);
+  };
+  double time = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Isometry3d ca = Eigen::Isometry3d::Identity(), cb = ca;
+  const double min2 = min_move_m * min_move_m;
+  for (const MapSample& s : samples) {
+    if (s.time_s != time) {
+      time = s.time_s;
+      ca = at(a, stamp_of(s));
+      cb = at(b, stamp_of(s));
+    }
+    const Eigen::Vector3d p = s.position.cast<double>();
+    if ((cb * p - ca * p).squaredNorm() > min2) return true;
+  }
+  return false;
 }
 
 double CorrectionTrack::max_translation_m() const {

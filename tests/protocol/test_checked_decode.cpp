@@ -108,6 +108,7 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   frame.session_id = "s1";
   frame.source = frame_t::SOURCE_PRIOR_MAP;
   frame.orientation[0] = 1.0;
+  frame.tiles_orientation[0] = 1.0;
   expect_round_trip(frame);
 }
 

@@ -188,5 +188,37 @@ TEST(CorrectionTrack, InterpolatesBetweenKeyframesAndHoldsBeyond) {
   EXPECT_NEAR(track.max_rotation_rad(), 0.1, 1e-9);
 }
 
+// The live tiles follow the graph: a sample moves by the correction at its
+// scan's time; a tile is sent again when a new correction moves any of its
+// samples by more than the threshold.
+TEST(CorrectionTrack, MovesEachSampleByItsScansCorrectionAndSaysWhenATileMoved) {
+  const std::vector<std::int64_t> stamps{1'000'000'000, 2'000'000'000};  // 1 s, 2 s
+  const std::vector<Eigen::Isometry3d> odometry{pose(0, 0, 0), pose(10, 0, 0)};
+  const CorrectionTrack first(stamps, std::vector{pose(0, 0, 0), pose(10, 0.5, 0)}, odometry);
+  const CorrectionTrack second(stamps, std::vector{pose(0, 0, 0), pose(10, 0.6, 0)}, odometry);
+  const std::vector<MapSample> early{{Eigen::Vector3f(1, 2, 0), 5.0F, 0.5}, {Eigen::Vector3f(3, 2, 0), 6.0F, 1.0}};
+  const std::vector<MapSample> late{{Eigen::Vector3f(12, 2, 0), 5.0F, 2.0}, {Eigen::Vector3f(13, 2, 0), 5.0F, 2.0},
+                                    {Eigen::Vector3f(14, 1, 1), 5.0F, 3.5}};
+  std::vector<MapSample> out;
+  correct_samples(late, &first, Eigen::Isometry3d::Identity(), out);
+  ASSERT_EQ(out.size(), late.size());
+  for (std::size_t i = 0; i < late.size(); ++i) {
+    const Eigen::Vector3d want = first.at(static_cast<std::int64_t>(late[i].time_s * 1e9)) * late[i].position.cast<double>();
+    EXPECT_LT((out[i].position.cast<double>() - want).norm(), 1e-5);
+    EXPECT_EQ(out[i].intensity, late[i].intensity);
+    EXPECT_EQ(out[i].time_s, late[i].time_s);
+  }
+  EXPECT_NEAR((out[2].position - late[2].position).norm(), 0.5F, 1e-5F);  // held beyond the last keyframe
+  correct_samples(early, &first, pose(5, 0, 0), out);            // then placed
+  EXPECT_LT((out[0].position - Eigen::Vector3f(6, 2, 0)).norm(), 1e-5F);
+
+  // The start is not corrected; the end moves 0.5 m by the first correction and 0.1 m further by the second.
+  EXPECT_FALSE(correction_moves(early, nullptr, &first, 0.02));
+  EXPECT_TRUE(correction_moves(late, nullptr, &first, 0.02));
+  EXPECT_TRUE(correction_moves(late, &first, &second, 0.02));
+  EXPECT_FALSE(correction_moves(late, &first, &second, 0.2));
+  EXPECT_FALSE(correction_moves(late, &first, &first, 0.0));
+}
+
 }  // namespace
 }  // namespace adit::slam

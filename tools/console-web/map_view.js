@@ -3,9 +3,11 @@
 // one colour scale that follows the map's extent without recolouring); the
 // path is a line, the current pose a cone; the live 2D grid a textured plane
 // under the points (grid_layer.js); cameras: follow, top, free (orbit with a
-// finger or the mouse, pinch or wheel to zoom). All of them are in the
-// session's odometry frame, inside one group that the payload's frame
-// (frame_t: the prior map's once anchored) places in the map frame.
+// finger or the mouse, pinch or wheel to zoom). The path and the pose are in
+// the session's odometry frame, the tiles and the grid in the tiles' frame
+// (the odometry's, or the pose graph's when the loop closure moves the map),
+// each inside a group that the payload's frame (frame_t: the prior map's once
+// anchored) places in the map frame.
 import * as THREE from '/vendor/three/three.module.js';
 import { GridLayer } from './grid_layer.js';
 
@@ -38,6 +40,9 @@ export class MapView {
     this.world = new THREE.Group();  // map <- odometry (setFrame)
     this.world.matrixAutoUpdate = false;
     this.scene.add(this.world);
+    this.tilesWorld = new THREE.Group();  // map <- tiles (setFrame)
+    this.tilesWorld.matrixAutoUpdate = false;
+    this.scene.add(this.tilesWorld);
     this.camera = new THREE.PerspectiveCamera(60, 1, 0.1, 5000);
     this.camera.up.set(0, 0, 1);  // the map frame has z up
     this.material = new THREE.ShaderMaterial({
@@ -61,7 +66,7 @@ export class MapView {
     this.marker = new THREE.Mesh(cone, new THREE.MeshBasicMaterial({ color: 0xff2bd6 }));
     this.marker.visible = false;
     this.world.add(this.marker);
-    this.grid = new GridLayer(this.world);
+    this.grid = new GridLayer(this.tilesWorld);
     this.mode = 'follow';
     this.orbit = { target: new THREE.Vector3(), distance: 40, azimuth: -Math.PI / 2, elevation: 0.9 };
     this.poseDirty = false;
@@ -106,15 +111,20 @@ export class MapView {
     this.dirty = true;
   }
 
-  // Where the odometry frame lies in the map frame ({p: [x y z], q: [w x y z]}, or null: identity).
+  // Where the odometry frame and the tiles' frame lie in the map frame
+  // ({p, q: map <- odometry, tp, tq: map <- tiles; p [x y z], q [w x y z]}, or null: identity).
   setFrame(frame) {
-    if (frame) {
-      const q = new THREE.Quaternion(frame.q[1], frame.q[2], frame.q[3], frame.q[0]);  // three.js: x y z w
-      this.world.matrix.compose(new THREE.Vector3(frame.p[0], frame.p[1], frame.p[2]), q, new THREE.Vector3(1, 1, 1));
-    } else {
-      this.world.matrix.identity();
-    }
-    this.world.matrixWorldNeedsUpdate = true;
+    const place = (group, p, q) => {
+      if (p && q) {
+        const r = new THREE.Quaternion(q[1], q[2], q[3], q[0]);  // three.js: x y z w
+        group.matrix.compose(new THREE.Vector3(p[0], p[1], p[2]), r, new THREE.Vector3(1, 1, 1));
+      } else {
+        group.matrix.identity();
+      }
+      group.matrixWorldNeedsUpdate = true;
+    };
+    place(this.world, frame && frame.p, frame && frame.q);
+    place(this.tilesWorld, frame && (frame.tp || frame.p), frame && (frame.tq || frame.q));
     this.dirty = true;
   }
 
@@ -135,7 +145,7 @@ export class MapView {
 
   dropTile(t) {
     if (t.points) {
-      this.world.remove(t.points);
+      this.tilesWorld.remove(t.points);
       t.points.geometry.dispose();
     }
   }
@@ -171,7 +181,7 @@ export class MapView {
       t.points.geometry = geometry;
     } else {
       t.points = new THREE.Points(geometry, this.material);
-      this.world.add(t.points);
+      this.tilesWorld.add(t.points);
     }
     t.n = n / 3;
     this.dirty = true;

@@ -75,9 +75,13 @@ nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms) {
 
 nlohmann::json frame_json(const frame_t& f) {
   return {{"session", f.session_id},
-          {"source", f.source == frame_t::SOURCE_PRIOR_MAP ? "prior_map" : "odometry"},
+          {"source", f.source == frame_t::SOURCE_PRIOR_MAP ? "prior_map"
+                     : f.source == frame_t::SOURCE_LOOPS  ? "loops"
+                                                          : "odometry"},
           {"p", {f.position[0], f.position[1], f.position[2]}},
-          {"q", {f.orientation[0], f.orientation[1], f.orientation[2], f.orientation[3]}}};
+          {"q", {f.orientation[0], f.orientation[1], f.orientation[2], f.orientation[3]}},
+          {"tp", {f.tiles_position[0], f.tiles_position[1], f.tiles_position[2]}},
+          {"tq", {f.tiles_orientation[0], f.tiles_orientation[1], f.tiles_orientation[2], f.tiles_orientation[3]}}};
 }
 
 LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)

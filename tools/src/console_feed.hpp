@@ -34,8 +34,9 @@ namespace adit::tools::console {
 
 nlohmann::json status_json(const status_t& s);
 nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms);
-// frame_t for the page: map <- odometry as {"source", "p": [x y z], "q": [w x y z]};
-// the page draws the tiles, the path and the pose through it.
+// frame_t for the page: map <- odometry as {"source", "p": [x y z], "q": [w x y z]},
+// the page's path and pose through it; map <- tiles as "tp", "tq", the tiles
+// and the grid through it.
 nlohmann::json frame_json(const frame_t& f);
 
 // A tile's points for a browser: segments `from` .. n-1 at `version`, every

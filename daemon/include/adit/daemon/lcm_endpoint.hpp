@@ -51,8 +51,10 @@ struct ThreadLoad {
 // Where the running session's odometry frame lies in its map frame (frame_t).
 struct MapFrame {
   std::int8_t source = 0;  // frame_t.SOURCE_*
-  std::array<double, 3> position{};
+  std::array<double, 3> position{};               // map <- odometry (the poses)
   std::array<double, 4> orientation{1, 0, 0, 0};  // w, x, y, z
+  std::array<double, 3> tiles_position{};         // map <- tiles
+  std::array<double, 4> tiles_orientation{1, 0, 0, 0};
 };
 
 // What the daemon knows about its health; the endpoint adds state, session

@@ -4,7 +4,8 @@
 //
 // In:   keyframes (KeyframeQueue), each with the pose the map placed it at.
 // Out:  the graph's poses and the correction through time (correction()),
-//       counts in PipelineStats (loop_*), read after join().
+//       counts in PipelineStats (loop_*), read after join(); live, the
+//       correction after each optimisation that accepted a loop (live()).
 // Thread "loops", lowered to nice 10 on top of its thread settings: it takes
 // the CPU the other stages leave. It never blocks another stage: the mapping
 // thread only pushes into the queue; the odometry never sees it. At the end
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "adit/config/config.hpp"
+#include "adit/daemon/correction_board.hpp"
 #include "adit/daemon/keyframe_queue.hpp"
 #include "adit/daemon/pipeline_stats.hpp"
 #include "adit/daemon/stage_thread.hpp"
@@ -46,6 +48,8 @@ class LoopClosureStage {
   // Complete after finish().
   const slam::LoopCloser& closer() const { return closer_; }
   slam::CorrectionTrack correction() const { return closer_.correction_track(); }
+  // While it runs: the correction after the latest optimisation that accepted a loop.
+  const CorrectionBoard& live() const { return live_; }
   double refine_time_s() const { return refine_time_s_; }
 
  private:
@@ -56,6 +60,7 @@ class LoopClosureStage {
   StageThread thread_;
   KeyframeQueue keyframes_;
   slam::LoopCloser closer_;
+  CorrectionBoard live_;
   double refine_time_s_ = 0.0;
 };
 

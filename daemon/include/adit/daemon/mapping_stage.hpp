@@ -18,12 +18,14 @@
 
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <map>
 #include <optional>
 #include <vector>
 
 #include "adit/config/config.hpp"
+#include "adit/daemon/correction_board.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/journal_writer.hpp"
 #include "adit/daemon/keyframe_queue.hpp"
@@ -56,6 +58,14 @@ class MappingStage {
   void spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir);
   // Before start(): each keyframe also goes to `loops` (the loop-closure stage's queue).
   void feed_loops(KeyframeQueue* loops) { loops_ = loops; }
+  // Before start(): the tiles sent go placed by the loop closure's latest
+  // correction (map.loops_move_map; docs/LOOPS.md "Live tiles"): each sample
+  // moved by the correction at its scan's time, and a tile sent before a new
+  // correction sent again when any of its points moves by more than
+  // kTileMoveM (a few tiles each flush, at most kReplaceBudgetMs of it).
+  void follow_graph(const CorrectionBoard* graph) { graph_ = graph; }
+  static constexpr double kTileMoveM = 0.02;
+  static constexpr std::int64_t kReplaceBudgetMs = 20;
   // Before start(): each mapped scan's pose, the points each tile confirms and
   // each keyframe also go to the session journal.
   void journal_to(JournalWriter* journal) { journal_ = journal; }
@@ -86,7 +96,11 @@ class MappingStage {
   void compact_tiles(const std::vector<slam::TileCoord>& coords);
   void restore_tiles(const std::vector<slam::TileCoord>& coords);
   void evict_tiles(const std::vector<slam::TileCoord>& coords);
-  void flush_tiles();
+  void flush_tiles(bool final = false);
+  std::string whole_tile(const slam::TileCoord& coord, std::vector<slam::MapSample>& buffer,
+                         std::span<const slam::MapSample>& samples) const;
+  void send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples);
+  void replace_moved_tiles(bool all);
   void flush_grid();
   void journal_new_points();
   void tile_file_error(const std::string& problem);
@@ -108,6 +122,11 @@ class MappingStage {
   std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
   std::uint64_t keyframe_bytes_ = 0;
   KeyframeQueue* loops_ = nullptr;
+  const CorrectionBoard* graph_ = nullptr;
+  std::shared_ptr<const slam::CorrectionTrack> placement_;  // the tiles sent now are placed by it (null: identity)
+  // With graph_: each tile sent and the correction it was placed by.
+  std::map<slam::TileCoord, std::shared_ptr<const slam::CorrectionTrack>> sent_with_;
+  std::deque<slam::TileCoord> recheck_;  // tiles to check against placement_
   JournalWriter* journal_ = nullptr;
   std::map<slam::TileCoord, std::size_t> journaled_;  // per resident tile: points of tile() already journaled
   slam::KeyframeSelector keyframe_selector_;

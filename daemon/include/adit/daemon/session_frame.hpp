@@ -5,8 +5,9 @@
 // session's prior_frame.json the moment it is found; at the session's end, and
 // on its recovery after a crash, the map files and the trajectories are
 // written through it, and summary.json's "frame" says which frame they are in.
-// The tiles/ folder and the live tiles stay in the odometry frame (the live
-// frame_t places them).
+// The tiles/ folder stays in the odometry frame; the live tiles too, unless
+// map.loops_move_map moves them by the loop closure's graph (the live
+// frame_t places them either way; docs/LOOPS.md "Live tiles").
 
 #include <filesystem>
 #include <optional>

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "adit/slam/lie.hpp"
+#include "adit/slam/tiled_map.hpp"
 
 namespace adit::slam {
 
@@ -35,5 +36,17 @@ class CorrectionTrack {
   std::vector<Eigen::Isometry3d> corrections_;
   std::vector<Vector6d> steps_;  // log(C_k⁻¹·C_k+1)
 };
+
+// The map following the graph: `in` into `out`, each sample moved by
+// placed_by·C(t) at its scan's time t (C: `track`, identity when null). The
+// correction is computed once per run of samples of one scan.
+void correct_samples(std::span<const MapSample> in, const CorrectionTrack* track, const Eigen::Isometry3d& placed_by,
+                     std::vector<MapSample>& out);
+
+// Whether any of `samples` is placed more than `min_move_m` apart by the
+// correction `a` and by `b` (either null: identity): a live tile sent placed
+// by `a` that must be sent again placed by `b`. Stops at the first such sample.
+bool correction_moves(std::span<const MapSample> samples, const CorrectionTrack* a, const CorrectionTrack* b,
+                      double min_move_m);
 
 }  // namespace adit::slam

@@ -1,0 +1,144 @@
+// The mapping stage's live tiles placed by the loop closure's correction
+// (MappingStage::follow_graph, map.loops_move_map; docs/LOOPS.md "Live
+// tiles"): a tile sent before a correction is posted goes again, unchanged in
+// content, with every point moved by the correction at its scan's time; one
+// the correction moves by less than MappingStage::kTileMoveM is not sent again.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "adit/daemon/mapping_stage.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+
+Eigen::Isometry3d shifted(double x, double y) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(x, y, 0.0);
+  return t;
+}
+
+// A wall 5 m ahead of a still sensor, 0.1 m apart: the same voxels every scan.
+void fill_wall(MapSlot& slot, std::int64_t stamp_ns) {
+  slot.stamp_ns = stamp_ns;
+  slot.pose = Eigen::Isometry3d::Identity();
+  slot.valid = true;
+  slot.points.clear();
+  slot.times_s.clear();
+  slot.intensities.clear();
+  for (int i = -30; i <= 30; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      slot.points.emplace_back(5.0F, 0.1F * static_cast<float>(i), 0.1F * static_cast<float>(j) - 1.0F);
+      slot.times_s.push_back(0.0F);
+      slot.intensities.push_back(10.0F);
+    }
+}
+
+struct Sent {
+  std::mutex mutex;
+  std::map<slam::TileCoord, std::vector<std::vector<slam::MapSample>>> tiles;  // every send of each tile
+  std::size_t count() {
+    const std::lock_guard lock(mutex);
+    std::size_t n = 0;
+    for (const auto& [coord, sends] : tiles) n += sends.size();
+    return n;
+  }
+};
+
+struct StageRun {
+  Sent sent;
+  PipelineStats stats;
+};
+
+// Scans at 1 s and 2 s; once their tiles went out, `correction` is posted (if
+// any); a third scan at 3 s; then the stage ends (its last flush).
+void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correction) {
+  config::Config config;
+  config.map.refine = false;  // the poses as given
+  config.map.min_hits = 1;
+  config.map.publish_period_s = 0.05;
+  config.grid.enabled = false;
+  std::atomic<bool> stop{false};
+  constexpr std::size_t kMaxPoints = 2000;
+  Handoff<MapSlot> scans(4, Overflow::wait, [] {
+    MapSlot s;
+    s.points.reserve(kMaxPoints);
+    s.times_s.reserve(kMaxPoints);
+    s.intensities.reserve(kMaxPoints);
+    return s;
+  });
+  CorrectionBoard board;
+  MappingStage stage(
+      config, slam::OdometryConfig{}, scans, kMaxPoints,
+      [&run](const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
+        const std::lock_guard lock(run.sent.mutex);
+        run.sent.tiles[coord].emplace_back(samples.begin(), samples.end());
+      },
+      run.stats, stop);
+  stage.follow_graph(&board);
+  stage.start();
+  const auto push = [&](std::int64_t stamp_ns) {
+    MapSlot* slot = scans.acquire_or_wait([] { return true; });
+    ASSERT_NE(slot, nullptr);
+    fill_wall(*slot, stamp_ns);
+    scans.publish(slot);
+  };
+  push(1'000'000'000);
+  push(2'000'000'000);
+  for (int i = 0; i < 200 && run.sent.count() == 0; ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_GT(run.sent.count(), 0U) << "the first scan's tiles never went out";
+  if (correction) board.post(*correction);
+  push(3'000'000'000);
+  scans.close();
+  stage.join();
+}
+
+TEST(MappingFollowsGraph, TilesSentBeforeACorrectionGoAgainMovedByIt) {
+  // The graph moved the keyframes at 1 s and 3 s by 0.5 m and 0.7 m in y;
+  // the wall's points are all the first scan's (the later ones hit the same voxels).
+  const std::vector<std::int64_t> stamps{1'000'000'000, 3'000'000'000};
+  const std::vector<Eigen::Isometry3d> odometry{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  const slam::CorrectionTrack track(stamps, std::vector{shifted(0, 0.5), shifted(0, 0.7)}, odometry);
+  StageRun run;
+  run_stage(run, track);
+  ASSERT_FALSE(run.sent.tiles.empty());
+  std::size_t resent = 0;
+  for (const auto& [coord, sends] : run.sent.tiles) {
+    ASSERT_GE(sends.size(), 2U) << "tile " << coord.x << " " << coord.y << " " << coord.z << " not sent again";
+    const std::vector<slam::MapSample>& first = sends.front();
+    const std::vector<slam::MapSample>& last = sends.back();
+    ASSERT_EQ(last.size(), first.size());  // the same voxels: only moved
+    for (std::size_t i = 0; i < first.size(); ++i) {
+      const Eigen::Vector3d want =
+          track.at(static_cast<std::int64_t>(first[i].time_s * 1e9)) * first[i].position.cast<double>();
+      EXPECT_LT((last[i].position.cast<double>() - want).norm(), 1e-5);
+      EXPECT_NEAR(last[i].position.y() - first[i].position.y(), 0.5, 1e-5);  // every point is the first scan's
+    }
+    ++resent;
+  }
+  EXPECT_EQ(run.stats.tiles_moved_by_loops.load(), resent);
+  EXPECT_GE(run.stats.tiles_checked_for_loops.load(), resent);
+}
+
+TEST(MappingFollowsGraph, ACorrectionBelowTheThresholdSendsNothingAgain) {
+  const std::vector<std::int64_t> stamps{1'000'000'000};
+  const double small = 0.5 * MappingStage::kTileMoveM;
+  const slam::CorrectionTrack track(stamps, std::vector{shifted(small, 0)}, std::vector{Eigen::Isometry3d::Identity()});
+  StageRun run;
+  run_stage(run, track);
+  EXPECT_EQ(run.stats.tiles_moved_by_loops.load(), 0U);
+  EXPECT_GT(run.stats.tiles_checked_for_loops.load(), 0U);
+  for (const auto& [coord, sends] : run.sent.tiles) EXPECT_EQ(sends.size(), 1U);  // sent once, as measured
+  StageRun without;
+  run_stage(without, std::nullopt);
+  EXPECT_EQ(without.stats.tiles_checked_for_loops.load(), 0U);
+  EXPECT_EQ(without.sent.count(), run.sent.count());
+}
+
+}  // namespace
+}  // namespace adit::daemon
