@@ -399,6 +399,44 @@ TEST(LcmEndpoint, DownloadAssemblesTheWholeMapDespite20PercentDroppedChunks) {
   EXPECT_GT(sniffer.messages.load(), 10u);
 }
 
+// `adit download` places the map as the session's frame_t places its tiles:
+// in the prior map's frame once anchored, as the session's map files are.
+TEST(LcmEndpoint, DownloadPlacesTheMapWhereTheSessionsFramePutsItsTiles) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  std::vector<protocol::MapPoint> all;
+  for (auto& [key, points] : room()) {
+    all.insert(all.end(), points.begin(), points.end());
+    h.endpoint->publish_tile({1'763'700'000'000'000, key, std::move(points)});
+  }
+  // map <- tiles: a quarter turn about z, then 100 m east and 50 m north; the
+  // poses' transform differs (a loop correction on top), and is not the map's.
+  MapFrame f;
+  f.source = 1;
+  f.position = {101.0, 50.0, 0.0};
+  f.orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+  f.tiles_position = {100.0, 50.0, 0.0};
+  f.tiles_orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+  const auto file = std::filesystem::temp_directory_path() / fmt::format("adit-download-frame-{}.ply", ::getpid());
+  test::ProgramResult r;
+  feed_while(
+      h, [](int) { return std::array<double, 3>{0, 0, 0}; },
+      [&](int, std::int64_t) {
+        StatusSample s;
+        s.frame = f;
+        return s;
+      },
+      [&] { r = h.adit({"download", "--format", "ply", "--out", file.string(), "--quiet"}, 10); });
+  ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("in the prior map's frame"), std::string::npos) << r.out;
+  std::set<MmPoint> expected;
+  for (const protocol::MapPoint& p : all) expected.insert(mm(100.0 - p.y, 50.0 + p.x, p.z));
+  std::set<MmPoint> got;
+  for (const auto& p : test::read_ply(file)) got.insert(mm(p.x, p.y, p.z));
+  EXPECT_EQ(got, expected);
+  std::filesystem::remove(file);
+}
+
 TEST(LcmEndpoint, ChangedTilesGoOutAtMostOnceASecond) {
   Harness h;
   Sniffer sniffer(h.url);

@@ -42,6 +42,7 @@ std::optional<Message> decode(const lcm::ReceiveBuffer* rbuf) {
 }
 
 constexpr std::size_t kMaxRequestEntries = 3000;  // tile_request_t stays < 60 KB
+constexpr double kFrameWaitS = 0.6;              // a status period (0.5 s) and a little more
 
 // A subscription for as long as it lives (LCM 1.3 takes no std::function).
 class Listen {
@@ -134,14 +135,24 @@ std::optional<status_t> LcmClient::wait_status() {
   return status;
 }
 
-Eigen::Isometry3d map_from_odometry(const frame_t& frame) {
-  const Eigen::Quaterniond q(frame.orientation[0], frame.orientation[1], frame.orientation[2], frame.orientation[3]);
+namespace {
+
+Eigen::Isometry3d isometry_of(const double* position, const double* orientation) {
+  const Eigen::Quaterniond q(orientation[0], orientation[1], orientation[2], orientation[3]);
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d p(frame.position[0], frame.position[1], frame.position[2]);
+  const Eigen::Vector3d p(position[0], position[1], position[2]);
   if (!(std::abs(q.norm() - 1.0) <= 1e-3) || !p.allFinite()) return t;  // NaN fails the first test too
   t.linear() = q.normalized().toRotationMatrix();
   t.translation() = p;
   return t;
+}
+
+}  // namespace
+
+Eigen::Isometry3d map_from_odometry(const frame_t& frame) { return isometry_of(frame.position, frame.orientation); }
+
+Eigen::Isometry3d map_from_tiles(const frame_t& frame) {
+  return frame.schema >= 2 ? isometry_of(frame.tiles_position, frame.tiles_orientation) : map_from_odometry(frame);
 }
 
 void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
@@ -219,6 +230,11 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
       progress(tiles.segments_have(), tiles.segments_wanted());
     }
   });
+  std::optional<frame_t> any_frame;  // the newest, of whichever session, until `locked` is known
+  const Listen frames(impl_->lcm, impl_->channel(Channel::frame), [&](const lcm::ReceiveBuffer* rbuf) {
+    auto m = decode<frame_t>(rbuf);
+    if (m && m->payload_id == impl_->options.payload_id) any_frame = std::move(m);
+  });
   const auto index_complete = [&] { return n_parts > 0 && static_cast<std::int32_t>(parts.size()) >= n_parts; };
 
   auto last_send = Clock::now() - std::chrono::seconds(10);
@@ -237,6 +253,10 @@ LcmClient::DownloadResult LcmClient::download(const std::string& session, protoc
     }
     if (index_complete() && tiles.complete()) {
       result.ok = true;
+      // The frame comes with each status (2 Hz) for the daemon's current or last session only.
+      const auto done = Clock::now();
+      while ((!any_frame || any_frame->session_id != locked) && seconds_since(done) < kFrameWaitS) impl_->handle_for(0.05);
+      if (any_frame && any_frame->session_id == locked) result.frame = any_frame;
       break;
     }
     // Ask again once the stream has been quiet for a moment: what is still

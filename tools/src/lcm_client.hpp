@@ -36,6 +36,9 @@ struct ClientOptions {
 // frame_t (none received: its quaternion is zero), a non-unit quaternion or
 // a position that is not finite.
 Eigen::Isometry3d map_from_odometry(const frame_t& frame);
+// The same for the tiles, map <- tiles: schema 2's own transform (the tiles
+// follow the pose graph with map.loops_move_map), schema 1's map <- odometry.
+Eigen::Isometry3d map_from_tiles(const frame_t& frame);
 
 class LcmClient {
  public:
@@ -73,10 +76,12 @@ class LcmClient {
     bool ok = false;
     std::string error;
     std::size_t requests = 0;
+    std::optional<frame_t> frame;  // the session's, when the daemon sent one (its current or last session)
   };
   // Fetches the tile index and every tile of `session` ("" = the current one)
   // into `tiles`, re-requesting what is missing until complete or no progress
-  // for the timeout. `progress(have, wanted)` is called as chunks arrive.
+  // for the timeout, and the session's frame_t (waiting up to one status
+  // period for it). `progress(have, wanted)` is called as chunks arrive.
   DownloadResult download(const std::string& session, protocol::TileAssembler& tiles,
                           const std::function<void(std::size_t, std::size_t)>& progress);
 
