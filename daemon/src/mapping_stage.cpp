@@ -75,6 +75,7 @@ MappingStage::MappingStage(const config::Config& config, const slam::OdometryCon
   }
   for (std::vector<Eigen::Vector3f>* v : {&points_, &deskewed_, &keyframe_points_, &pending_.points}) v->reserve(max_points);
   for (std::vector<float>* v : {&times_, &intensities_, &pending_.times_s, &pending_.intensities}) v->reserve(max_points);
+  pending_.sweep.reserve(slam::Odometry::kSweepMotionCapacity);
 }
 
 void MappingStage::write_map_trajectory_to(const std::filesystem::path& file) {
@@ -150,7 +151,14 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
     intensities_.push_back(i < slot.intensities.size() ? slot.intensities[i] : 0.0F);
   }
   deskewed_.resize(points_.size());
-  deskewer_.deskew(points_, times_, velocity, deskewed_);
+  // An inertial scan as the odometry deskewed it (the IMU's motion through the
+  // sweep); otherwise with the motion between its pose and the next: in a
+  // fast, changing turn the constant velocity left a drone's keyframes turned
+  // by 1.5° (docs/decisions/055).
+  if (!slot.sweep.empty())
+    deskewer_.deskew(points_, times_, slot.sweep, deskewed_);
+  else
+    deskewer_.deskew(points_, times_, velocity, deskewed_);
   // The map's pose of the scan: the odometry's, refined against the map of
   // the scans before it (slam::MapRefiner says why).
   const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;

@@ -27,6 +27,7 @@ OdometryStage::OdometryStage(const config::Config& config, const slam::OdometryC
       slot.points.reserve(max_points);
       slot.times_s.reserve(max_points);
       slot.intensities.reserve(max_points);
+      slot.sweep.reserve(slam::Odometry::kSweepMotionCapacity);
       return slot;
     });
   }
@@ -115,6 +116,10 @@ void OdometryStage::hand_to_mapping(const drivers::LidarScan& scan, const slam::
   m->times_s.assign(odometry_.body_times().begin(), odometry_.body_times().end());
   m->intensities.clear();
   for (const drivers::LidarPoint& p : scan.points) m->intensities.push_back(p.intensity);
+  if (result.inertial)
+    m->sweep.assign(odometry_.odometry().sweep_motion().begin(), odometry_.odometry().sweep_motion().end());
+  else
+    m->sweep.clear();
   map_slots_->publish(m);
 }
 

@@ -49,7 +49,7 @@ Odometry::Odometry(const OdometryConfig& config, std::function<bool()> keeping_u
       inertial_registration_(config.registration) {
   inertial_registration_.point_sigma_m = config.inertial_point_sigma_m;
   // An IMU at 400 Hz over a 0.2 s sweep, with room.
-  sweep_motion_.reserve(256);
+  sweep_motion_.reserve(kSweepMotionCapacity);
   for (auto* buffer : {&deskewed_, &frame_, &source_, &registered_}) buffer->reserve(config.max_scan_points);
   for (auto* buffer : {&frame_times_, &source_times_}) buffer->reserve(config.max_scan_points);
   source_deskewed_.resize(config.max_scan_points);

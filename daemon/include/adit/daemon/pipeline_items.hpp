@@ -49,6 +49,10 @@ struct MapSlot {
   std::vector<Eigen::Vector3f> points;
   std::vector<float> times_s;
   std::vector<float> intensities;
+  // An inertial scan's motion over its sweep as the odometry deskewed it (the
+  // IMU's, after the scan's update; slam::Odometry::sweep_motion); empty:
+  // the mapping deskews with the constant velocity between its pose and the next.
+  std::vector<slam::TimedPose> sweep;
 };
 
 // Where results leave the pipeline. Each runs on one pipeline thread and must

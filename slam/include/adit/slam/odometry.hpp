@@ -259,6 +259,10 @@ class Odometry {
   // The last scan, deskewed, downsampled at the map resolution, in the
   // odometry frame: what mapping accumulates. Valid until the next process().
   std::span<const Eigen::Vector3f> last_registered_points() const { return registered_; }
+  // An inertial scan's motion over its sweep, from its start, as the IMU had
+  // it after the scan's update: what its map points were deskewed with.
+  std::span<const TimedPose> sweep_motion() const { return sweep_motion_; }
+  static constexpr std::size_t kSweepMotionCapacity = 256;  // instants reserved (the IMU's over a sweep)
   const OdometryConfig& config() const { return config_; }
 
  private:
