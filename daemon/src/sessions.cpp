@@ -633,6 +633,9 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
   if (!plain) return fmt::format("'{}' is not a session name", id);
   const std::filesystem::path tiles = folder(id) / "tiles";
   std::error_code ec;
+  // A finished session that mapped nothing (stopped, or killed, before its
+  // first map point) has no tiles: its map is empty, not missing.
+  if (!std::filesystem::is_directory(tiles, ec) && std::filesystem::exists(folder(id) / "summary.json", ec)) return "";
   if (!std::filesystem::is_directory(tiles, ec)) return fmt::format("no stored tiles for session '{}'", id);
   std::size_t bad = 0;
   std::string first_problem;

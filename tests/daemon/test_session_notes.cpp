@@ -10,6 +10,9 @@
 
 #include "adit/daemon/products_worker.hpp"
 #include "adit/daemon/sessions.hpp"
+#include "adit/daemon/tile_store.hpp"
+#include "adit/drivers/lidar/velodyne.hpp"
+#include "adit/drivers/lidar/velodyne_encoder.hpp"
 #include "plan_scene.hpp"
 #include "plan_session.hpp"
 #include "temp_file.hpp"
@@ -35,6 +38,28 @@ TEST(SessionNotes, RecoveredAndJoinedSessionsAreSaidSo) {
   EXPECT_EQ(session_notes(damaged), "");
   EXPECT_EQ(session_notes(root / "missing"), "");
   std::filesystem::remove_all(root);
+}
+
+// A stored session's tiles for a download: a session that mapped nothing
+// (killed before its first map point) is an empty map; an unknown one is named.
+TEST(StoredSessionTiles, ASessionThatMappedNothingIsAnEmptyMapAnUnknownOneIsNamed) {
+  const test::TempFolder root;
+  config::Config config;
+  config.payload.state_dir = root.path().string();
+  config.session.products = false;
+  const test::TempFile calibration(
+      drivers::format_velodyne_calibration(drivers::velodyne_nominal_calibration(drivers::VelodyneModel::vlp16)),
+      ".yaml");
+  config.lidar.model = "VLP-16";
+  config.lidar.calibration = calibration.path().string();
+  const auto empty = root.path() / "sessions" / "20261129T120000Z";
+  std::filesystem::create_directories(empty);
+  std::ofstream(empty / "summary.json") << R"({"map": {"points": 0}, "recovered": {"problem": ""}})";
+  const Sessions sessions(config, {});
+  TileStore tiles({});
+  EXPECT_EQ(sessions.load_tiles("20261129T120000Z", tiles), "");
+  EXPECT_EQ(tiles.tiles().size(), 0U);
+  EXPECT_EQ(sessions.load_tiles("20261129T130000Z", tiles), "no stored tiles for session '20261129T130000Z'");
 }
 
 // aditd's worker with session.join_previous (and no products): the session

@@ -191,7 +191,7 @@ TEST(ConsoleGrid, ThePayloadsGridIsServedAtApiGridCellForCellAndEachChangeIsAnno
   {
     const auto none = h.http().Get("/api/grid");
     ASSERT_TRUE(none);
-    EXPECT_EQ(none->status, 404) << "no patch yet: no grid";
+    EXPECT_EQ(none->status, 204) << "no patch yet: no grid";
   }
   for (int x = -1; x <= 1; ++x)
     for (int y = 0; y <= 1; ++y) h.publish(x, y, 1, patch_cells(x, y));
@@ -257,7 +257,7 @@ TEST(ConsoleGrid, ANewSessionStartsAnEmptyGrid) {
   EXPECT_TRUE(h.state()["grid"].is_null()) << "s1's grid is not shown for s2";
   const auto none = h.http().Get("/api/grid");
   ASSERT_TRUE(none);
-  EXPECT_EQ(none->status, 404);
+  EXPECT_EQ(none->status, 204);
 
   h.publish(2, -1, 4, patch_cells(2, -1));
   const auto r = h.grid_when(1, 4);

@@ -38,10 +38,10 @@ const gridShader = {
 };
 
 // GET /api/grid's answer as { session, v, patches, resolution, originX, originY, width, height, bitmap, bytes };
-// null when the console holds no grid.
+// null when the console holds no grid (204).
 export async function fetchGrid() {
   const r = await fetch('/api/grid');
-  if (r.status === 404) return null;
+  if (r.status === 204) return null;
   if (!r.ok) throw new Error(`grid: ${r.status}`);
   const h = (name) => r.headers.get(name);
   const blob = await r.blob();

@@ -237,8 +237,9 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
       reply_error(res, 500, e.what());
       return;
     }
-    if (!grid) {
-      reply_error(res, 404, "no grid held: the payload has sent no grid patch for this session");
+    if (!grid) {  // an answer, not an error: a browser logs every 404 as one
+      res.status = 204;
+      res.set_header("X-Grid-Problem", "no grid held: the payload has sent no grid patch for this session");
       return;
     }
     res.set_header("X-Grid-Session", grid->session);
