@@ -635,8 +635,9 @@ std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
   std::error_code ec;
   // A finished session that mapped nothing (stopped, or killed, before its
   // first map point) has no tiles: its map is empty, not missing.
-  if (!std::filesystem::is_directory(tiles, ec) && std::filesystem::exists(folder(id) / "summary.json", ec)) return "";
-  if (!std::filesystem::is_directory(tiles, ec)) return fmt::format("no stored tiles for session '{}'", id);
+  if (!std::filesystem::is_directory(tiles, ec))
+    return std::filesystem::exists(folder(id) / "summary.json", ec) ? ""
+                                                                    : fmt::format("no stored tiles for session '{}'", id);
   std::size_t bad = 0;
   std::string first_problem;
   for (const auto& entry : std::filesystem::directory_iterator(tiles, ec)) {
