@@ -1,20 +1,28 @@
 // The Java bindings and tablet client (protocol/java, build/java/adit-lcm.jar)
 // against a running aditd with a command key, over real LCM multicast on
 // loopback: status, watch, an unsigned START refused, signed START and STOP
-// executed. Skips with a message when the jar was not built (no javac or
-// liblcm-java).
+// executed; and the watch placing the last pose in the map frame by the
+// session's frame_t. Skips with a message when the jar was not built (no
+// javac or liblcm-java).
 
 #include <gtest/gtest.h>
 
+#include <lcm/lcm-cpp.hpp>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "adit/frame_t.hpp"
+#include "adit/pose_t.hpp"
+#include "adit/protocol/channels.hpp"
+#include "adit/status_t.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
@@ -37,9 +45,11 @@ struct Java {
   }
 };
 
+bool java_built() { return !std::string(ADIT_JAVA_JAR).empty() && std::filesystem::exists(ADIT_JAVA_JAR); }
+constexpr const char* kNoJava = "the Java bindings were not built (needs javac 17 and liblcm-java: scripts/install-deps.sh)";
+
 TEST(JavaClient, StatusWatchAndSignedStartStopAgainstAditd) {
-  if (std::string(ADIT_JAVA_JAR).empty() || !std::filesystem::exists(ADIT_JAVA_JAR))
-    GTEST_SKIP() << "the Java bindings were not built (needs javac 17 and liblcm-java: scripts/install-deps.sh)";
+  if (!java_built()) GTEST_SKIP() << kNoJava;
   const std::filesystem::path work = binary_dir() / fmt::format("java-client-{}", ::getpid());
   std::filesystem::remove_all(work);
   std::filesystem::create_directories(work);
@@ -98,6 +108,63 @@ TEST(JavaClient, StatusWatchAndSignedStartStopAgainstAditd) {
   std::ifstream log(work / "aditd.log");
   const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("commands: signed commands only, 1 key(s)"), std::string::npos) << text;
+}
+
+// A payload anchored to a prior map a quarter turn and 100 m away, played by
+// the test itself over LCM: the watch prints the last pose in the odometry
+// frame and, through frame_t, in the map frame (R·p + t), as the console and
+// `adit download` place them.
+TEST(JavaClient, WatchPlacesTheLastPoseInTheSessionsMapFrame) {
+  if (!java_built()) GTEST_SKIP() << kNoJava;
+  const Java java{fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 13) % 30000),
+                  fmt::format("javaframe{}", ::getpid())};
+  lcm::LCM lcm(java.url);
+  ASSERT_TRUE(lcm.good());
+  std::atomic<bool> running{true};
+  std::thread payload([&] {
+    status_t s{};
+    s.schema = 1;
+    s.payload_id = java.payload;
+    s.session_id = "20261129T000000Z";
+    s.state = 1;  // MAPPING
+    pose_t p{};
+    p.schema = 1;
+    p.session_id = s.session_id;
+    p.position[0] = 1.0;
+    p.position[1] = 2.0;
+    p.position[2] = 3.0;
+    p.orientation[0] = 1.0;
+    p.flags = pose_t::FLAG_VALID;
+    frame_t f{};
+    f.schema = 2;
+    f.payload_id = java.payload;
+    f.session_id = s.session_id;
+    f.source = frame_t::SOURCE_PRIOR_MAP;
+    f.position[0] = 100.0;
+    f.orientation[0] = std::sqrt(0.5);  // a quarter turn about z
+    f.orientation[3] = std::sqrt(0.5);
+    f.tiles_position[0] = 100.0;
+    f.tiles_orientation[0] = std::sqrt(0.5);
+    f.tiles_orientation[3] = std::sqrt(0.5);
+    while (running) {
+      lcm.publish(protocol::channel_name(java.payload, protocol::Channel::status), &s);
+      lcm.publish(protocol::channel_name(java.payload, protocol::Channel::frame), &f);
+      for (int i = 0; i < 5 && running; ++i) {
+        ++p.seq;
+        lcm.publish(protocol::channel_name(java.payload, protocol::Channel::pose), &p);
+        std::this_thread::sleep_for(20ms);
+      }
+    }
+  });
+  const ProgramResult r = java.run({"watch", "--duration", "1.5"});
+  running = false;
+  payload.join();
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("frame PRIOR_MAP session 20261129T000000Z"), std::string::npos) << r.out;
+  // R_z(90°)·(1, 2, 3) + (100, 0, 0) = (98, 1, 3).
+  EXPECT_NE(r.out.find("last pose: odometry (1.000, 2.000, 3.000) m, map (98.000, 1.000, 3.000) m (PRIOR_MAP)"),
+            std::string::npos)
+      << r.out;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // A small client of an adit payload over LCM, for tablet apps: the status,
-// the live pose and status stream, and commands (signed when a key is given),
+// the live pose, status and frame stream, and commands (signed when a key is given),
 // resent with the same bytes every 250 ms until acknowledged, as `adit` does
 // (docs/PROTOCOL.md).
 package adit.tablet;
@@ -51,6 +51,15 @@ public final class AditClient implements AutoCloseable {
     /** Calls the handlers (on LCM's thread) for every pose and status for `seconds`. */
     public void watch(Consumer<adit.pose_t> onPose, Consumer<adit.status_t> onStatus, double seconds)
         throws InterruptedException {
+        watch(onPose, onStatus, f -> { }, seconds);
+    }
+
+    /**
+     * As above, and every frame_t of this payload (2 Hz while a session runs): poses are in the odometry frame,
+     * MapFrame.of(frame) places them in the map frame (a prior map's once anchored).
+     */
+    public void watch(Consumer<adit.pose_t> onPose, Consumer<adit.status_t> onStatus, Consumer<adit.frame_t> onFrame,
+        double seconds) throws InterruptedException {
         LCMSubscriber poses = (lcm, channel, ins) -> {
             try {
                 onPose.accept(new adit.pose_t(ins));
@@ -65,13 +74,22 @@ public final class AditClient implements AutoCloseable {
                 // ignored
             }
         };
+        LCMSubscriber frames = (lcm, channel, ins) -> {
+            try {
+                onFrame.accept(new adit.frame_t(ins));
+            } catch (IOException e) {
+                // ignored
+            }
+        };
         lcm.subscribe(channel("POSE"), poses);
         lcm.subscribe(channel("STATUS"), statuses);
+        lcm.subscribe(channel("FRAME"), frames);
         try {
             Thread.sleep((long) (seconds * 1000));
         } finally {
             lcm.unsubscribe(channel("POSE"), poses);
             lcm.unsubscribe(channel("STATUS"), statuses);
+            lcm.unsubscribe(channel("FRAME"), frames);
         }
     }
 

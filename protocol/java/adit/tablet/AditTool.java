@@ -65,15 +65,37 @@ public final class AditTool {
                     return 0;
                 }
                 case "watch": {
-                    long[] counts = new long[2];
+                    // Poses arrive in the odometry frame; the session's frame_t places the last one in the map
+                    // frame (a prior map's once anchored, the loop closure's correction otherwise).
+                    long[] counts = new long[3];
+                    adit.pose_t[] last = new adit.pose_t[1];
+                    MapFrame[] frame = {MapFrame.IDENTITY};
                     client.watch(p -> {
-                        synchronized (counts) { ++counts[0]; }
+                        synchronized (counts) {
+                            ++counts[0];
+                            last[0] = p;
+                        }
                     }, s -> {
                         synchronized (counts) { ++counts[1]; }
                         System.out.printf("status %s %s%n", state(s.state), s.session_id.isEmpty() ? "-" : s.session_id);
+                    }, f -> {
+                        synchronized (counts) {
+                            ++counts[2];
+                            MapFrame m = MapFrame.of(f);
+                            if (m.source != frame[0].source)
+                                System.out.printf("frame %s session %s%n", m.sourceName(), m.sessionId);
+                            frame[0] = m;
+                        }
                     }, duration);
                     synchronized (counts) {
-                        System.out.printf("%d poses, %d status messages received%n", counts[0], counts[1]);
+                        System.out.printf("%d poses, %d status messages, %d frames received%n", counts[0], counts[1],
+                            counts[2]);
+                        if (last[0] != null) {
+                            double[] o = last[0].position;
+                            double[] m = frame[0].positionInMap(o);
+                            System.out.printf("last pose: odometry (%.3f, %.3f, %.3f) m, map (%.3f, %.3f, %.3f) m (%s)%n",
+                                o[0], o[1], o[2], m[0], m[1], m[2], frame[0].sourceName());
+                        }
                         return counts[1] > 0 ? 0 : noAnswer(payload, duration);
                     }
                 }
