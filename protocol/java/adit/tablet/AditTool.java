@@ -91,10 +91,12 @@ public final class AditTool {
                         System.out.printf("%d poses, %d status messages, %d frames received%n", counts[0], counts[1],
                             counts[2]);
                         if (last[0] != null) {
+                            // Another session's frame does not place this pose.
+                            MapFrame f = frame[0].sessionId.equals(last[0].session_id) ? frame[0] : MapFrame.IDENTITY;
                             double[] o = last[0].position;
-                            double[] m = frame[0].positionInMap(o);
+                            double[] m = f.positionInMap(o);
                             System.out.printf("last pose: odometry (%.3f, %.3f, %.3f) m, map (%.3f, %.3f, %.3f) m (%s)%n",
-                                o[0], o[1], o[2], m[0], m[1], m[2], frame[0].sourceName());
+                                o[0], o[1], o[2], m[0], m[1], m[2], f.sourceName());
                         }
                         return counts[1] > 0 ? 0 : noAnswer(payload, duration);
                     }
