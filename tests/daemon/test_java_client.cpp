@@ -111,15 +111,13 @@ TEST(JavaClient, StatusWatchAndSignedStartStopAgainstAditd) {
 }
 
 // A payload anchored to a prior map a quarter turn and 100 m away, played by
-// the test itself over LCM: the watch prints the last pose in the odometry
-// frame and, through frame_t, in the map frame (R·p + t), as the console and
-// `adit download` place them.
-TEST(JavaClient, WatchPlacesTheLastPoseInTheSessionsMapFrame) {
-  if (!java_built()) GTEST_SKIP() << kNoJava;
+// the test itself over LCM (poses of session "20261129T000000Z", the frame of
+// `frame_session`) while `AditTool watch` runs: its output.
+ProgramResult watch_an_anchored_payload(const std::string& frame_session) {
   const Java java{fmt::format("udpm://239.255.76.67:{}?ttl=0", 20000 + (::getpid() + 13) % 30000),
                   fmt::format("javaframe{}", ::getpid())};
   lcm::LCM lcm(java.url);
-  ASSERT_TRUE(lcm.good());
+  if (!lcm.good()) return {.exit_status = -1, .out = "", .err = "LCM did not start"};
   std::atomic<bool> running{true};
   std::thread payload([&] {
     status_t s{};
@@ -138,7 +136,7 @@ TEST(JavaClient, WatchPlacesTheLastPoseInTheSessionsMapFrame) {
     frame_t f{};
     f.schema = 2;
     f.payload_id = java.payload;
-    f.session_id = s.session_id;
+    f.session_id = frame_session;
     f.source = frame_t::SOURCE_PRIOR_MAP;
     f.position[0] = 100.0;
     f.orientation[0] = std::sqrt(0.5);  // a quarter turn about z
@@ -156,13 +154,33 @@ TEST(JavaClient, WatchPlacesTheLastPoseInTheSessionsMapFrame) {
       }
     }
   });
-  const ProgramResult r = java.run({"watch", "--duration", "1.5"});
+  ProgramResult r = java.run({"watch", "--duration", "1.5"});
   running = false;
   payload.join();
+  return r;
+}
+
+// The watch prints the last pose in the odometry frame and, through the
+// session's frame_t, in the map frame (R·p + t), as the console and `adit
+// download` place them.
+TEST(JavaClient, WatchPlacesTheLastPoseInTheSessionsMapFrame) {
+  if (!java_built()) GTEST_SKIP() << kNoJava;
+  const ProgramResult r = watch_an_anchored_payload("20261129T000000Z");
   EXPECT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("frame PRIOR_MAP session 20261129T000000Z"), std::string::npos) << r.out;
   // R_z(90°)·(1, 2, 3) + (100, 0, 0) = (98, 1, 3).
   EXPECT_NE(r.out.find("last pose: odometry (1.000, 2.000, 3.000) m, map (98.000, 1.000, 3.000) m (PRIOR_MAP)"),
+            std::string::npos)
+      << r.out;
+}
+
+// A frame of another session (an earlier one's, still on the channel) does
+// not place this session's pose.
+TEST(JavaClient, AnotherSessionsFrameDoesNotPlaceThePose) {
+  if (!java_built()) GTEST_SKIP() << kNoJava;
+  const ProgramResult r = watch_an_anchored_payload("20261128T000000Z");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("last pose: odometry (1.000, 2.000, 3.000) m, map (1.000, 2.000, 3.000) m (ODOMETRY)"),
             std::string::npos)
       << r.out;
 }
