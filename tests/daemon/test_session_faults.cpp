@@ -114,19 +114,22 @@ TEST(SessionFaults, TheRecordingGoesOnInPartsThatReadBackAsOneCapture) {
 TEST(SessionFaults, LowDiskStopsTheRecordingAndTheStatusSaysSo) {
   const std::filesystem::path work = test::binary_dir() / fmt::format("faults-low-{}", ::getpid());
   std::filesystem::remove_all(work);
-  // A reserve no disk has: the first status finds the disk "low".
-  Sessions sessions(session_config(work, "session:\n  record_min_free_mb: 1e8\n"), {});
-  const std::string id = sessions.start();
-  std::string fault;
-  const auto deadline = std::chrono::steady_clock::now() + 120s;
-  while (!sessions.poll() && std::chrono::steady_clock::now() < deadline) {
-    const StatusSample status = sessions.status_sample();
-    if (status.fault.find("raw recording stopped") != std::string::npos) fault = status.fault;
-    std::this_thread::sleep_for(20ms);
-  }
-  sessions.stop_and_wait();
-  EXPECT_NE(fault.find("free disk space fell below session.record_min_free_mb"), std::string::npos) << fault;
-  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(sessions.folder(id) / "summary.json"));
+  nlohmann::json summary;
+  {
+    // A reserve no disk has: the first status finds the disk "low".
+    Sessions sessions(session_config(work, "session:\n  record_min_free_mb: 1e8\n"), {});
+    const std::string id = sessions.start();
+    std::string fault;
+    const auto deadline = std::chrono::steady_clock::now() + 120s;
+    while (!sessions.poll() && std::chrono::steady_clock::now() < deadline) {
+      const StatusSample status = sessions.status_sample();
+      if (status.fault.find("raw recording stopped") != std::string::npos) fault = status.fault;
+      std::this_thread::sleep_for(20ms);
+    }
+    sessions.stop_and_wait();
+    EXPECT_NE(fault.find("free disk space fell below session.record_min_free_mb"), std::string::npos) << fault;
+    summary = nlohmann::json::parse(std::ifstream(sessions.folder(id) / "summary.json"));
+  }  // Sessions' products thread ends here: it writes into the session folder until then
   EXPECT_EQ(summary["lidar"]["recording_stopped"], "free disk space fell below session.record_min_free_mb");
   EXPECT_LT(summary["lidar"]["recorded_datagrams"].get<std::size_t>(), summary["lidar"]["datagrams"].get<std::size_t>());
   EXPECT_GT(summary["poses"]["total"].get<std::size_t>(), 100U);  // mapped to the end: 12 s at 10 Hz
