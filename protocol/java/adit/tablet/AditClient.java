@@ -33,13 +33,7 @@ public final class AditClient implements AutoCloseable {
     /** The next status_t, or null when none arrives within the timeout. */
     public adit.status_t status(double timeoutSeconds) throws InterruptedException {
         BlockingQueue<adit.status_t> got = new ArrayBlockingQueue<>(1);
-        LCMSubscriber sub = (lcm, channel, ins) -> {
-            try {
-                got.offer(new adit.status_t(ins));
-            } catch (IOException e) {
-                // not a status_t: ignored, as the C++ client does
-            }
-        };
+        LCMSubscriber sub = subscriber(adit.status_t::new, got::offer);
         lcm.subscribe(channel("STATUS"), sub);
         try {
             return got.poll((long) (timeoutSeconds * 1000), TimeUnit.MILLISECONDS);
@@ -60,27 +54,9 @@ public final class AditClient implements AutoCloseable {
      */
     public void watch(Consumer<adit.pose_t> onPose, Consumer<adit.status_t> onStatus, Consumer<adit.frame_t> onFrame,
         double seconds) throws InterruptedException {
-        LCMSubscriber poses = (lcm, channel, ins) -> {
-            try {
-                onPose.accept(new adit.pose_t(ins));
-            } catch (IOException e) {
-                // ignored
-            }
-        };
-        LCMSubscriber statuses = (lcm, channel, ins) -> {
-            try {
-                onStatus.accept(new adit.status_t(ins));
-            } catch (IOException e) {
-                // ignored
-            }
-        };
-        LCMSubscriber frames = (lcm, channel, ins) -> {
-            try {
-                onFrame.accept(new adit.frame_t(ins));
-            } catch (IOException e) {
-                // ignored
-            }
-        };
+        LCMSubscriber poses = subscriber(adit.pose_t::new, onPose);
+        LCMSubscriber statuses = subscriber(adit.status_t::new, onStatus);
+        LCMSubscriber frames = subscriber(adit.frame_t::new, onFrame);
         lcm.subscribe(channel("POSE"), poses);
         lcm.subscribe(channel("STATUS"), statuses);
         lcm.subscribe(channel("FRAME"), frames);
@@ -110,14 +86,9 @@ public final class AditClient implements AutoCloseable {
         if (key != null) CommandAuth.sign(c, key);
         final long id = c.request_id;
         BlockingQueue<adit.command_ack_t> acks = new ArrayBlockingQueue<>(1);
-        LCMSubscriber sub = (lcm, channel, ins) -> {
-            try {
-                adit.command_ack_t ack = new adit.command_ack_t(ins);
-                if (ack.request_id == id) acks.offer(ack);
-            } catch (IOException e) {
-                // ignored
-            }
-        };
+        LCMSubscriber sub = subscriber(adit.command_ack_t::new, ack -> {
+            if (ack.request_id == id) acks.offer(ack);
+        });
         lcm.subscribe(channel("ACK"), sub);
         try {
             long deadline = System.nanoTime() + (long) (timeoutSeconds * 1e9);
@@ -134,4 +105,20 @@ public final class AditClient implements AutoCloseable {
 
     @Override
     public void close() { lcm.close(); }
+
+    private interface Decoder<T> {
+        T decode(LCMDataInputStream ins) throws IOException;
+    }
+
+    // Decodes each message on the channel and hands it on; one that is not of
+    // the type is ignored, as the C++ client does.
+    private static <T> LCMSubscriber subscriber(Decoder<T> decoder, Consumer<T> handler) {
+        return (lcm, channel, ins) -> {
+            try {
+                handler.accept(decoder.decode(ins));
+            } catch (IOException e) {
+                // not a T: ignored
+            }
+        };
+    }
 }
