@@ -45,9 +45,18 @@ std::string TileSpill::write(const slam::TileCoord& coord, std::span<const slam:
   }
   std::filesystem::rename(part, file, ec);
   if (ec) return fmt::format("{}: cannot rename the tile into place: {}", file.string(), ec.message());
-  double newest = 0.0;
-  for (const slam::MapSample& s : points) newest = std::max(newest, s.time_s);
-  newest_time_s_[coord] = newest;
+  std::vector<double>& times = segment_times_s_[coord];
+  times.clear();
+  std::vector<double> segment;
+  for (std::size_t begin = 0; begin < points.size(); begin += params_.segment_points) {
+    const std::size_t end = std::min<std::size_t>(points.size(), begin + params_.segment_points);
+    segment.clear();
+    for (std::size_t i = begin; i < end; ++i) segment.push_back(points[i].time_s);
+    const auto middle = segment.begin() + static_cast<std::ptrdiff_t>(segment.size() / 2);
+    std::nth_element(segment.begin(), middle, segment.end());
+    times.push_back(*middle);
+  }
+  times.shrink_to_fit();
   return "";
 }
 
@@ -78,8 +87,8 @@ std::string TileSpill::read_into(const slam::TileCoord& coord, std::vector<slam:
   std::vector<std::uint8_t>().swap(blob);  // the segments hold copies of its frames
   std::size_t n = 0;
   for (const protocol::TileSegment& segment : segments) n += segment.n_points;
-  const auto time = newest_time_s_.find(coord);
-  const double time_s = time == newest_time_s_.end() ? 0.0 : time->second;
+  const auto found = segment_times_s_.find(coord);
+  const std::span<const double> times = found == segment_times_s_.end() ? std::span<const double>() : found->second;
   out.reserve(n + extra);
   std::vector<protocol::MapPoint> points;
   points.reserve(protocol::kMaxSegmentPoints);
@@ -92,6 +101,7 @@ std::string TileSpill::read_into(const slam::TileCoord& coord, std::vector<slam:
       return fmt::format("{}: tile's segment {}: {}", file.string(), s, problem);
     }
     std::vector<std::uint8_t>().swap(segments[s].frame);
+    const double time_s = s < times.size() ? times[s] : 0.0;
     for (const protocol::MapPoint& p : points)
       out.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
                      p.intensity, time_s});

@@ -2,9 +2,15 @@
 // The session folder's tiles/<id>.adt files (protocol/tile_codec.hpp) as the
 // mapping thread's store for tiles it evicted from RAM (slam::TiledVoxelMap::evict),
 // and as the finished session's tiles. The codec keeps positions (1 mm) and
-// intensities, not each point's time: a tile read back gives its points the
-// time of the newest point it held when written (kept here, a few bytes per tile).
+// intensities, not each point's time, and sorts each segment's points (a
+// segment: the next segment_points of the tile in append order). So the time
+// kept here is one per segment, its points' median (8 bytes per 4096 points):
+// a tile read back gives each point the time of the scans around the one
+// that mapped it, which the loop closure's correction through time needs to
+// move it (slam/correction_track.hpp), rather than one time for the whole
+// tile. A tile this object did not write (another run's) reads back with time 0.
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <span>
@@ -48,7 +54,7 @@ class TileSpill {
 
   std::filesystem::path dir_;
   protocol::TileParams params_;
-  std::map<slam::TileCoord, double> newest_time_s_;
+  std::map<slam::TileCoord, std::vector<double>> segment_times_s_;  // each segment's median time
 };
 
 }  // namespace adit::daemon
