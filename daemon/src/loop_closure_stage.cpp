@@ -81,6 +81,9 @@ void LoopClosureStage::loop() {
   const std::int64_t t0 = monotonic_ns();
   closer_.refine();
   refine_time_s_ = 1e-9 * static_cast<double>(monotonic_ns() - t0);
+  // The correction the map files follow, for the live tiles' last placement
+  // (MappingStage::follow_final_correction) and the status's frame.
+  if (closer_.stats().accepted > 0) live_.post(closer_.correction_track());
   update_stats();
 }
 

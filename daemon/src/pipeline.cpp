@@ -210,6 +210,7 @@ void Pipeline::join() {
   // Clean when the mapping ended by draining (a stop, the end of a replay), not by an abort.
   if (i.journal) i.journal->close(!i.stop.load(std::memory_order_acquire));
   if (i.loops) i.loops->finish();  // drains the keyframes the mapping left, then a last optimisation
+  if (i.mapping) i.mapping->follow_final_correction();  // the live tiles where the map files will be
   if (i.can) i.can->stop();
   i.odometry.copy_imu_stats();  // the readings after the last scan too
   if (i.started) {

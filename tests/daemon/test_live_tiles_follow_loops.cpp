@@ -128,8 +128,8 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   EXPECT_GE(tiles_moved, 1U);
 
   // What a client holds at the end is the exported map (moved by the graph
-  // after its last refinement): the same points, each as near as the last
-  // correction sent and the refinement leave it.
+  // after its last refinement, which the tiles sent follow at the end too):
+  // the same points, each within the 2 cm a tile may move unsent.
   std::vector<Eigen::Vector3d> live;
   for (const auto& [tile, points] : newest)
     for (const protocol::MapPoint& p : points) live.emplace_back(p.x, p.y, p.z);
@@ -138,12 +138,15 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   const std::vector<double> d = nearest_distances(live, exported);
   fmt::print("live tiles against the export: median {:.4f} m, p99 {:.4f} m, max {:.4f} m\n", quantile(d, 0.5),
              quantile(d, 0.99), quantile(d, 1.0));
-  // A tile is sent again when it moves by more than kTileMoveM (2 cm); the
-  // export follows the graph's last refinement, which the live tiles never
-  // see, nor the optimisations after the mapping's last flush (1-2 cm here).
-  EXPECT_LT(quantile(d, 0.5), 0.01);
-  EXPECT_LT(quantile(d, 0.99), MappingStage::kTileMoveM + 0.015);
-  EXPECT_LT(quantile(d, 1.0), MappingStage::kTileMoveM + 0.04);
+  // A tile is sent again when the correction moves it by more than
+  // kTileMoveM (2 cm), also by the optimisations after the mapping's last
+  // flush and the graph's last refinement (MappingStage::follow_final_correction);
+  // a few mm more where a tile went to disk and back: the export reads it
+  // back whole, its points timed by segment (daemon/tile_spill.hpp), the live
+  // tile's new points kept their own times.
+  EXPECT_LT(quantile(d, 0.5), 0.005);
+  EXPECT_LT(quantile(d, 0.99), 0.01);
+  EXPECT_LT(quantile(d, 1.0), MappingStage::kTileMoveM + 0.005);
 }
 
 }  // namespace

@@ -79,6 +79,13 @@ class MappingStage {
   }
   void start();
   void join() { thread_.join(); }
+  // After join(), once the loop closure has posted its last correction (the
+  // keyframes the mapping left, then the refinement): the tiles sent go again
+  // where it moves them by more than kTileMoveM, so that what a client holds
+  // at the end is the exported map. Nothing without follow_graph().
+  void follow_final_correction() {
+    if (graph_ != nullptr) flush_tiles(true);
+  }
 
   StageThread& thread() { return thread_; }
   const Handoff<MapSlot>& input() const { return scans_; }
