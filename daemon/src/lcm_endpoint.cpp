@@ -111,6 +111,8 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   GridPublisher grid_publisher;
   std::int64_t pose_seq = 0;
   MapFrame frame;  // the current (or last) session's, sent with each status
+  std::string stored_session;                // a stored session whose tiles the publisher holds
+  std::optional<MapFrame> stored_frame;      // its frame (hooks.stored_frame)
   EndpointCounters counters;
   FileIdentity key_identity;
   Clock::time_point next_key_check{};
@@ -422,23 +424,23 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       send(Channel::status, m);
       ++counters.status_published;
       if (s.frame) frame = *s.frame;
-      if (!session_id.empty()) send_frame(m.utime);
+      if (!session_id.empty()) send_frame(m.utime, session_id, frame);
     }
   }
 
   // The session's frame, for a client that draws its poses and tiles in the
   // map frame (the prior's once anchored; docs/PROTOCOL.md).
-  void send_frame(std::int64_t utime) {
+  void send_frame(std::int64_t utime, const std::string& session, const MapFrame& placing) {
     frame_t f;
     f.utime = utime;
     f.schema = 2;
     f.payload_id = options.payload_id;
-    f.session_id = session_id;
-    f.source = frame.source;
-    std::copy(frame.position.begin(), frame.position.end(), f.position);
-    std::copy(frame.orientation.begin(), frame.orientation.end(), f.orientation);
-    std::copy(frame.tiles_position.begin(), frame.tiles_position.end(), f.tiles_position);
-    std::copy(frame.tiles_orientation.begin(), frame.tiles_orientation.end(), f.tiles_orientation);
+    f.session_id = session;
+    f.source = placing.source;
+    std::copy(placing.position.begin(), placing.position.end(), f.position);
+    std::copy(placing.orientation.begin(), placing.orientation.end(), f.orientation);
+    std::copy(placing.tiles_position.begin(), placing.tiles_position.end(), f.tiles_position);
+    std::copy(placing.tiles_orientation.begin(), placing.tiles_orientation.end(), f.tiles_orientation);
     send(Channel::frame, f);
     ++counters.frames_published;
   }
@@ -449,7 +451,12 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
     if (machine.state() != protocol::SessionState::idle)
       return fmt::format("mapping session '{}' is running: download other sessions after STOP", session_id);
     if (!hooks.load_tiles) return fmt::format("session '{}' is not held by this daemon", session);
-    return hooks.load_tiles(session, into);
+    std::string problem = hooks.load_tiles(session, into);
+    if (problem.empty()) {
+      stored_session = session;
+      stored_frame = hooks.stored_frame ? hooks.stored_frame(session) : std::nullopt;
+    }
+    return problem;
   }
 
   void on_tile_request(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
@@ -460,6 +467,11 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
     }
     ++counters.tile_requests;
     publisher.answer(r);
+    // A stored session's frame goes with each answer for its tiles (a live
+    // session's goes with the status): a client downloading it after a
+    // restart places them in its map frame.
+    if (stored_frame && !stored_session.empty() && publisher.session_id() == stored_session)
+      send_frame(realtime_us(), stored_session, *stored_frame);
   }
 
   // A stored session's product file (product_file_server.hpp); "" names the last session.

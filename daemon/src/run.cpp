@@ -189,6 +189,7 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     return files;
   };
   hooks.load_tiles = [&sessions](const std::string& id, TileStore& into) { return sessions.load_tiles(id, into); };
+  hooks.stored_frame = [&sessions](const std::string& id) { return sessions.stored_frame(id); };
   hooks.session_folder = [&sessions](const std::string& id) { return sessions.folder(id); };
   hooks.hint = [&sessions](const protocol::LocaliseHint& hint) { return sessions.hint(hint); };
   auto endpoint = std::make_unique<LcmEndpoint>(endpoint_options(config), std::move(hooks));

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "adit/common/error.hpp"
 #include "adit/daemon/durable_file.hpp"
 #include "adit/slam/tum.hpp"
@@ -15,6 +17,7 @@ namespace adit::daemon {
 namespace {
 
 constexpr const char* kKey = "prior_from_odometry";
+constexpr const char* kCorrectionKey = "graph_from_odometry";
 // The first line of a trajectory file moved into the prior's frame.
 constexpr std::string_view kPlacedLine = "# frame: prior_map (prior_from_odometry of prior_frame.json applied)";
 
@@ -28,6 +31,44 @@ nlohmann::json rows_of(const Eigen::Isometry3d& t) {
   return rows;
 }
 
+// The whole of `file`; nullopt when it does not exist, adit::InputError when
+// it exists and cannot be read.
+std::optional<std::string> read_text(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) {
+    if (!std::filesystem::exists(file)) return std::nullopt;
+    throw InputError(file.string(), "", "cannot be read");
+  }
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A rigid 4 × 4 matrix under `key` of the JSON `text`, as rows_of writes it;
+// `what` names the kind of file in errors.
+Eigen::Isometry3d parse_transform(std::string_view text, const std::string& name, const char* key, const char* what) {
+  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (!j.is_object() || !j.contains(key)) throw InputError(name, key, fmt::format("missing (not {})", what));
+  const nlohmann::json& rows = j.at(key);
+  if (!rows.is_array() || rows.size() != 4) throw InputError(name, key, "not a 4 x 4 matrix");
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    const nlohmann::json& row = rows[static_cast<std::size_t>(r)];
+    if (!row.is_array() || row.size() != 4) throw InputError(name, key, "not a 4 x 4 matrix");
+    for (int c = 0; c < 4; ++c) {
+      const nlohmann::json& v = row[static_cast<std::size_t>(c)];
+      if (!v.is_number() || !std::isfinite(v.get<double>())) throw InputError(name, key, "not finite numbers");
+      m(r, c) = v.get<double>();
+    }
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  const bool rigid = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-6 && r.determinant() > 0.0 &&
+                     m.row(3) == Eigen::RowVector4d(0, 0, 0, 1);
+  if (!rigid) throw InputError(name, key, "not a rigid transform (rotation and translation)");
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
+  t.translation() = m.topRightCorner<3, 1>();
+  return t;
+}
+
 }  // namespace
 
 void write_prior_frame(const std::filesystem::path& file, const Eigen::Isometry3d& prior_from_odometry) {
@@ -39,38 +80,53 @@ void write_prior_frame(const std::filesystem::path& file, const Eigen::Isometry3
 }
 
 Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& name) {
-  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
-  if (!j.is_object() || !j.contains(kKey)) throw InputError(name, kKey, "missing (not a prior frame file)");
-  const nlohmann::json& rows = j.at(kKey);
-  if (!rows.is_array() || rows.size() != 4) throw InputError(name, kKey, "not a 4 x 4 matrix");
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r) {
-    const nlohmann::json& row = rows[static_cast<std::size_t>(r)];
-    if (!row.is_array() || row.size() != 4) throw InputError(name, kKey, "not a 4 x 4 matrix");
-    for (int c = 0; c < 4; ++c) {
-      const nlohmann::json& v = row[static_cast<std::size_t>(c)];
-      if (!v.is_number() || !std::isfinite(v.get<double>())) throw InputError(name, kKey, "not finite numbers");
-      m(r, c) = v.get<double>();
-    }
-  }
-  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
-  const bool rigid = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-6 && r.determinant() > 0.0 &&
-                     m.row(3) == Eigen::RowVector4d(0, 0, 0, 1);
-  if (!rigid) throw InputError(name, kKey, "not a rigid transform (rotation and translation)");
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
-  t.translation() = m.topRightCorner<3, 1>();
-  return t;
+  return parse_transform(text, name, kKey, "a prior frame file");
 }
 
 std::optional<Eigen::Isometry3d> read_prior_frame(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) {
-    if (!std::filesystem::exists(file)) return std::nullopt;
-    throw InputError(file.string(), "", "cannot be read");
-  }
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_prior_frame(text, file.string());
+  const std::optional<std::string> text = read_text(file);
+  if (!text) return std::nullopt;
+  return parse_prior_frame(*text, file.string());
+}
+
+void write_graph_correction(const std::filesystem::path& file, const Eigen::Isometry3d& graph_from_odometry) {
+  const nlohmann::json j = {
+      {kCorrectionKey, rows_of(graph_from_odometry)},
+      {"note", "the pose graph's last correction: the tiles in this folder are in the graph's frame, the session's "
+               "trajectory.tum in the odometry's; this places the latter in the former"}};
+  write_durably(file, j.dump(2) + "\n");
+}
+
+std::optional<Eigen::Isometry3d> read_graph_correction(const std::filesystem::path& file) {
+  const std::optional<std::string> text = read_text(file);
+  if (!text) return std::nullopt;
+  return parse_transform(*text, file.string(), kCorrectionKey, "a graph correction file");
+}
+
+std::optional<MapFrame> map_frame_of(const std::optional<Eigen::Isometry3d>& anchor,
+                                     const std::optional<Eigen::Isometry3d>& correction) {
+  if (!anchor && !correction) return std::nullopt;
+  const Eigen::Isometry3d tiles = anchor.value_or(Eigen::Isometry3d::Identity());
+  const Eigen::Isometry3d odometry = correction ? tiles * *correction : tiles;
+  const auto put = [](const Eigen::Isometry3d& t, std::array<double, 3>& p, std::array<double, 4>& q) {
+    const Eigen::Quaterniond r(t.linear());
+    p = {t.translation().x(), t.translation().y(), t.translation().z()};
+    q = {r.w(), r.x(), r.y(), r.z()};
+  };
+  MapFrame f;
+  f.source = anchor ? kFrameSourcePriorMap : kFrameSourceLoops;
+  put(odometry, f.position, f.orientation);
+  put(tiles, f.tiles_position, f.tiles_orientation);
+  return f;
+}
+
+std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir) {
+  const std::optional<Eigen::Isometry3d> anchor = read_prior_frame(dir / "prior_frame.json");
+  const std::optional<Eigen::Isometry3d> correction =
+      std::filesystem::is_directory(dir / kGraphTilesFolder)
+          ? read_graph_correction(dir / kGraphTilesFolder / kGraphCorrectionFile)
+          : std::nullopt;
+  return map_frame_of(anchor, correction);
 }
 
 bool place_trajectory_file(const std::filesystem::path& file, const Eigen::Isometry3d& frame) {

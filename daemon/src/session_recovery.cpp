@@ -214,6 +214,11 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
         log::warn("session {}: {}; its exports stay in the odometry frame", r.session, e.what());
       }
       const Eigen::Isometry3d placed_by = r.prior_from_odometry.value_or(Eigen::Isometry3d::Identity());
+      // A crash during the session's end may have left the graph's tiles
+      // (whole or in part): the recovered map does not follow the graph, so
+      // they would not match its map files.
+      std::filesystem::remove_all(dir / kGraphTilesFolder);
+      std::filesystem::remove_all(dir / (std::string(kGraphTilesFolder) + ".partial"));
       // The tiles and the map files, one tile decoded at a time.
       TileSpill tiles(dir / "tiles", stored_tile_params(tile_size_m));
       std::vector<slam::TileCoord> coords;

@@ -43,10 +43,6 @@ namespace adit::daemon {
 
 namespace {
 
-// frame_t.SOURCE_PRIOR_MAP and SOURCE_LOOPS, as numbers: this file needs no LCM header.
-constexpr std::int8_t kFrameSourcePriorMap = 1;
-constexpr std::int8_t kFrameSourceLoops = 2;
-
 // summary.json's "imu": the IMU source's figures (imu_stats.hpp).
 // The CAN feed's frames and its bus's health; null without a CAN feed.
 nlohmann::json can_summary(const CanFeedStats* can) {
@@ -90,28 +86,14 @@ nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& sou
           {"unconfirmed_tries", s.unconfirmed.load()}};
 }
 
-// The running session's map frame for frame_t: the prior's once found. When
-// the live tiles follow the graph (`loops`: map.loops_move_map), they are in
-// the graph's frame and the poses in the odometry's, which the latest
-// correction C places in it: map <- tiles = A, map <- odometry = A·C
-// (docs/LOOPS.md, "Live tiles").
+// The running session's map frame for frame_t: the prior's once found, the
+// tiles placed by the graph's latest correction when they follow it
+// (`loops`: map.loops_move_map; map_frame.hpp).
 MapFrame session_frame(const PriorLocaliser* prior, const LoopClosureStage* loops) {
-  MapFrame f;
-  const std::optional<Eigen::Isometry3d> anchor = prior != nullptr ? prior->anchor() : std::nullopt;
   const std::shared_ptr<const slam::CorrectionTrack> track = loops != nullptr ? loops->live().latest() : nullptr;
-  const bool corrected = track != nullptr && !track->empty();
-  if (!anchor && !corrected) return f;
-  const Eigen::Isometry3d tiles = anchor.value_or(Eigen::Isometry3d::Identity());
-  const Eigen::Isometry3d odometry = corrected ? tiles * track->corrections().back() : tiles;
-  const auto put = [](const Eigen::Isometry3d& t, std::array<double, 3>& p, std::array<double, 4>& q) {
-    const Eigen::Quaterniond r(t.linear());
-    p = {t.translation().x(), t.translation().y(), t.translation().z()};
-    q = {r.w(), r.x(), r.y(), r.z()};
-  };
-  f.source = anchor ? kFrameSourcePriorMap : kFrameSourceLoops;
-  put(odometry, f.position, f.orientation);
-  put(tiles, f.tiles_position, f.tiles_orientation);
-  return f;
+  return map_frame_of(prior != nullptr ? prior->anchor() : std::nullopt,
+                      track != nullptr && !track->empty() ? std::optional(track->corrections().back()) : std::nullopt)
+      .value_or(MapFrame{});
 }
 
 // The map file (map.ply, else .las, else .pcd: session.exports) of the newest
@@ -460,6 +442,15 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     }
     std::vector<slam::MapSample> read_back;
     std::vector<slam::MapSample> moved;
+    std::vector<slam::MapSample> placed;
+    // The tiles as the graph placed them last go to tiles_graph/ too, whole
+    // before it takes that name: a download after a restart is served from
+    // there (load_tiles), as the live tiles were.
+    const std::filesystem::path graph_dir = dir / kGraphTilesFolder;
+    const std::filesystem::path graph_partial = dir / (std::string(kGraphTilesFolder) + ".partial");
+    std::filesystem::remove_all(graph_partial);
+    std::filesystem::remove_all(graph_dir);
+    TileSpill graph_tiles(graph_partial, params);
     const auto read_tile = [&](const slam::TileCoord& c, std::vector<protocol::MapPoint>& points) {
       std::span<const slam::MapSample> samples = map.tile(c);
       if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
@@ -470,15 +461,28 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         if (!problem.empty()) throw std::runtime_error(problem);
         samples = read_back;
       }
-      if (corrected || anchor) {
-        slam::correct_samples(samples, corrected ? &track : nullptr, placed_by, moved);
+      if (corrected) {
+        slam::correct_samples(samples, &track, Eigen::Isometry3d::Identity(), moved);
         samples = moved;
+        if (const std::string problem = graph_tiles.write(c, samples); !problem.empty())
+          throw std::runtime_error(problem);
+      }
+      if (anchor) {
+        slam::correct_samples(samples, nullptr, placed_by, placed);
+        samples = placed;
       }
       points = map_points_of(samples);
     };
     for (std::string& name : write_map_files(dir, config_.session.exports, map.size(),
                                              map_corner(coords, config_.map.tile_size_m, margin, placed_by), coords, read_tile))
       files.push_back(std::move(name));
+    if (corrected) {
+      std::filesystem::create_directories(graph_partial);  // also for a map of no tiles
+      write_graph_correction(graph_partial / kGraphCorrectionFile,
+                             track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back());
+      std::filesystem::rename(graph_partial, graph_dir);
+      files.push_back(std::string(kGraphTilesFolder) + "/");
+    }
     slam::Trajectory keyframes;  // the graph's poses with loop closure (the same keyframes, in order)
     const std::vector<Eigen::Isometry3d>* graph = loops != nullptr ? &loops->closer().poses() : nullptr;
     for (std::size_t i = 0; i < pipeline->keyframes().size(); ++i) {
@@ -627,12 +631,31 @@ std::string Sessions::hint(const protocol::LocaliseHint& hint) {
   return prior->set_hint(hint);
 }
 
+namespace {
+
+// A session id from the network names a folder under the sessions' root only.
+bool plain_session_name(const std::string& id) {
+  return !id.empty() && id.size() <= 64 && id.front() != '.' &&
+         std::all_of(id.begin(), id.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'; });
+}
+
+}  // namespace
+
+std::optional<MapFrame> Sessions::stored_frame(const std::string& id) const {
+  if (!plain_session_name(id)) return std::nullopt;
+  try {
+    return stored_session_frame(folder(id));
+  } catch (const std::exception& e) {
+    log::warn("session {}: its tiles are sent in its own frame: {}", id, e.what());
+    return std::nullopt;
+  }
+}
+
 std::string Sessions::load_tiles(const std::string& id, TileStore& into) const {
-  const bool plain = !id.empty() && id.size() <= 64 && id.front() != '.' &&
-                     std::all_of(id.begin(), id.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'; });
-  if (!plain) return fmt::format("'{}' is not a session name", id);
-  const std::filesystem::path tiles = folder(id) / "tiles";
+  if (!plain_session_name(id)) return fmt::format("'{}' is not a session name", id);
   std::error_code ec;
+  const std::filesystem::path graph = folder(id) / kGraphTilesFolder;
+  const std::filesystem::path tiles = std::filesystem::is_directory(graph, ec) ? graph : folder(id) / "tiles";
   // A finished session that mapped nothing (stopped, or killed, before its
   // first map point) has no tiles: its map is empty, not missing.
   if (!std::filesystem::is_directory(tiles, ec))

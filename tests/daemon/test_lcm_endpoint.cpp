@@ -437,6 +437,57 @@ TEST(LcmEndpoint, DownloadPlacesTheMapWhereTheSessionsFramePutsItsTiles) {
   std::filesystem::remove(file);
 }
 
+// After a restart the daemon holds no live session: a stored session's tiles
+// come from its folder, and its frame (hooks.stored_frame: the prior's anchor,
+// the graph's last correction) goes with the answers, so `adit download`
+// places them as it did while the session ran; without one they stay put.
+TEST(LcmEndpoint, AStoredSessionsDownloadIsPlacedByItsStoredFrame) {
+  EndpointOptions o;
+  o.lcm_url = unique_url();
+  o.payload_id = fmt::format("stored-{}", ::getpid());
+  std::vector<MapPoint> all;
+  for (const auto& [key, points] : room()) all.insert(all.end(), points.begin(), points.end());
+  SessionHooks hooks;
+  hooks.load_tiles = [](const std::string& id, TileStore& into) -> std::string {
+    if (id != "anchored" && id != "plain") return fmt::format("no session '{}'", id);
+    for (const auto& [key, points] : room()) into.update(key, points, 1);
+    return "";
+  };
+  MapFrame f;  // map <- tiles: a quarter turn about z, then 100 m east and 50 m north
+  f.source = kFrameSourcePriorMap;
+  f.position = {101.0, 50.0, 0.0};
+  f.orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+  f.tiles_position = {100.0, 50.0, 0.0};
+  f.tiles_orientation = {std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+  hooks.stored_frame = [&f](const std::string& id) { return id == "anchored" ? std::optional(f) : std::nullopt; };
+  LcmEndpoint endpoint(o, hooks);
+  const auto adit = (test::binary_dir() / "bin" / "adit").string();
+  const auto download = [&](const std::string& session, std::set<MmPoint>& got) {
+    const auto file = std::filesystem::temp_directory_path() / fmt::format("adit-stored-{}-{}.ply", session, ::getpid());
+    const auto r = test::run_program({adit, "download", "--session", session, "--format", "ply", "--out", file.string(),
+                                      "--quiet", "--payload", o.payload_id, "--lcm-url", o.lcm_url, "--timeout", "10"});
+    for (const auto& p : test::read_ply(file)) got.insert(mm(p.x, p.y, p.z));
+    std::filesystem::remove(file);
+    return r;
+  };
+  std::set<MmPoint> got;
+  const auto anchored = download("anchored", got);
+  ASSERT_EQ(anchored.exit_status, 0) << anchored.out << anchored.err;
+  EXPECT_NE(anchored.out.find("in the prior map's frame"), std::string::npos) << anchored.out;
+  std::set<MmPoint> expected;
+  for (const MapPoint& p : all) expected.insert(mm(100.0 - p.y, 50.0 + p.x, p.z));
+  EXPECT_EQ(got, expected);
+  EXPECT_GE(endpoint.counters().frames_published.load(), 1U);
+
+  got.clear();
+  const auto plain = download("plain", got);
+  ASSERT_EQ(plain.exit_status, 0) << plain.out << plain.err;
+  EXPECT_NE(plain.out.find("in the session's own frame"), std::string::npos) << plain.out;
+  expected.clear();
+  for (const MapPoint& p : all) expected.insert(mm(p.x, p.y, p.z));
+  EXPECT_EQ(got, expected);
+}
+
 TEST(LcmEndpoint, ChangedTilesGoOutAtMostOnceASecond) {
   Harness h;
   Sniffer sniffer(h.url);

@@ -1,8 +1,9 @@
 // The live tiles follow the pose graph (map.loops_move_map; docs/LOOPS.md,
 // "Live tiles"): on a simulated building floor driven round its loop, tiles
 // sent before a closure go again with their points moved, the status's frame
-// places the poses by the latest correction and the tiles by none, and at the
-// end the tiles as a client holds them lie where the exported map does.
+// places the poses by the latest correction and the tiles by none, at the
+// end the tiles as a client holds them lie where the exported map does, and
+// so do the stored tiles a download after a restart gets.
 
 #include <gtest/gtest.h>
 
@@ -21,6 +22,8 @@
 #include "adit/config/load.hpp"
 #include "adit/daemon/mapping_stage.hpp"
 #include "adit/daemon/sessions.hpp"
+#include "adit/daemon/tile_spill.hpp"
+#include "adit/daemon/tile_store.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "daemon_process.hpp"
 #include "map_readers.hpp"
@@ -147,6 +150,37 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   EXPECT_LT(quantile(d, 0.5), 0.005);
   EXPECT_LT(quantile(d, 0.99), 0.01);
   EXPECT_LT(quantile(d, 1.0), MappingStage::kTileMoveM + 0.005);
+
+  // After a restart (a daemon holding nothing of the session) a download is
+  // served from the stored tiles: those the graph placed last (tiles_graph/),
+  // where the export is, in the graph's frame, which frame_t names.
+  ASSERT_TRUE(std::filesystem::is_directory(folder / "tiles_graph")) << "no tiles_graph/ in " << folder;
+  Sessions restarted(config::load_config(config_file), Sessions::Outputs{});
+  TileStore stored(stored_tile_params(20.0));
+  ASSERT_EQ(restarted.load_tiles(id, stored), "");
+  std::vector<Eigen::Vector3d> downloaded;
+  std::vector<std::uint8_t> frame;
+  std::vector<protocol::MapPoint> points;
+  for (const auto& [tile_id, tile] : stored.tiles())
+    for (std::size_t s = 0; s < tile.segments.size(); ++s) {
+      ASSERT_EQ(stored.read_frame(tile, s, frame), "");
+      points.clear();
+      ASSERT_EQ(protocol::decode_segment(frame, protocol::tile_key(tile_id), tile.params.tile_size_m,
+                                         tile.params.quantum_m, tile.params.centred, points),
+                "");
+      for (const protocol::MapPoint& p : points) downloaded.emplace_back(p.x, p.y, p.z);
+    }
+  EXPECT_EQ(downloaded.size(), exported.size());
+  const std::vector<double> e = nearest_distances(downloaded, exported);
+  fmt::print("stored tiles after a restart against the export: median {:.4f} m, max {:.4f} m\n", quantile(e, 0.5),
+             quantile(e, 1.0));
+  EXPECT_LT(quantile(e, 1.0), 0.002);  // the same points: each quantised to 1 mm in the tile, to float in the file
+  const std::optional<MapFrame> placed = restarted.stored_frame(id);
+  ASSERT_TRUE(placed.has_value());
+  EXPECT_EQ(placed->source, kFrameSourceLoops);
+  EXPECT_EQ(placed->tiles_position, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_GT(std::hypot(placed->position[0], placed->position[1], placed->position[2]), 0.0)
+      << "the poses are placed by the graph's last correction";
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The frame a session's exports are in (daemon/session_frame.hpp): the anchor
 // written and read back, a bad prior_frame.json named, a trajectory file moved
-// into the prior's frame once only, and the LAS corner below a moved map.
+// into the prior's frame once only, a stored session's frame, and the LAS
+// corner below a moved map.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -52,6 +53,53 @@ TEST(SessionFrame, ABadFileIsNamedWithItsKey) {
       EXPECT_EQ(e.key(), "prior_from_odometry") << text;
       EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
     }
+  }
+}
+
+// A finished session's frame as a download after a restart gets it: the
+// anchor and, with tiles_graph/, the graph's last correction, as the live
+// frame_t had them (map <- tiles = A, map <- odometry = A·C).
+TEST(SessionFrame, AStoredSessionsFrameComesFromItsAnchorAndTheGraphsLastCorrection) {
+  const test::TempFolder dir;
+  EXPECT_FALSE(stored_session_frame(dir.path()).has_value());  // the odometry's own frame
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  correction.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  correction.translation() = Eigen::Vector3d(0.4, -0.2, 0.05);
+  const auto isometry = [](const std::array<double, 3>& p, const std::array<double, 4>& q) {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+    t.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+    return t;
+  };
+  const std::filesystem::path graph = dir.path() / kGraphTilesFolder;
+  std::filesystem::create_directories(graph);
+  write_graph_correction(graph / kGraphCorrectionFile, correction);
+  std::optional<MapFrame> f = stored_session_frame(dir.path());
+  ASSERT_TRUE(f.has_value());
+  EXPECT_EQ(f->source, kFrameSourceLoops);
+  EXPECT_TRUE(isometry(f->tiles_position, f->tiles_orientation).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  EXPECT_TRUE(isometry(f->position, f->orientation).isApprox(correction, 1e-12));
+
+  write_prior_frame(dir.path() / "prior_frame.json", sample_anchor());
+  f = stored_session_frame(dir.path());
+  ASSERT_TRUE(f.has_value());
+  EXPECT_EQ(f->source, kFrameSourcePriorMap);
+  EXPECT_TRUE(isometry(f->tiles_position, f->tiles_orientation).isApprox(sample_anchor(), 1e-12));
+  EXPECT_TRUE(isometry(f->position, f->orientation).isApprox(sample_anchor() * correction, 1e-12));
+
+  std::filesystem::remove_all(graph);  // no graph's tiles: its tiles/ are in the odometry frame
+  f = stored_session_frame(dir.path());
+  ASSERT_TRUE(f.has_value());
+  EXPECT_TRUE(isometry(f->position, f->orientation).isApprox(sample_anchor(), 1e-12));
+
+  std::filesystem::create_directories(graph);
+  std::ofstream(graph / kGraphCorrectionFile) << R"({"graph_from_odometry": [[1, 0, 0, 0]]})";
+  try {
+    stored_session_frame(dir.path());
+    ADD_FAILURE() << "a malformed correction was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), (graph / kGraphCorrectionFile).string());
+    EXPECT_EQ(e.key(), "graph_from_odometry");
   }
 }
 

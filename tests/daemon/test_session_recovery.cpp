@@ -117,6 +117,26 @@ TEST(SessionRecovery, ACleanlyClosedJournalEndsWithItsEndRecordAndEachPointOnce)
   EXPECT_EQ(r.map_poses, w.poses);
 }
 
+// A crash while the session's end wrote the graph's tiles (tiles_graph/, or
+// its .partial): the recovered map does not follow the graph, so a download
+// must not be served from them; they go, and the frame is the odometry's.
+TEST(SessionRecovery, TheGraphsTilesOfAnEndCutShortGo) {
+  const std::filesystem::path dir = work_dir("graph-tiles");
+  write_session(dir, 25, 0.0, 5, true);
+  for (const char* folder : {"tiles_graph", "tiles_graph.partial"}) {
+    std::filesystem::create_directories(dir / folder);
+    std::ofstream(dir / folder / "0.adt") << "half a tile";
+  }
+  write_graph_correction(dir / kGraphTilesFolder / kGraphCorrectionFile, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(stored_session_frame(dir).has_value());
+  const RecoveryReport r = recover_session(dir, {"ply"}, 20.0);
+  ASSERT_TRUE(r.recovered) << r.problem;
+  EXPECT_FALSE(std::filesystem::exists(dir / "tiles_graph"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "tiles_graph.partial"));
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "tiles"));
+  EXPECT_FALSE(stored_session_frame(dir).has_value());
+}
+
 // Wherever the crash cut the journal, what came before the cut is recovered
 // and the rest is named as lost; the file itself is cut back to whole records.
 TEST(SessionRecovery, ATornJournalIsCutAtItsLastGoodRecordAndTheRestRecovered) {

@@ -21,6 +21,7 @@
 #include "adit/protocol/session_state.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/daemon/grid_publisher.hpp"
+#include "adit/daemon/map_frame.hpp"
 #include "adit/daemon/tile_store.hpp"
 
 namespace adit::daemon {
@@ -46,15 +47,6 @@ struct ThreadLoad {
   float load = 0;
   std::int32_t queue_depth = 0;
   std::int32_t queue_capacity = 0;
-};
-
-// Where the running session's odometry frame lies in its map frame (frame_t).
-struct MapFrame {
-  std::int8_t source = 0;  // frame_t.SOURCE_*
-  std::array<double, 3> position{};               // map <- odometry (the poses)
-  std::array<double, 4> orientation{1, 0, 0, 0};  // w, x, y, z
-  std::array<double, 3> tiles_position{};         // map <- tiles
-  std::array<double, 4> tiles_orientation{1, 0, 0, 0};
 };
 
 // What the daemon knows about its health; the endpoint adds state, session
@@ -88,6 +80,10 @@ struct SessionHooks {
   // A download of a stored session (not the one in memory): fills `into`
   // from its folder; returns "" or why not. Called only while IDLE.
   std::function<std::string(const std::string& session, TileStore& into)> load_tiles;
+  // The frame of a stored session whose tiles load_tiles filled (its tiles
+  // and poses in its map frame), sent as frame_t with each answer to a
+  // request for them; nullopt (or unset): the session's own frame, none sent.
+  std::function<std::optional<MapFrame>(const std::string& session)> stored_frame;
   // The folder of a session just started: the tile stream keeps its segments
   // in a file there rather than in RAM. Empty (or unset): in RAM.
   std::function<std::filesystem::path(const std::string& session)> session_folder;

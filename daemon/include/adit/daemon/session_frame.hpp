@@ -7,7 +7,9 @@
 // written through it, and summary.json's "frame" says which frame they are in.
 // The tiles/ folder stays in the odometry frame; the live tiles too, unless
 // map.loops_move_map moves them by the loop closure's graph (the live
-// frame_t places them either way; docs/LOOPS.md "Live tiles").
+// frame_t places them either way; docs/LOOPS.md "Live tiles"). Then, at the
+// session's end, tiles_graph/ holds them as the graph placed them last, with
+// that last correction, and a download after a restart is served from it.
 
 #include <filesystem>
 #include <optional>
@@ -17,7 +19,14 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "adit/daemon/map_frame.hpp"
+
 namespace adit::daemon {
+
+// A finished session's tiles placed by the pose graph's last correction, and
+// that correction (graph_from_odometry), when loop closure moved its map.
+constexpr const char* kGraphTilesFolder = "tiles_graph";
+constexpr const char* kGraphCorrectionFile = "correction.json";
 
 // Writes the anchor durably (a 4 × 4 matrix, row by row); throws
 // std::runtime_error naming the file when it cannot be written.
@@ -35,6 +44,17 @@ Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& na
 // twice). Returns false when there is no such file; throws adit::InputError
 // naming a malformed one, std::runtime_error one that cannot be written.
 bool place_trajectory_file(const std::filesystem::path& file, const Eigen::Isometry3d& frame);
+
+// The graph's last correction C (graph <- odometry), written durably into
+// tiles_graph/; read back as read_prior_frame reads the anchor.
+void write_graph_correction(const std::filesystem::path& file, const Eigen::Isometry3d& graph_from_odometry);
+std::optional<Eigen::Isometry3d> read_graph_correction(const std::filesystem::path& file);
+
+// The frame of the finished session in `dir` as frame_t gives it: its anchor
+// (prior_frame.json) and, when tiles_graph/ is there, the graph's last
+// correction; nullopt in the odometry's own frame. Throws adit::InputError
+// naming a malformed file.
+std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir);
 
 // summary.json's "frame": {"name": "prior_map", "prior_from_odometry": 4 × 4}
 // with an anchor, {"name": "odometry"} without.

@@ -91,9 +91,14 @@ class Sessions {
   // Sessions on disk, oldest first: "<id>" and its session_notes().
   std::vector<std::string> list() const;
   std::filesystem::path folder(const std::string& id) const;
-  // Fills `into` with a stored session's tiles (tiles/*.adt); "" or why not.
-  // `id` comes from the network: only a plain session name is accepted.
+  // Fills `into` with a stored session's tiles: tiles_graph/*.adt when loop
+  // closure moved its map (as the live tiles were at the end), else
+  // tiles/*.adt; "" or why not. `id` comes from the network: only a plain
+  // session name is accepted.
   std::string load_tiles(const std::string& id, TileStore& into) const;
+  // The frame those tiles are in (stored_session_frame); nullopt in the
+  // session's own frame, or when its frame files are unreadable (logged).
+  std::optional<MapFrame> stored_frame(const std::string& id) const;
   // HINT: the running session's search against its prior map narrowed to
   // `hint` (prior_localiser.hpp); "" or why not (no session, no prior, anchored).
   std::string hint(const protocol::LocaliseHint& hint);
