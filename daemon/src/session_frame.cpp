@@ -69,14 +69,25 @@ Eigen::Isometry3d parse_transform(std::string_view text, const std::string& name
   return t;
 }
 
+// `t` under `key`, with a note for whoever opens the file, written durably.
+void write_transform(const std::filesystem::path& file, const char* key, const Eigen::Isometry3d& t, const char* note) {
+  const nlohmann::json j = {{key, rows_of(t)}, {"note", note}};
+  write_durably(file, j.dump(2) + "\n");
+}
+
+// parse_transform of `file`; nullopt when it does not exist.
+std::optional<Eigen::Isometry3d> read_transform(const std::filesystem::path& file, const char* key, const char* what) {
+  const std::optional<std::string> text = read_text(file);
+  if (!text) return std::nullopt;
+  return parse_transform(*text, file.string(), key, what);
+}
+
 }  // namespace
 
 void write_prior_frame(const std::filesystem::path& file, const Eigen::Isometry3d& prior_from_odometry) {
-  const nlohmann::json j = {
-      {kKey, rows_of(prior_from_odometry)},
-      {"note", "the session's live poses and tiles are in the odometry frame; this places them in the prior map's, "
-               "where its exports are (summary.json \"frame\")"}};
-  write_durably(file, j.dump(2) + "\n");
+  write_transform(file, kKey, prior_from_odometry,
+                  "the session's live poses and tiles are in the odometry frame; this places them in the prior "
+                  "map's, where its exports are (summary.json \"frame\")");
 }
 
 Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& name) {
@@ -84,23 +95,17 @@ Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& na
 }
 
 std::optional<Eigen::Isometry3d> read_prior_frame(const std::filesystem::path& file) {
-  const std::optional<std::string> text = read_text(file);
-  if (!text) return std::nullopt;
-  return parse_prior_frame(*text, file.string());
+  return read_transform(file, kKey, "a prior frame file");
 }
 
 void write_graph_correction(const std::filesystem::path& file, const Eigen::Isometry3d& graph_from_odometry) {
-  const nlohmann::json j = {
-      {kCorrectionKey, rows_of(graph_from_odometry)},
-      {"note", "the pose graph's last correction: the tiles in this folder are in the graph's frame, the session's "
-               "trajectory.tum in the odometry's; this places the latter in the former"}};
-  write_durably(file, j.dump(2) + "\n");
+  write_transform(file, kCorrectionKey, graph_from_odometry,
+                  "the pose graph's last correction: the tiles in this folder are in the graph's frame, the "
+                  "session's trajectory.tum in the odometry's; this places the latter in the former");
 }
 
 std::optional<Eigen::Isometry3d> read_graph_correction(const std::filesystem::path& file) {
-  const std::optional<std::string> text = read_text(file);
-  if (!text) return std::nullopt;
-  return parse_transform(*text, file.string(), kCorrectionKey, "a graph correction file");
+  return read_transform(file, kCorrectionKey, "a graph correction file");
 }
 
 std::optional<MapFrame> map_frame_of(const std::optional<Eigen::Isometry3d>& anchor,
