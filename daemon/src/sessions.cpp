@@ -445,12 +445,15 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     std::vector<slam::MapSample> placed;
     // The tiles as the graph placed them last go to tiles_graph/ too, whole
     // before it takes that name: a download after a restart is served from
-    // there (load_tiles), as the live tiles were.
+    // there (load_tiles), as the live tiles were. A failure there (a full
+    // disk) leaves the map files be: the first one is kept and said below.
     const std::filesystem::path graph_dir = dir / kGraphTilesFolder;
     const std::filesystem::path graph_partial = dir / (std::string(kGraphTilesFolder) + ".partial");
-    std::filesystem::remove_all(graph_partial);
-    std::filesystem::remove_all(graph_dir);
+    std::error_code ignored;
+    std::filesystem::remove_all(graph_partial, ignored);
+    std::filesystem::remove_all(graph_dir, ignored);
     TileSpill graph_tiles(graph_partial, params);
+    std::string graph_problem;
     const auto read_tile = [&](const slam::TileCoord& c, std::vector<protocol::MapPoint>& points) {
       std::span<const slam::MapSample> samples = map.tile(c);
       if (map.is_evicted(c) || map.stored_points(c) > 0) {  // its file is whole now: read it back
@@ -464,8 +467,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       if (corrected) {
         slam::correct_samples(samples, &track, Eigen::Isometry3d::Identity(), moved);
         samples = moved;
-        if (const std::string problem = graph_tiles.write(c, samples); !problem.empty())
-          throw std::runtime_error(problem);
+        if (graph_problem.empty()) graph_problem = graph_tiles.write(c, samples);
       }
       if (anchor) {
         slam::correct_samples(samples, nullptr, placed_by, placed);
@@ -477,11 +479,18 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                                              map_corner(coords, config_.map.tile_size_m, margin, placed_by), coords, read_tile))
       files.push_back(std::move(name));
     if (corrected) {
-      std::filesystem::create_directories(graph_partial);  // also for a map of no tiles
-      write_graph_correction(graph_partial / kGraphCorrectionFile,
-                             track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back());
-      std::filesystem::rename(graph_partial, graph_dir);
-      files.push_back(std::string(kGraphTilesFolder) + "/");
+      try {
+        if (!graph_problem.empty()) throw std::runtime_error(graph_problem);
+        std::filesystem::create_directories(graph_partial);  // also for a map of no tiles
+        write_graph_correction(graph_partial / kGraphCorrectionFile,
+                               track.empty() ? Eigen::Isometry3d::Identity() : track.corrections().back());
+        std::filesystem::rename(graph_partial, graph_dir);
+        files.push_back(std::string(kGraphTilesFolder) + "/");
+      } catch (const std::exception& e) {
+        std::filesystem::remove_all(graph_partial, ignored);
+        log::warn("session {}: {}/ not written ({}); a download after a restart gets tiles/, not moved by the loops",
+                  id, kGraphTilesFolder, e.what());
+      }
     }
     slam::Trajectory keyframes;  // the graph's poses with loop closure (the same keyframes, in order)
     const std::vector<Eigen::Isometry3d>* graph = loops != nullptr ? &loops->closer().poses() : nullptr;
