@@ -218,7 +218,7 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
       // (whole or in part): the recovered map does not follow the graph, so
       // they would not match its map files.
       std::filesystem::remove_all(dir / kGraphTilesFolder);
-      std::filesystem::remove_all(dir / (std::string(kGraphTilesFolder) + ".partial"));
+      std::filesystem::remove_all(dir / kGraphTilesPartialFolder);
       // The tiles and the map files, one tile decoded at a time.
       TileSpill tiles(dir / "tiles", stored_tile_params(tile_size_m));
       std::vector<slam::TileCoord> coords;

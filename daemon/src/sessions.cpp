@@ -448,7 +448,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     // there (load_tiles), as the live tiles were. A failure there (a full
     // disk) leaves the map files be: the first one is kept and said below.
     const std::filesystem::path graph_dir = dir / kGraphTilesFolder;
-    const std::filesystem::path graph_partial = dir / (std::string(kGraphTilesFolder) + ".partial");
+    const std::filesystem::path graph_partial = dir / kGraphTilesPartialFolder;
     std::error_code ignored;
     std::filesystem::remove_all(graph_partial, ignored);
     std::filesystem::remove_all(graph_dir, ignored);

@@ -26,6 +26,7 @@ namespace adit::daemon {
 // A finished session's tiles placed by the pose graph's last correction, and
 // that correction (graph_from_odometry), when loop closure moved its map.
 constexpr const char* kGraphTilesFolder = "tiles_graph";
+constexpr const char* kGraphTilesPartialFolder = "tiles_graph.partial";  // being written
 constexpr const char* kGraphCorrectionFile = "correction.json";
 
 // Writes the anchor durably (a 4 × 4 matrix, row by row); throws
