@@ -15,6 +15,7 @@
 #include "adit/common/error.hpp"
 #include "adit/common/log.hpp"
 #include "adit/command_ack_t.hpp"
+#include "adit/daemon/graph_path.hpp"
 #include "adit/daemon/handoff.hpp"
 #include "adit/daemon/product_file_server.hpp"
 #include "adit/daemon/tile_publisher.hpp"
@@ -25,6 +26,7 @@
 #include "adit/protocol/command_gate.hpp"
 #include "adit/common/clock.hpp"
 #include "adit/frame_t.hpp"
+#include "adit/graph_path_t.hpp"
 #include "adit/grid_patch_t.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
@@ -37,6 +39,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using protocol::Channel;
 
+// graph_path_t again this often after a change: for a client that lost it
+// (UDP) or joined late; at most 48 KB each time.
+constexpr double kGraphPathResendS = 5.0;
 
 // The hand-offs carry items by swapping them with the pool's: the producer
 // gets the slot's old buffers back, so nothing is allocated once warm.
@@ -111,6 +116,11 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   GridPublisher grid_publisher;
   std::int64_t pose_seq = 0;
   MapFrame frame;  // the current (or last) session's, sent with each status
+  // The current (or last) session's graph: its path goes out when it changes
+  // and every kGraphPathResendS after.
+  std::shared_ptr<const slam::CorrectionTrack> graph;
+  std::int32_t graph_revision = 0;
+  Clock::time_point graph_sent{};
   std::string stored_session;                // a stored session whose tiles the publisher holds
   std::optional<MapFrame> stored_frame;      // its frame (hooks.stored_frame)
   EndpointCounters counters;
@@ -359,6 +369,8 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       grid_publisher.reset(session_id);
       pose_seq = 0;
       frame = MapFrame{};
+      graph.reset();
+      graph_revision = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
       hooks.stop();
@@ -425,7 +437,34 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       ++counters.status_published;
       if (s.frame) frame = *s.frame;
       if (!session_id.empty()) send_frame(m.utime, session_id, frame);
+      const bool changed = s.graph != nullptr && s.graph != graph;
+      if (changed) {
+        graph = std::move(s.graph);
+        ++graph_revision;
+      }
+      if (graph != nullptr && !session_id.empty() &&
+          (changed || Clock::now() - graph_sent >= std::chrono::duration<double>(kGraphPathResendS)))
+        send_graph_path();
     }
+  }
+
+  // The graph's keyframes for a client that draws the path with the map the
+  // loops moved (graph_path.hpp, docs/PROTOCOL.md).
+  void send_graph_path() {
+    const GraphPath path = graph_path_of(*graph);
+    graph_path_t m;
+    m.utime = path.utime;
+    m.schema = 1;
+    m.payload_id = options.payload_id;
+    m.session_id = session_id;
+    m.revision = graph_revision;
+    m.n_keyframes = path.n_keyframes;
+    m.n = static_cast<std::int32_t>(path.positions.size());
+    m.positions.reserve(path.positions.size());
+    for (const auto& p : path.positions) m.positions.push_back({p[0], p[1], p[2]});
+    send(Channel::graph_path, m);
+    graph_sent = Clock::now();
+    ++counters.graph_paths_published;
   }
 
   // The session's frame, for a client that draws its poses and tiles in the

@@ -792,7 +792,9 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
-  sample.frame = session_frame(pipeline_->prior_localiser(), config_.map.loops_move_map ? pipeline_->loop_closure() : nullptr);
+  const LoopClosureStage* moving = config_.map.loops_move_map ? pipeline_->loop_closure() : nullptr;
+  sample.frame = session_frame(pipeline_->prior_localiser(), moving);
+  if (moving != nullptr) sample.graph = moving->live().latest();
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;
 }

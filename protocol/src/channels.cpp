@@ -28,6 +28,7 @@ std::string_view channel_kind(Channel channel) {
     case Channel::imu_pose: return "POSE_IMU";
     case Channel::grid: return "GRID";
     case Channel::frame: return "FRAME";
+    case Channel::graph_path: return "GRAPH_PATH";
   }
   return "UNKNOWN";
 }

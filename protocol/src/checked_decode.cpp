@@ -90,6 +90,7 @@ class Walker {
 
 const std::vector<Field> kSensorHealth{STR, F32, I64, I64, F32};
 const std::vector<Field> kThreadLoad{STR, F32, I32, I32};
+const std::vector<Field> kXyz{{Kind::f32, 3}};
 
 const std::vector<Field>& layout(LcmType type) {
   static const std::vector<Field> pose{I64, I16, STR, I64, {Kind::f64, 3}, {Kind::f64, 4}, {Kind::f64, 36}, I32};
@@ -111,6 +112,7 @@ const std::vector<Field>& layout(LcmType type) {
                                              counted(Kind::i8, 10)};
   static const std::vector<Field> frame{I64,           I16,           STR,           STR,          I8,
                                         {Kind::f64, 3}, {Kind::f64, 4}, {Kind::f64, 3}, {Kind::f64, 4}};
+  static const std::vector<Field> graph_path{I64, I16, STR, STR, I32, I32, I32, {Kind::nested, 1, 6, &kXyz}};
   switch (type) {
     case LcmType::pose: return pose;
     case LcmType::status: return status;
@@ -123,6 +125,7 @@ const std::vector<Field>& layout(LcmType type) {
     case LcmType::file_chunk: return file_chunk;
     case LcmType::grid_patch: return grid_patch;
     case LcmType::frame: return frame;
+    case LcmType::graph_path: return graph_path;
   }
   return pose;
 }

@@ -12,7 +12,11 @@ CorrectionTrack::CorrectionTrack(std::span<const std::int64_t> stamps_ns, std::s
   const std::size_t n = std::min({stamps_ns.size(), graph.size(), odometry.size()});
   stamps_.assign(stamps_ns.begin(), stamps_ns.begin() + static_cast<std::ptrdiff_t>(n));
   corrections_.reserve(n);
-  for (std::size_t k = 0; k < n; ++k) corrections_.push_back(graph[k] * odometry[k].inverse());
+  positions_.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    corrections_.push_back(graph[k] * odometry[k].inverse());
+    positions_.push_back(graph[k].translation());
+  }
   steps_.reserve(n);
   for (std::size_t k = 0; k + 1 < n; ++k) steps_.push_back(log_se3(corrections_[k].inverse() * corrections_[k + 1]));
 }

@@ -1,7 +1,8 @@
 // Fuzzes what places a session in the map frame: prior_frame.json's text (read
-// back at the session's end and on recovery after a crash) and the frame_t a
-// client receives. A bad file must throw adit::InputError, a bad message be
-// refused; whatever is accepted must be a finite rigid transform.
+// back at the session's end and on recovery after a crash), and the frame_t
+// and graph_path_t a client receives. A bad file must throw adit::InputError,
+// a bad message be refused; whatever is accepted must be a finite rigid
+// transform, and a graph path as many x y z triples as it says.
 
 #include <cmath>
 #include <cstddef>
@@ -12,6 +13,7 @@
 #include "adit/common/error.hpp"
 #include "adit/daemon/session_frame.hpp"
 #include "adit/frame_t.hpp"
+#include "adit/graph_path_t.hpp"
 #include "adit/protocol/checked_decode.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -24,5 +26,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   adit::frame_t frame;
   (void)adit::protocol::checked_decode(data, size, frame);
+  adit::graph_path_t path;
+  if (adit::protocol::checked_decode(data, size, path)) {
+    if (path.n < 0 || path.positions.size() != static_cast<std::size_t>(path.n)) std::abort();
+    for (const auto& p : path.positions)
+      if (p.size() != 3) std::abort();
+  }
   return 0;
 }

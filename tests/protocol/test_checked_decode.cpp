@@ -110,6 +110,12 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   frame.orientation[0] = 1.0;
   frame.tiles_orientation[0] = 1.0;
   expect_round_trip(frame);
+
+  graph_path_t path{};
+  path.session_id = "s1";
+  path.positions = {{1.0F, 2.0F, 3.0F}, {4.0F, 5.0F, 6.0F}};
+  path.n = 2;
+  expect_round_trip(path);
 }
 
 // Byte offset of n_args in sample_command(): hash, utime, schema, request id,

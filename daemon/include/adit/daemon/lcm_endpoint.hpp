@@ -24,6 +24,10 @@
 #include "adit/daemon/map_frame.hpp"
 #include "adit/daemon/tile_store.hpp"
 
+namespace adit::slam {
+class CorrectionTrack;
+}
+
 namespace adit::daemon {
 
 struct PoseSample {
@@ -60,6 +64,10 @@ struct StatusSample {
   // A running session's frame; none between sessions (the endpoint keeps
   // sending the last session's, so a client still draws its map in place).
   std::optional<MapFrame> frame;
+  // The loop closure's latest correction while it moves the map: its
+  // keyframes go out as graph_path_t when it changes and every 5 s after
+  // (kept, as the frame, once the session ended).
+  std::shared_ptr<const slam::CorrectionTrack> graph;
 };
 
 // The whole new content of one tile (after voxel downsampling).
@@ -119,6 +127,7 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> poses_dropped{0};  // hand-off queue full
   std::atomic<std::uint64_t> status_published{0};
   std::atomic<std::uint64_t> frames_published{0};
+  std::atomic<std::uint64_t> graph_paths_published{0};
   std::atomic<std::uint64_t> status_dropped{0};
   std::atomic<std::uint64_t> tiles_dropped{0};
   std::atomic<std::uint64_t> chunks_published{0};

@@ -30,9 +30,14 @@ class CorrectionTrack {
   double max_translation_m() const;
   double max_rotation_rad() const;
   const std::vector<Eigen::Isometry3d>& corrections() const { return corrections_; }
+  // The keyframes' stamps and where the graph puts them (G_k's translation):
+  // the path a client draws with the corrected map.
+  const std::vector<std::int64_t>& stamps_ns() const { return stamps_; }
+  const std::vector<Eigen::Vector3d>& graph_positions() const { return positions_; }
 
  private:
   std::vector<std::int64_t> stamps_;
+  std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::Isometry3d> corrections_;
   std::vector<Vector6d> steps_;  // log(C_k⁻¹·C_k+1)
 };
