@@ -167,6 +167,22 @@ try {
     return { x: after.x - (100 - before.y), y: after.y - (-20 + before.x), back: back.distanceTo(before) };
   });
   assert.ok(Math.abs(shift.x) < 1e-3 && Math.abs(shift.y) < 1e-3 && shift.back < 1e-6, JSON.stringify(shift));
+  // The pose graph's path (graph_path_t, after a loop closed; this drive's
+  // first loop comes after the stop, so the page is given one as the
+  // console's graph_path event would: ConsoleGraphPath.* tests that side):
+  // drawn with the tiles, and the poses' path kept from its newest keyframe on.
+  const graphPath = await page.evaluate(() => {
+    const v = window.adit.view;
+    const n = v.pathCount;
+    const mid = v.pathTimes[Math.floor(n / 2)];
+    const kept = Array.from(v.pathTimes.subarray(0, n)).filter((t) => t >= mid).length;
+    v.setGraphPath({ utime: mid, points: [[0, 0, 0], [1, 0, 0], [2, 1, 0]] });
+    return { before: n, after: v.pathCount, kept, first: v.pathTimes[0], mid, withTiles: v.graphPath.parent === v.tilesWorld,
+             visible: v.graphPath.visible, drawn: v.graphGeometry.drawRange.count };
+  });
+  assert.ok(graphPath.before > 10 && graphPath.after === graphPath.kept && graphPath.after < graphPath.before &&
+            graphPath.first >= graphPath.mid && graphPath.withTiles && graphPath.visible && graphPath.drawn === 3,
+            JSON.stringify(graphPath));
   if (screenshots) {
     await waitFor('the phone page to draw the map', async () => (await metrics(other)).tileFetches > 3, 20000);
     await other.screenshot({ path: path.join(screenshots, 'console-phone.png') });

@@ -4,7 +4,8 @@
 // reads: GET /api/grid (a PNG and where it lies), the snapshot and the event
 // stream. The PNG is decoded here with libpng's own reader, independently of
 // the console's encoder, and compared cell for cell with what was sent. The
-// session's frame (frame_t) travels the same way to the page's snapshot.
+// session's frame (frame_t) and the pose graph's path (graph_path_t) travel
+// the same way to the page's snapshot and events.
 #include <gtest/gtest.h>
 
 #include <httplib.h>
@@ -12,6 +13,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <future>
 #include <mutex>
 #include <thread>
 
@@ -19,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/daemon/lcm_endpoint.hpp"
+#include "adit/slam/correction_track.hpp"
 #include "daemon_process.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
@@ -297,6 +300,71 @@ TEST(ConsoleFrame, TheSessionsFrameReachesThePageAndANewSessionForgetsIt) {
   for (int i = 0; i < 50 && h.state()["frame"]["session"] != "s2"; ++i) std::this_thread::sleep_for(100ms);
   EXPECT_EQ(h.state()["frame"]["session"], "s2");
   EXPECT_EQ(h.state()["frame"]["source"], "odometry");
+}
+
+// A loop closed: the graph's path (its keyframes where the graph put them)
+// reaches the page, and the poses' path kept for it starts at the graph's
+// newest keyframe; the same graph again (its resend) is not news, a new one is.
+TEST(ConsoleGraphPath, TheGraphsPathReplacesThePosesPathUpToItsNewestKeyframe) {
+  Harness h;
+  ASSERT_TRUE(h.console_listens()) << "adit console did not listen on " << h.port;
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.endpoint->publish_status(daemon::StatusSample{});
+  for (int k = 0; k <= 20; ++k) {  // 1 s to 3 s, 0.2 m apart along x
+    daemon::PoseSample p;
+    p.utime = 1'000'000 + k * 100'000;
+    p.position = {0.2 * k, 0.0, 0.0};
+    p.flags = 1;  // pose_t.FLAG_VALID
+    ASSERT_TRUE(h.endpoint->publish_pose(p));
+  }
+  for (int i = 0; i < 50 && h.state()["path"].size() < 21; ++i) std::this_thread::sleep_for(100ms);
+  ASSERT_EQ(h.state()["path"].size(), 21U) << h.state()["path"].dump();
+  EXPECT_TRUE(h.state()["graph_path"].is_null());
+
+  // The keyframes at 1.0 .. 2.0 s, bent by the graph toward +y by `bend` per metre.
+  const auto graph = [](double bend) {
+    std::vector<std::int64_t> stamps;
+    std::vector<Eigen::Isometry3d> placed, odometry;
+    for (int k = 0; k <= 10; ++k) {
+      stamps.push_back(1'000'000'000 + k * 100'000'000);
+      Eigen::Isometry3d o = Eigen::Isometry3d::Identity(), g = Eigen::Isometry3d::Identity();
+      o.translation() = Eigen::Vector3d(0.2 * k, 0, 0);
+      g.translation() = Eigen::Vector3d(0.2 * k, bend * 0.2 * k, 0);
+      odometry.push_back(o);
+      placed.push_back(g);
+    }
+    return std::make_shared<const slam::CorrectionTrack>(stamps, placed, odometry);
+  };
+  const auto first = graph(0.1);
+  daemon::StatusSample closed;
+  closed.graph = first;
+  h.endpoint->publish_status(std::move(closed));
+  for (int i = 0; i < 50 && h.state()["graph_path"].is_null(); ++i) std::this_thread::sleep_for(100ms);
+  const nlohmann::json g = h.state()["graph_path"];
+  ASSERT_FALSE(g.is_null());
+  EXPECT_EQ(g["session"], "s1");
+  EXPECT_EQ(g["rev"], 1);
+  EXPECT_EQ(g["utime"], 2'000'000);
+  EXPECT_EQ(g["n_keyframes"], 11);
+  ASSERT_EQ(g["points"].size(), 11U);
+  EXPECT_NEAR(g["points"][10][0].get<double>(), 2.0, 1e-3);
+  EXPECT_NEAR(g["points"][10][1].get<double>(), 0.2, 1e-3);  // where the graph put it, not the odometry (0)
+  const nlohmann::json path = h.state()["path"];
+  ASSERT_EQ(path.size(), 11U) << path.dump();  // 2.0 .. 3.0 s: from the graph's newest keyframe on
+  for (const auto& p : path) EXPECT_GE(p[3].get<std::int64_t>(), 2'000'000) << p.dump();
+
+  daemon::StatusSample again;  // the same graph (the 2 Hz status): not a new revision
+  again.graph = first;
+  h.endpoint->publish_status(std::move(again));
+  auto announced = std::async(std::launch::async, [&] { return wait_for_event(h, "graph_path", "\"rev\":2"); });
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(h.state()["graph_path"]["rev"], 1);
+  daemon::StatusSample moved;
+  moved.graph = graph(0.2);
+  h.endpoint->publish_status(std::move(moved));
+  const std::string seen = announced.get();
+  EXPECT_NE(seen.find("\"rev\":2"), std::string::npos) << seen.substr(0, 2000);
+  EXPECT_NEAR(h.state()["graph_path"]["points"][10][1].get<double>(), 0.4, 1e-3);
 }
 
 }  // namespace

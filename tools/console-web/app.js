@@ -17,7 +17,7 @@ const pointBudget = Number(params.get('budget')) || 300000;
 
 // What the browser tests read (tests/console): latencies, poses, frames.
 const metrics = { latencies: [], poses: 0, lastSeq: -1, frames: 0, frameTimes: [], tileFetches: 0, tileBytes: 0,
-                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0, mapFrame: null };
+                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0, mapFrame: null, graphPaths: 0, graphPath: null };
 window.adit = { metrics };
 
 const view = new MapView(el('map'));
@@ -182,6 +182,7 @@ function applySnapshot(s) {
   // heard the payload yet knows no session (""): that is no new session.
   if (s.session && s.session !== mapSession) { view.clear(); queue.clear(); clearGrid(); mapSession = s.session; }
   if (s.frame) onFrame(s.frame);
+  if (s.graph_path) onGraphPath(s.graph_path);
   if (s.path.length >= view.pathCount) view.setPath(s.path);  // a restarted console knows less of it
   mapPoints = Math.max(mapPoints, s.map_points);
   for (const t of s.tiles) wantTile(t.id, t.v);
@@ -215,6 +216,15 @@ function onFrame(f) {
   if (lastPose) onPose(lastPose, false);
 }
 
+// The path as the pose graph placed it (a loop closed): drawn with the
+// tiles, which the graph moved too; the poses' path goes on from its end.
+function onGraphPath(g) {
+  if (mapSession && g.session && g.session !== mapSession) return;
+  metrics.graphPaths += 1;
+  metrics.graphPath = { rev: g.rev, utime: g.utime, n: g.points.length };
+  view.setGraphPath(g);
+}
+
 function connect() {
   const events = new EventSource('/api/events');
   events.onopen = () => { consoleUp = true; showBanner(); };
@@ -222,6 +232,7 @@ function connect() {
   events.addEventListener('hello', (e) => { consoleUp = true; applySnapshot(JSON.parse(e.data)); });
   events.addEventListener('pose', (e) => onPose(JSON.parse(e.data), true));
   events.addEventListener('frame', (e) => onFrame(JSON.parse(e.data)));
+  events.addEventListener('graph_path', (e) => onGraphPath(JSON.parse(e.data)));
   events.addEventListener('status', (e) => {
     const s = JSON.parse(e.data);
     mapPoints = Math.max(mapPoints, s.map_points);

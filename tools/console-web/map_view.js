@@ -7,7 +7,9 @@
 // the session's odometry frame, the tiles and the grid in the tiles' frame
 // (the odometry's, or the pose graph's when the loop closure moves the map),
 // each inside a group that the payload's frame (frame_t: the prior map's once
-// anchored) places in the map frame.
+// anchored) places in the map frame. Once a loop closed, the path up to the
+// graph's newest keyframe is the graph's (graph_path_t, in the tiles' frame,
+// moved with the map) and the poses' path goes on from there.
 import * as THREE from '/vendor/three/three.module.js';
 import { GridLayer } from './grid_layer.js';
 
@@ -54,6 +56,7 @@ export class MapView {
     this.zRange = null;
     this.pathCapacity = 1024;
     this.pathPositions = new Float32Array(this.pathCapacity * 3);
+    this.pathTimes = new Float64Array(this.pathCapacity);  // each point's pose utime (µs)
     this.pathCount = 0;
     this.pathGeometry = new THREE.BufferGeometry();
     this.pathGeometry.setAttribute('position', new THREE.BufferAttribute(this.pathPositions, 3));
@@ -61,6 +64,12 @@ export class MapView {
     this.path = new THREE.Line(this.pathGeometry, new THREE.LineBasicMaterial({ color: 0xffffff }));
     this.path.frustumCulled = false;
     this.world.add(this.path);
+    this.graphGeometry = new THREE.BufferGeometry();
+    this.graphPath = new THREE.Line(this.graphGeometry, this.path.material);
+    this.graphPath.frustumCulled = false;
+    this.graphPath.visible = false;
+    this.tilesWorld.add(this.graphPath);
+    this.graphTime = -Infinity;  // the graph path's newest keyframe (µs): the poses' path starts there
     const cone = new THREE.ConeBufferGeometry(0.5, 1.6, 12);
     cone.rotateZ(-Math.PI / 2);  // the cone points along the body's x axis
     this.marker = new THREE.Mesh(cone, new THREE.MeshBasicMaterial({ color: 0xff2bd6 }));
@@ -105,6 +114,8 @@ export class MapView {
     this.zRange = null;
     this.pathCount = 0;
     this.pathGeometry.setDrawRange(0, 0);
+    this.graphPath.visible = false;
+    this.graphTime = -Infinity;
     this.marker.visible = false;
     this.grid.clear();
     this.setFrame(null);
@@ -193,12 +204,36 @@ export class MapView {
     if (z > this.zRange[1]) this.zRange[1] = z;
   }
 
+  // Points [x, y, z, utime] in the odometry frame.
   setPath(points) {
     this.pathCount = 0;
-    for (const p of points) this.addPathPoint(p);
+    for (const p of points) this.addPathPoint(p, p[3]);
+    this.pathGeometry.setDrawRange(0, this.pathCount);
   }
 
-  addPathPoint(p) {
+  // The pose graph's path ({utime, points: [[x y z], ...]} in the tiles'
+  // frame): drawn with the tiles; the poses' path before its newest keyframe goes.
+  setGraphPath(g) {
+    const flat = new Float32Array(g.points.length * 3);
+    g.points.forEach((p, i) => flat.set(p, i * 3));
+    this.graphGeometry.setAttribute('position', new THREE.BufferAttribute(flat, 3));
+    this.graphGeometry.setDrawRange(0, g.points.length);
+    this.graphPath.visible = g.points.length > 1;
+    this.graphTime = g.utime;
+    let first = 0;
+    while (first < this.pathCount && this.pathTimes[first] < g.utime) first += 1;
+    if (first > 0) {
+      this.pathPositions.copyWithin(0, first * 3, this.pathCount * 3);
+      this.pathTimes.copyWithin(0, first, this.pathCount);
+      this.pathCount -= first;
+      this.pathGeometry.attributes.position.needsUpdate = true;
+      this.pathGeometry.setDrawRange(0, this.pathCount);
+    }
+    this.dirty = true;
+  }
+
+  addPathPoint(p, t) {
+    if (t < this.graphTime) return;  // the graph's path holds it
     if (this.pathCount > 0) {
       const i = (this.pathCount - 1) * 3;
       const dx = p[0] - this.pathPositions[i], dy = p[1] - this.pathPositions[i + 1], dz = p[2] - this.pathPositions[i + 2];
@@ -209,9 +244,13 @@ export class MapView {
       const bigger = new Float32Array(this.pathCapacity * 3);
       bigger.set(this.pathPositions);
       this.pathPositions = bigger;
+      const times = new Float64Array(this.pathCapacity);
+      times.set(this.pathTimes);
+      this.pathTimes = times;
       this.pathGeometry.setAttribute('position', new THREE.BufferAttribute(this.pathPositions, 3));
     }
-    this.pathPositions.set(p, this.pathCount * 3);
+    this.pathPositions.set([p[0], p[1], p[2]], this.pathCount * 3);
+    this.pathTimes[this.pathCount] = t;
     this.pathCount += 1;
     this.pathGeometry.attributes.position.needsUpdate = true;
     this.pathGeometry.setDrawRange(0, this.pathCount);
@@ -221,7 +260,7 @@ export class MapView {
     this.marker.position.set(pose.p[0], pose.p[1], pose.p[2]);
     this.marker.quaternion.set(pose.q[1], pose.q[2], pose.q[3], pose.q[0]);  // three.js: x y z w
     this.marker.visible = true;
-    if (pose.valid) this.addPathPoint(pose.p);
+    if (pose.valid) this.addPathPoint(pose.p, pose.utime);
     this.poseDirty = true;
     this.dirty = true;
   }
@@ -270,7 +309,7 @@ export class MapView {
     // From above, the grid (and the path and pose on it) over the points: the roof would hide them.
     const overlay = this.mode === 'top' && this.grid.visible && this.grid.version() > 0;
     this.grid.setOnTop(overlay);
-    for (const o of [this.path, this.marker]) {
+    for (const o of [this.path, this.graphPath, this.marker]) {
       o.material.depthTest = !overlay;
       o.renderOrder = overlay ? 2 : 0;
     }

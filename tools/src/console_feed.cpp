@@ -1,6 +1,7 @@
 #include "console_feed.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "adit/common/clock.hpp"
@@ -84,6 +85,17 @@ nlohmann::json frame_json(const frame_t& f) {
           {"tq", {f.tiles_orientation[0], f.tiles_orientation[1], f.tiles_orientation[2], f.tiles_orientation[3]}}};
 }
 
+nlohmann::json graph_path_json(const graph_path_t& g) {
+  nlohmann::json points = nlohmann::json::array();
+  const auto mm = [](float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; };  // shorter JSON
+  for (const auto& p : g.positions) points.push_back({mm(p[0]), mm(p[1]), mm(p[2])});
+  return {{"session", g.session_id},
+          {"rev", g.revision},
+          {"utime", g.utime},
+          {"n_keyframes", g.n_keyframes},
+          {"points", std::move(points)}};
+}
+
 LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)
     : options_(std::move(options)), hub_(hub), client_(std::make_unique<LcmClient>(options_)) {
   last_status_ms_ = now_ms();  // silent since the console started, until a status arrives
@@ -101,7 +113,8 @@ void LiveFeed::run() {
                    .tile_index = [this](const tile_index_t& m) { on_index(m); },
                    .tile_segment = [this](const tile_segment_t& m) { on_segment(m); },
                    .grid_patch = [this](const grid_patch_t& m) { on_grid(m); },
-                   .frame = [this](const frame_t& m) { on_frame(m); }},
+                   .frame = [this](const frame_t& m) { on_frame(m); },
+                   .graph_path = [this](const graph_path_t& m) { on_graph_path(m); }},
                   [this] {
                     tick();
                     return stop_.load();
@@ -115,6 +128,8 @@ void LiveFeed::switch_session(const std::string& session) {
   changes_.clear();
   pending_event_.clear();
   path_.clear();
+  graph_path_.reset();
+  graph_utime_ = 0;
   index_received_ = false;
   grid_ = {};
   grid_changed_ = false;
@@ -136,10 +151,10 @@ void LiveFeed::on_pose(const pose_t& p) {
         const float dx = at[0] - last[0], dy = at[1] - last[1], dz = at[2] - last[2];
         return dx * dx + dy * dy + dz * dz >= kPathStepM * kPathStepM;
       };
-      if (path_.empty() || far(path_.back())) {
-        path_.push_back(at);
+      if (p.utime >= graph_utime_ && (path_.empty() || far(path_.back().at))) {
+        path_.push_back({at, p.utime});
         if (path_.size() > kPathMax) {
-          std::vector<std::array<float, 3>> halved;
+          std::vector<PathPoint> halved;
           for (std::size_t i = 0; i < path_.size(); i += 2) halved.push_back(path_[i]);
           path_ = std::move(halved);
         }
@@ -177,6 +192,22 @@ void LiveFeed::on_frame(const frame_t& f) {
     frame_ = j;
   }
   hub_.publish("frame", j.dump());
+}
+
+// Announced when the graph changed (it comes again every 5 s unchanged). The
+// poses' path before its newest keyframe is dropped: the graph's is drawn there.
+void LiveFeed::on_graph_path(const graph_path_t& g) {
+  if (g.payload_id != options_.payload_id || g.session_id.empty()) return;
+  nlohmann::json j = graph_path_json(g);
+  {
+    const std::lock_guard lock(mutex_);
+    switch_session(g.session_id);
+    if (graph_path_ && (*graph_path_)["rev"] == j["rev"] && (*graph_path_)["utime"] == j["utime"]) return;
+    graph_path_ = j;
+    graph_utime_ = g.utime;
+    std::erase_if(path_, [&](const PathPoint& p) { return p.utime < g.utime; });
+  }
+  hub_.publish("graph_path", j.dump());
 }
 
 void LiveFeed::on_index(const tile_index_t& m) {
@@ -262,7 +293,7 @@ void LiveFeed::tick() {
 nlohmann::json LiveFeed::snapshot() const {
   const std::lock_guard lock(mutex_);
   nlohmann::json path = nlohmann::json::array();
-  for (const auto& p : path_) path.push_back({p[0], p[1], p[2]});
+  for (const auto& p : path_) path.push_back({p.at[0], p.at[1], p.at[2], p.utime});
   nlohmann::json tiles = nlohmann::json::array();
   std::size_t points = 0;
   for (const auto& [id, changes] : changes_) {
@@ -279,6 +310,7 @@ nlohmann::json LiveFeed::snapshot() const {
           {"pose", pose_ ? *pose_ : nlohmann::json()},
           {"frame", frame_ ? *frame_ : nlohmann::json()},
           {"path", path},
+          {"graph_path", graph_path_ ? *graph_path_ : nlohmann::json()},
           {"tiles", tiles},
           {"map_points", points},
           {"grid", grid_.patch_count() == 0

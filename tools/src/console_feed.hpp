@@ -10,6 +10,9 @@
 //   tiles    the tiles completed at a new version, at most every 250 ms
 //   grid     the grid changed (its version), at most every 500 ms
 //   session  the payload's session changed (the browser clears its map)
+//   graph_path  the pose graph placed the path anew (a loop closed): its
+//            keyframes, in the tiles' frame; the path kept from the poses
+//            starts at its newest keyframe from then on
 //   link     the payload stopped answering (no status for 2 s) or came back
 
 #include <atomic>
@@ -38,6 +41,9 @@ nlohmann::json pose_json(const pose_t& p, std::int64_t received_ms);
 // the page's path and pose through it; map <- tiles as "tp", "tq", the tiles
 // and the grid through it.
 nlohmann::json frame_json(const frame_t& f);
+// graph_path_t for the page: {"session", "rev", "utime" (the newest
+// keyframe's, µs), "n_keyframes", "points": [[x y z], ...]}.
+nlohmann::json graph_path_json(const graph_path_t& g);
 
 // A tile's points for a browser: segments `from` .. n-1 at `version`, every
 // `every`-th point (x y z as float32, little-endian, per segment a uint32
@@ -71,6 +77,7 @@ class LiveFeed {
   void on_pose(const pose_t& p);
   void on_status(const status_t& s);
   void on_frame(const frame_t& f);
+  void on_graph_path(const graph_path_t& g);
   void on_index(const tile_index_t& m);
   void on_segment(const tile_segment_t& m);
   void on_grid(const grid_patch_t& m);
@@ -86,7 +93,15 @@ class LiveFeed {
   std::optional<nlohmann::json> status_;
   std::optional<nlohmann::json> pose_;
   std::optional<nlohmann::json> frame_;  // the session's, once its frame_t came
-  std::vector<std::array<float, 3>> path_;
+  // The path from the poses: a point per kPathStepM travelled, with its
+  // pose's utime; from the graph's newest keyframe on once a graph path came.
+  struct PathPoint {
+    std::array<float, 3> at{};
+    std::int64_t utime = 0;
+  };
+  std::vector<PathPoint> path_;
+  std::optional<nlohmann::json> graph_path_;  // the session's latest graph_path_t
+  std::int64_t graph_utime_ = 0;              // its newest keyframe's time
   protocol::TileAssembler tiles_;
   // Per tile, the completions seen: (version before, version, first segment replaced).
   struct Change {

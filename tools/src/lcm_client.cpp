@@ -171,6 +171,7 @@ void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool(
   const auto segments = listen(Channel::tile, handlers.tile_segment);
   const auto grid = listen(Channel::grid, handlers.grid_patch);
   const auto frames = listen(Channel::frame, handlers.frame);
+  const auto graph_paths = listen(Channel::graph_path, handlers.graph_path);
   while (!until()) impl_->handle_for(0.05);
 }
 

@@ -15,6 +15,7 @@
 
 #include "adit/command_ack_t.hpp"
 #include "adit/frame_t.hpp"
+#include "adit/graph_path_t.hpp"
 #include "adit/grid_patch_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/tile_assembler.hpp"
@@ -63,6 +64,7 @@ class LcmClient {
     std::function<void(const tile_segment_t&)> tile_segment;
     std::function<void(const grid_patch_t&)> grid_patch;
     std::function<void(const frame_t&)> frame;
+    std::function<void(const graph_path_t&)> graph_path;
   };
   // Calls the handlers for every message until `until` returns true (checked
   // at least every 50 ms).
