@@ -3,11 +3,19 @@
 // sent before a closure go again with their points moved, the status's frame
 // places the poses by the latest correction and the tiles by none, at the
 // end the tiles as a client holds them lie where the exported map does, and
-// so do the stored tiles a download after a restart gets.
+// so do the stored tiles a download after a restart gets. A tiles_graph/ that
+// cannot be written costs the session none of its map files.
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -21,6 +29,7 @@
 #include "adit/common/quantile.hpp"
 #include "adit/config/load.hpp"
 #include "adit/daemon/mapping_stage.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/daemon/sessions.hpp"
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/daemon/tile_store.hpp"
@@ -67,21 +76,25 @@ std::vector<double> nearest_distances(const std::vector<Eigen::Vector3d>& points
   return out;
 }
 
-TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExportIs) {
-  const std::filesystem::path session = loop_session();
-  const std::filesystem::path work = test::binary_dir() / "live-tiles-follow-loops";
+// aditd's configuration for the loop drive in a fresh `work` folder: the
+// LiDAR's mounting given 3° off in yaw (a bracket turned on its bolts), so the
+// odometry drifts round the floor and the loops pull the map back.
+std::filesystem::path loop_config(const std::string& name) {
+  const std::filesystem::path work = test::binary_dir() / name;
   std::filesystem::remove_all(work);
   std::filesystem::create_directories(work);
-  const std::filesystem::path config_file = work / "aditd.yaml";
-  // The LiDAR's mounting given 3° off in yaw (a bracket turned on its bolts):
-  // the odometry drifts round the floor and the loops pull the map back.
   std::string yaml = test::aditd_yaml_for(
-      session, work / "state",
+      loop_session(), work / "state",
       {"", "", true, "map:\n  loops_move_map: true\nsession:\n  exports: [ply]\nthreads:\n  lock_memory: false\n"});
   const std::size_t rpy = yaml.find("rpy_deg: [0, 0, 0]");
-  ASSERT_NE(rpy, std::string::npos) << yaml;
+  if (rpy == std::string::npos) throw std::runtime_error("no mounting rpy_deg in the simulated session's yaml");
   yaml.replace(rpy, 18, "rpy_deg: [0, 0, 3]");
-  std::ofstream(config_file) << yaml;
+  std::ofstream(work / "aditd.yaml") << yaml;
+  return work / "aditd.yaml";
+}
+
+TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExportIs) {
+  const std::filesystem::path config_file = loop_config("live-tiles-follow-loops");
 
   std::mutex mutex;
   std::map<std::int64_t, std::vector<protocol::MapPoint>> first, newest;  // per tile: its first and newest update
@@ -103,6 +116,7 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
       ++frames_with_correction;
       EXPECT_EQ(status.frame->tiles_position, (std::array<double, 3>{0, 0, 0}));
       EXPECT_EQ(status.frame->tiles_orientation, (std::array<double, 4>{1, 0, 0, 0}));
+      EXPECT_NE(status.graph, nullptr) << "the graph's path (graph_path_t) goes with its correction";
     }
     std::this_thread::sleep_for(20ms);
   }
@@ -181,6 +195,71 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   EXPECT_EQ(placed->tiles_position, (std::array<double, 3>{0, 0, 0}));
   EXPECT_GT(std::hypot(placed->position[0], placed->position[1], placed->position[2]), 0.0)
       << "the poses are placed by the graph's last correction";
+}
+
+// A folder nothing may be written in, not even by root (the ext4 immutable
+// flag, as `chattr +i`), lifted again when the test ends.
+class ImmutableFolder {
+ public:
+  explicit ImmutableFolder(std::filesystem::path dir) : dir_(std::move(dir)) {
+    std::filesystem::create_directories(dir_);
+    set(true);
+  }
+  ~ImmutableFolder() {
+    if (held_) set(false);
+  }
+  ImmutableFolder(const ImmutableFolder&) = delete;
+  ImmutableFolder& operator=(const ImmutableFolder&) = delete;
+  bool held() const { return held_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  void set(bool on) {
+    const int fd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY);
+    int flags = 0;
+    if (fd < 0 || ::ioctl(fd, FS_IOC_GETFLAGS, &flags) != 0) {
+      problem_ = std::strerror(errno);
+    } else {
+      flags = on ? (flags | FS_IMMUTABLE_FL) : (flags & ~FS_IMMUTABLE_FL);
+      if (::ioctl(fd, FS_IOC_SETFLAGS, &flags) == 0) held_ = on;
+      else problem_ = std::strerror(errno);
+    }
+    if (fd >= 0) ::close(fd);
+  }
+  std::filesystem::path dir_;
+  bool held_ = false;
+  std::string problem_;
+};
+
+// A tiles_graph/ that cannot be written at the session's end (here: its
+// partial folder made immutable; on a payload, a full disk): the map files
+// are written all the same, no tiles_graph/ is left, and a download after a
+// restart is served from tiles/, in the odometry's frame.
+TEST(LiveTilesFollowLoops, AGraphTilesFolderThatCannotBeWrittenCostsNoMapFile) {
+  const std::filesystem::path config_file = loop_config("live-tiles-graph-unwritable");
+  Sessions sessions(config::load_config(config_file), Sessions::Outputs{});
+  const std::string id = sessions.start();
+  const std::filesystem::path folder = sessions.folder(id);
+  const ImmutableFolder blocked(folder / kGraphTilesPartialFolder);
+  if (!blocked.held())
+    GTEST_SKIP() << "cannot make a folder immutable here (" << blocked.problem() << "): needs root on ext4";
+  const auto deadline = std::chrono::steady_clock::now() + 300s;
+  while (!sessions.poll() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(20ms);
+  sessions.stop_and_wait();
+
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(folder / "summary.json"));
+  ASSERT_GE(summary["loops"]["accepted"].get<int>(), 1) << "the drive closed no loop";
+  EXPECT_TRUE(summary["loops"]["map_moved"].get<bool>());
+  const std::vector<test::XyzI> exported = test::read_ply(folder / "map.ply");
+  EXPECT_GT(exported.size(), 100'000U);
+  EXPECT_FALSE(std::filesystem::exists(folder / kGraphTilesFolder));
+  EXPECT_TRUE(std::filesystem::is_empty(folder / kGraphTilesPartialFolder));
+
+  Sessions restarted(config::load_config(config_file), Sessions::Outputs{});
+  TileStore stored(stored_tile_params(20.0));
+  ASSERT_EQ(restarted.load_tiles(id, stored), "");
+  EXPECT_EQ(stored.total_points(), static_cast<std::int64_t>(exported.size())) << "tiles/ holds the map's points";
+  EXPECT_FALSE(restarted.stored_frame(id).has_value()) << "tiles/ is in the odometry frame: no frame to place it";
 }
 
 }  // namespace
