@@ -216,6 +216,9 @@ export class MapView {
   setGraphPath(g) {
     const flat = new Float32Array(g.points.length * 3);
     g.points.forEach((p, i) => flat.set(p, i * 3));
+    this.graphGeometry.dispose();  // frees the last path's GPU buffer (a new one per loop closed)
+    this.graphGeometry = new THREE.BufferGeometry();
+    this.graphPath.geometry = this.graphGeometry;
     this.graphGeometry.setAttribute('position', new THREE.BufferAttribute(flat, 3));
     this.graphGeometry.setDrawRange(0, g.points.length);
     this.graphPath.visible = g.points.length > 1;
