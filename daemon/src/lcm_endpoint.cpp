@@ -116,10 +116,10 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   GridPublisher grid_publisher;
   std::int64_t pose_seq = 0;
   MapFrame frame;  // the current (or last) session's, sent with each status
-  // The current (or last) session's graph: its path goes out when it changes
-  // and every kGraphPathResendS after.
+  // The current (or last) session's graph and its path, built once per
+  // graph: sent when it changes and again every kGraphPathResendS.
   std::shared_ptr<const slam::CorrectionTrack> graph;
-  std::int32_t graph_revision = 0;
+  graph_path_t graph_msg{};  // value-initialised: lcm-gen leaves numbers unset
   Clock::time_point graph_sent{};
   std::string stored_session;                // a stored session whose tiles the publisher holds
   std::optional<MapFrame> stored_frame;      // its frame (hooks.stored_frame)
@@ -370,7 +370,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       pose_seq = 0;
       frame = MapFrame{};
       graph.reset();
-      graph_revision = 0;
+      graph_msg.revision = 0;
       ack.reason += ": session " + session_id;
     } else if (event == protocol::SessionEvent::stop && hooks.stop) {
       hooks.stop();
@@ -440,31 +440,31 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       const bool changed = s.graph != nullptr && s.graph != graph;
       if (changed) {
         graph = std::move(s.graph);
-        ++graph_revision;
+        build_graph_path();
       }
       if (graph != nullptr && !session_id.empty() &&
-          (changed || Clock::now() - graph_sent >= std::chrono::duration<double>(kGraphPathResendS)))
-        send_graph_path();
+          (changed || Clock::now() - graph_sent >= std::chrono::duration<double>(kGraphPathResendS))) {
+        send(Channel::graph_path, graph_msg);
+        graph_sent = Clock::now();
+        ++counters.graph_paths_published;
+      }
     }
   }
 
-  // The graph's keyframes for a client that draws the path with the map the
-  // loops moved (graph_path.hpp, docs/PROTOCOL.md).
-  void send_graph_path() {
+  // The new graph's keyframes for a client that draws the path with the map
+  // the loops moved (graph_path.hpp, docs/PROTOCOL.md), its next revision.
+  void build_graph_path() {
     const GraphPath path = graph_path_of(*graph);
-    graph_path_t m;
-    m.utime = path.utime;
-    m.schema = 1;
-    m.payload_id = options.payload_id;
-    m.session_id = session_id;
-    m.revision = graph_revision;
-    m.n_keyframes = path.n_keyframes;
-    m.n = static_cast<std::int32_t>(path.positions.size());
-    m.positions.reserve(path.positions.size());
-    for (const auto& p : path.positions) m.positions.push_back({p[0], p[1], p[2]});
-    send(Channel::graph_path, m);
-    graph_sent = Clock::now();
-    ++counters.graph_paths_published;
+    graph_msg.utime = path.utime;
+    graph_msg.schema = 1;
+    graph_msg.payload_id = options.payload_id;
+    graph_msg.session_id = session_id;
+    ++graph_msg.revision;
+    graph_msg.n_keyframes = path.n_keyframes;
+    graph_msg.n = static_cast<std::int32_t>(path.positions.size());
+    graph_msg.positions.clear();
+    graph_msg.positions.reserve(path.positions.size());
+    for (const auto& p : path.positions) graph_msg.positions.push_back({p[0], p[1], p[2]});
   }
 
   // The session's frame, for a client that draws its poses and tiles in the

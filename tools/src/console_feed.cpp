@@ -129,6 +129,7 @@ void LiveFeed::switch_session(const std::string& session) {
   pending_event_.clear();
   path_.clear();
   graph_path_.reset();
+  graph_revision_ = 0;
   graph_utime_ = 0;
   index_received_ = false;
   grid_ = {};
@@ -198,16 +199,18 @@ void LiveFeed::on_frame(const frame_t& f) {
 // poses' path before its newest keyframe is dropped: the graph's is drawn there.
 void LiveFeed::on_graph_path(const graph_path_t& g) {
   if (g.payload_id != options_.payload_id || g.session_id.empty()) return;
-  nlohmann::json j = graph_path_json(g);
+  std::string event;
   {
     const std::lock_guard lock(mutex_);
     switch_session(g.session_id);
-    if (graph_path_ && (*graph_path_)["rev"] == j["rev"] && (*graph_path_)["utime"] == j["utime"]) return;
-    graph_path_ = j;
+    if (graph_path_ && g.revision == graph_revision_ && g.utime == graph_utime_) return;
+    graph_path_ = graph_path_json(g);
+    graph_revision_ = g.revision;
     graph_utime_ = g.utime;
     std::erase_if(path_, [&](const PathPoint& p) { return p.utime < g.utime; });
+    event = graph_path_->dump();
   }
-  hub_.publish("graph_path", j.dump());
+  hub_.publish("graph_path", std::move(event));
 }
 
 void LiveFeed::on_index(const tile_index_t& m) {

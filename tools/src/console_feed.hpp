@@ -101,6 +101,7 @@ class LiveFeed {
   };
   std::vector<PathPoint> path_;
   std::optional<nlohmann::json> graph_path_;  // the session's latest graph_path_t
+  std::int32_t graph_revision_ = 0;           // its revision
   std::int64_t graph_utime_ = 0;              // its newest keyframe's time
   protocol::TileAssembler tiles_;
   // Per tile, the completions seen: (version before, version, first segment replaced).
