@@ -41,8 +41,8 @@ ImuSource* imu_source_of(const config::Config& c, CanFeed* can, LidarSource& sou
 }
 
 // One localisation try gathers this many scans (1 s of a 10 Hz LiDAR, as the
-// benchmark's starts) and at most this many points (at the map's resolution a
-// VLP-16 scan has a few thousand).
+// benchmark's starts) and at most this many points in each of its two windows
+// (at the map's resolution a VLP-16 scan has a few thousand).
 constexpr int kPriorScansPerTry = 10;
 constexpr std::size_t kPriorCloudPoints = 400'000;
 

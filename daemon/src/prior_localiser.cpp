@@ -41,7 +41,7 @@ PriorLocaliser::PriorLocaliser(slam::PriorMap prior, int scans_per_try, std::siz
       localisation_(confirm ? slam::confirmed_localisation() : slam::LocalisationConfig{}),
       confirmation_(localisation_),
       thread_("prior", config::ThreadSettings{}, stop) {
-  cloud_.reserve(max_points);
+  for (Window& w : windows_) w.cloud.reserve(max_points);
 }
 
 PriorLocaliser::~PriorLocaliser() { join(); }
@@ -58,10 +58,14 @@ void PriorLocaliser::join() {
 
 void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eigen::Isometry3d& sensor,
                               const std::optional<Eigen::Vector3d>& up, std::int64_t stamp_ns) {
-  if (state_.load(std::memory_order_acquire) != kFilling) return;
+  if (progress_.load(std::memory_order_acquire) != kSearching) return;
+  Window& window = windows_[static_cast<std::size_t>(filling_)];
+  if (window.state.load(std::memory_order_acquire) != kFree) return;  // both windows are the prior thread's
+  // A failure's pass-over (posted before its window was freed) and a hint
+  // count from the next window's beginning, not within one.
   if (const int n = pass_over_.exchange(0, std::memory_order_relaxed); n > 0) skip_ = n;
   if (hint_arrived_.exchange(false, std::memory_order_relaxed)) skip_ = 0;  // a new hint is tried at once
-  if (skip_ > 0) {
+  if (scans_ == 0 && skip_ > 0) {
     --skip_;
     return;
   }
@@ -70,21 +74,23 @@ void PriorLocaliser::add_scan(std::span<const Eigen::Vector3f> points, const Eig
     return;
   }
   if (first_stamp_ns_ == 0) first_stamp_ns_ = stamp_ns;
-  const std::size_t room = cloud_.capacity() - cloud_.size();
-  cloud_.insert(cloud_.end(), points.begin(), points.begin() + static_cast<std::ptrdiff_t>(std::min(room, points.size())));
+  std::vector<Eigen::Vector3f>& cloud = window.cloud;
+  const std::size_t room = cloud.capacity() - cloud.size();
+  cloud.insert(cloud.end(), points.begin(), points.begin() + static_cast<std::ptrdiff_t>(std::min(room, points.size())));
   if (++scans_ < scans_per_try_) return;
   // A levelled frame at the sensor now, as a crew's start would be, and the
   // sensor's heading in it (a hint gives the heading in the prior's frame).
-  level_from_odometry_ = slam::levelled_frame_at(*up, sensor.translation());
-  const Eigen::Vector3d forward = level_from_odometry_.linear() * sensor.linear().col(0);
-  sensor_heading_rad_ = std::atan2(forward.y(), forward.x());
+  window.level_from_odometry = slam::levelled_frame_at(*up, sensor.translation());
+  const Eigen::Vector3d forward = window.level_from_odometry.linear() * sensor.linear().col(0);
+  window.sensor_heading_rad = std::atan2(forward.y(), forward.x());
   scans_ = 0;
-  state_.store(kLocalising, std::memory_order_release);
+  window.state.store(kReady, std::memory_order_release);
+  filling_ = 1 - filling_;
 }
 
 std::optional<Eigen::Isometry3d> PriorLocaliser::take_anchor(std::int64_t stamp_ns) {
-  if (state_.load(std::memory_order_acquire) != kFound) return std::nullopt;
-  state_.store(kAnchored, std::memory_order_relaxed);
+  if (progress_.load(std::memory_order_acquire) != kFound) return std::nullopt;
+  progress_.store(kAnchored, std::memory_order_relaxed);
   stats_.anchored_after_s.store(1e-9 * static_cast<double>(stamp_ns - first_stamp_ns_), std::memory_order_relaxed);
   stats_.anchored.store(true, std::memory_order_release);
   return anchor_;
@@ -101,35 +107,37 @@ void PriorLocaliser::loop() {
                 "for localisation; waiting for one");
       said_no_up = true;
     }
-    if (state_.load(std::memory_order_acquire) != kLocalising) {
+    Window& window = windows_[static_cast<std::size_t>(searching_)];
+    if (window.state.load(std::memory_order_acquire) != kReady) {
       std::this_thread::sleep_for(kPoll);
       continue;
     }
-    const Eigen::Isometry3f to_level = level_from_odometry_.cast<float>();
-    for (Eigen::Vector3f& p : cloud_) p = to_level * p;
-    const std::optional<slam::LocalisationHint> hint = search_hint();
-    const slam::LocalisationResult found = slam::localise(cloud_, prior_, index_, hint, localisation_);
+    const Eigen::Isometry3f to_level = window.level_from_odometry.cast<float>();
+    for (Eigen::Vector3f& p : window.cloud) p = to_level * p;
+    const std::optional<slam::LocalisationHint> hint = search_hint(window);
+    const slam::LocalisationResult found = slam::localise(window.cloud, prior_, index_, hint, localisation_);
     if (hint) stats_.hinted_tries.fetch_add(1, std::memory_order_relaxed);
     stats_.tries.fetch_add(1, std::memory_order_relaxed);
-    cloud_.clear();
+    window.cloud.clear();
+    searching_ = 1 - searching_;
     if (!found.success) {
       log::info("prior: not localised yet ({}); trying again with later scans", found.failure);
-      // Counted, then handed back: the odometry thread sees the count and the
-      // scans to pass over with the buffer. None while a found pose waits.
+      // Counted, then the window freed: the odometry thread sees the count and
+      // the scans to pass over with it. None while a found pose waits.
       const std::uint64_t failures = stats_.failures.fetch_add(1, std::memory_order_relaxed) + 1;
       pass_over_.store(scans_passed_over(failures, scans_per_try_, confirmation_.waiting()), std::memory_order_relaxed);
-      state_.store(kFilling, std::memory_order_release);
+      window.state.store(kFree, std::memory_order_release);
       continue;
     }
-    const Eigen::Isometry3d anchor = found.pose * level_from_odometry_;
+    const Eigen::Isometry3d anchor = found.pose * window.level_from_odometry;
     const Eigen::Vector3d t = found.pose.translation();
     const bool disagrees = confirmation_.waiting();
-    if (confirm_ && !confirmation_.agrees(anchor, level_from_odometry_.inverse())) {
+    if (confirm_ && !confirmation_.agrees(anchor, window.level_from_odometry.inverse())) {
       log::info("prior: found ({:.2f}, {:.2f}, {:.2f}) m in the prior's frame, overlap {:.2f}{}; taken once the next "
                 "try agrees",
                 t.x(), t.y(), t.z(), found.overlap, disagrees ? ", not where the try before found" : "");
       stats_.unconfirmed.fetch_add(1, std::memory_order_relaxed);
-      state_.store(kFilling, std::memory_order_release);  // not a failure: the next scans at once
+      window.state.store(kFree, std::memory_order_release);  // not a failure: nothing passed over
       continue;
     }
     anchor_ = anchor;
@@ -137,7 +145,7 @@ void PriorLocaliser::loop() {
               "{:.3f} m{}; the odometry registers against the prior from its next scan",
               t.x(), t.y(), t.z(), found.overlap, found.position_sigma_m, confirm_ ? ", where the try before found" : "");
     write_frame(anchor_);
-    state_.store(kFound, std::memory_order_release);
+    progress_.store(kFound, std::memory_order_release);
     break;  // one anchor a session
   }
 }
@@ -152,8 +160,7 @@ void PriorLocaliser::write_frame(const Eigen::Isometry3d& prior_from_odometry) c
 }
 
 std::string PriorLocaliser::set_hint(const protocol::LocaliseHint& hint) {
-  const int state = state_.load(std::memory_order_acquire);
-  if (state == kFound || state == kAnchored) return "already localised in the prior map";
+  if (progress_.load(std::memory_order_acquire) != kSearching) return "already localised in the prior map";
   {
     const std::lock_guard lock(hint_mutex_);
     hint_ = hint;
@@ -166,16 +173,16 @@ std::string PriorLocaliser::set_hint(const protocol::LocaliseHint& hint) {
 }
 
 // Prior thread: the hint as the search takes it. Its heading is the sensor's;
-// the search turns the levelled frame, whose x is the sensor's heading less
-// sensor_heading_rad_.
-std::optional<slam::LocalisationHint> PriorLocaliser::search_hint() const {
+// the search turns the window's levelled frame, whose x is the sensor's
+// heading less its sensor_heading_rad.
+std::optional<slam::LocalisationHint> PriorLocaliser::search_hint(const Window& window) const {
   const std::lock_guard lock(hint_mutex_);
   if (!hint_) return std::nullopt;
   slam::LocalisationHint h;
   h.position = Eigen::Vector2d(hint_->x_m, hint_->y_m);
   h.radius_m = hint_->radius_m;
   if (hint_->heading_deg) {
-    h.yaw_rad = *hint_->heading_deg * std::numbers::pi / 180.0 - sensor_heading_rad_;
+    h.yaw_rad = *hint_->heading_deg * std::numbers::pi / 180.0 - window.sensor_heading_rad;
     h.yaw_tolerance_rad = hint_->heading_tolerance_deg * std::numbers::pi / 180.0;
   } else {
     h.yaw_tolerance_rad = std::numbers::pi;  // any heading
@@ -184,8 +191,7 @@ std::optional<slam::LocalisationHint> PriorLocaliser::search_hint() const {
 }
 
 std::optional<Eigen::Isometry3d> PriorLocaliser::anchor() const {
-  const int state = state_.load(std::memory_order_acquire);
-  if (state != kFound && state != kAnchored) return std::nullopt;
+  if (progress_.load(std::memory_order_acquire) == kSearching) return std::nullopt;
   return anchor_;  // written before kFound was released, never after
 }
 

@@ -2,8 +2,9 @@
 // odometry thread's scans, in an odometry frame that is neither the prior's
 // nor level, are localised on thread "prior" and the anchor handed back once,
 // after a second try agreed with the first (prior_map.confirm);
-// a prior of another building is never anchored to, and the buffer comes back
-// for another try; scans without an up are not used. Runs under TSan in CI.
+// a prior of another building is never anchored to, and tries come less often;
+// the next window is gathered while a try searches; scans without an up are
+// not used. Runs under TSan in CI.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -68,7 +69,7 @@ TEST(PriorLocaliser, AnchorsTheOdometryFrameInThePriorOnceAndWritesIt) {
   for (int k = 0; k < 3; ++k) localiser.add_scan(f.points, f.sensor, f.up, 1'000'000'000LL + k * 100'000'000LL);
   // Found, but not taken until the next try agrees.
   ASSERT_TRUE(wait_for([&] { return localiser.stats().unconfirmed.load() == 1U; }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the buffer is handed back just after
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the window is freed just after
   EXPECT_FALSE(localiser.take_anchor(1'300'000'000LL));
   // A second later, a metre on and turned: the same anchor.
   const Feed g = feed_at(5.0, 5.6, 0.7);
@@ -116,12 +117,37 @@ TEST(PriorLocaliser, AnotherBuildingIsNeverAnchoredToAndTriesComeLessOften) {
       localiser.add_scan(f.points, f.sensor, f.up, scans * 100'000'000LL);
     }
     ASSERT_TRUE(wait_for([&] { return localiser.stats().failures.load() == static_cast<std::uint64_t>(attempt); }));
-    // The failure is counted just before the buffer is handed back (prior_localiser.cpp).
+    // The failure is counted just before its window is freed (prior_localiser.cpp).
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
   EXPECT_EQ(localiser.stats().tries.load(), 3U);
   EXPECT_FALSE(localiser.take_anchor(0));
   EXPECT_FALSE(localiser.stats().anchored.load());
+}
+
+// Two windows (decision 058): scans that arrive while a try searches go into
+// the next window, which is searched as soon as that try ends; scans that
+// arrive while both windows are the prior thread's are passed over.
+TEST(PriorLocaliser, TheNextWindowIsGatheredWhileATrySearches) {
+  const std::atomic<bool> stop{false};
+  PriorLocaliser localiser(slam::prepare_prior_map(sample_plan(other_building(), 30, 20, 0.1)), 2, 200'000, stop);
+  localiser.start({});
+  const Feed f = feed_at(4.0, 5.0);
+  // Six scans at once, before the prior thread (polling every 50 ms, a search
+  // taking far longer than six insertions) can have ended its first search:
+  // windows 1 and 2, then two passed over.
+  for (int k = 0; k < 6; ++k) localiser.add_scan(f.points, f.sensor, f.up, k * 100'000'000LL);
+  // No scan after them: the second try's window was gathered during the first.
+  ASSERT_TRUE(wait_for([&] { return localiser.stats().failures.load() == 2U; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(localiser.stats().tries.load(), 2U);  // the last two scans made no third window
+  // After the second failure 2 × 2 scans are passed over before the next window begins.
+  for (int k = 6; k < 11; ++k) localiser.add_scan(f.points, f.sensor, f.up, k * 100'000'000LL);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(localiser.stats().tries.load(), 2U);
+  localiser.add_scan(f.points, f.sensor, f.up, 11 * 100'000'000LL);
+  ASSERT_TRUE(wait_for([&] { return localiser.stats().tries.load() == 3U; }));
+  EXPECT_FALSE(localiser.take_anchor(0));
 }
 
 TEST(PriorLocaliser, ScansWithoutAnUpAreNotUsed) {

@@ -19,6 +19,8 @@
 #include "bench_prior_map.hpp"
 
 #include <algorithm>
+#include <deque>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -222,40 +224,85 @@ int run(const Options& o) {
                  start.scan, r.success ? (start.within ? "found " : "FALSE ") : "failed", start.error_m,
                  start.error_deg, r.overlap, r.rival_overlap, r.rival_distance_m, r.weakest_eigenvalue, r.position_sigma_m, r.yaw_sigma_rad * 180 / std::numbers::pi, start.seconds, r.success ? "" : ": ",
                  r.success ? "" : r.failure);
-    // As aditd goes on after a failed try (prior_localiser.hpp): the scans
-    // that arrive while a try runs are not gathered, then
-    // scans_passed_over(k) after the k-th failure, then the next window;
-    // until one is reported found or the budget's sensor time has passed.
-    std::size_t first = start.scan;
-    std::uint64_t failures = 0;
+    // As aditd goes on (prior_localiser.hpp), scan by scan: two windows, the
+    // next gathered while a try searches the other; a search begins when its
+    // window is in and the search before it has ended; after the k-th failure
+    // scans_passed_over(k) scans are passed over before the next window
+    // begins (none while a found pose waits); until one is reported found or
+    // the budget's sensor time has passed.
     slam::AnchorConfirmation confirmation(localisation);  // a found anchor waits for the next try to agree
-    for (;;) {
-      ++start.tries;
-      const double done_s = window_end_s(first) + attempt.cpu_s;
-      // The anchor a try implies: prior ← world (the odometry's frame here).
-      const Eigen::Isometry3d anchor = attempt.result.pose * attempt.level.inverse();
-      if (attempt.result.success && (!o.confirm || confirmation.agrees(anchor, attempt.level))) {
-        start.retry_reported = true;
-        start.retry_within = attempt.within;
-        start.time_to_localise_s = done_s - t0;
-        break;
+    std::uint64_t failures = 0;
+    struct Search {
+      std::size_t first = 0;
+      double done_s = 0.0;  // sensor time the search ends
+      Try attempt;
+    };
+    std::optional<Search> searching;  // the prior thread's search under way
+    std::deque<std::size_t> ready;    // windows in, not yet searched (their first scans)
+    std::optional<Try> first_try = attempt;
+    double prior_free_s = t0;         // when the prior thread ended its last search
+    int pass_over = 0;                // posted by a failure, taken by the odometry thread
+    bool found = false;
+    // The prior thread up to sensor time `t`: ends the search under way, begins the next.
+    const auto advance_prior = [&](double t) {
+      for (;;) {
+        if (searching && searching->done_s <= t) {
+          const Search done = *std::move(searching);
+          searching.reset();
+          prior_free_s = done.done_s;
+          ++start.tries;
+          if (done.first != start.scan && !o.json)
+            fmt::print("         try {} at scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, {:.2f} s{}{}\n",
+                       start.tries, done.first, done.attempt.result.success ? (done.attempt.within ? "found " : "FALSE ") : "failed",
+                       done.attempt.error_m, done.attempt.error_deg, done.attempt.result.overlap, done.attempt.result.rival_overlap,
+                       done.attempt.result.rival_distance_m, done.attempt.cpu_s, done.attempt.result.success ? "" : ": ",
+                       done.attempt.result.success ? "" : done.attempt.result.failure);
+          // The anchor a try implies: prior ← world (the odometry's frame here).
+          const Eigen::Isometry3d anchor = done.attempt.result.pose * done.attempt.level.inverse();
+          if (done.attempt.result.success && (!o.confirm || confirmation.agrees(anchor, done.attempt.level))) {
+            start.retry_reported = true;
+            start.retry_within = done.attempt.within;
+            start.time_to_localise_s = done.done_s - t0;
+            found = true;
+            return;
+          }
+          if (!done.attempt.result.success)
+            pass_over = daemon::scans_passed_over(++failures, o.scans, confirmation.waiting());
+          continue;
+        }
+        if (!searching && !ready.empty()) {
+          const std::size_t first = ready.front();
+          ready.pop_front();
+          Try next = first_try ? *std::move(first_try) : try_window(first, tilt_x, tilt_y, crew);
+          first_try.reset();
+          const double begin_s = std::max(window_end_s(first), prior_free_s);
+          searching = Search{first, begin_s + next.cpu_s, std::move(next)};
+          continue;
+        }
+        return;
       }
-      if (o.retry_s <= 0.0) break;
-      std::size_t next = first + static_cast<std::size_t>(o.scans);
-      while (next < scans.size() && stamp_s(next) < done_s) ++next;
-      // After a failure, scans are passed over by aditd's rule; after a found one, none.
-      if (!attempt.result.success)
-        next += static_cast<std::size_t>(daemon::scans_passed_over(++failures, o.scans, confirmation.waiting()));
-      if (next + static_cast<std::size_t>(o.scans) > scans.size() || window_end_s(next) - t0 > o.retry_s) break;
-      first = next;
-      attempt = try_window(first, tilt_x, tilt_y, crew);
-      if (!o.json)
-        fmt::print("         try {} at scan {:5d}: {} error {:.3f} m {:.2f} deg, overlap {:.2f} rival {:.2f} at {:.1f} m, {:.2f} s{}{}\n",
-                   start.tries + 1, first, attempt.result.success ? (attempt.within ? "found " : "FALSE ") : "failed",
-                   attempt.error_m, attempt.error_deg, attempt.result.overlap, attempt.result.rival_overlap,
-                   attempt.result.rival_distance_m, attempt.cpu_s, attempt.result.success ? "" : ": ",
-                   attempt.result.success ? "" : attempt.result.failure);
+    };
+    // The odometry thread, scan by scan from the start.
+    int skip = 0;
+    int in_window = 0;
+    std::size_t window_first = start.scan;
+    for (std::size_t j = start.scan; j < scans.size(); ++j) {
+      advance_prior(o.retry_s > 0.0 ? std::min(stamp_s(j), t0 + o.retry_s) : stamp_s(j));
+      if (found || (o.retry_s > 0.0 && stamp_s(j) - t0 > o.retry_s)) break;
+      if (ready.size() + (searching ? 1 : 0) >= 2) continue;  // both windows are the prior thread's
+      if (pass_over > 0) skip = std::exchange(pass_over, 0);
+      if (in_window == 0 && skip > 0) {
+        --skip;
+        continue;
+      }
+      if (in_window == 0) window_first = j;
+      if (++in_window == o.scans) {
+        ready.push_back(window_first);
+        in_window = 0;
+        if (o.retry_s <= 0.0) break;  // one try
+      }
     }
+    if (!found) advance_prior(o.retry_s > 0.0 ? t0 + o.retry_s : std::numeric_limits<double>::infinity());
     starts.push_back(start);
   }
   const auto count = [&](auto pred) { return static_cast<int>(std::count_if(starts.begin(), starts.end(), pred)); };
