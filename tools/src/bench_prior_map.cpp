@@ -237,9 +237,9 @@ int run(const Options& o) {
       double done_s = 0.0;  // sensor time the search ends
       Try attempt;
     };
-    std::optional<Search> searching;  // the prior thread's search under way
+    // The prior thread's search under way: the first window's, from when its scans are in.
+    std::optional<Search> searching = Search{start.scan, window_end_s(start.scan) + attempt.cpu_s, attempt};
     std::deque<std::size_t> ready;    // windows in, not yet searched (their first scans)
-    std::optional<Try> first_try = attempt;
     double prior_free_s = t0;         // when the prior thread ended its last search
     int pass_over = 0;                // posted by a failure, taken by the odometry thread
     bool found = false;
@@ -273,8 +273,7 @@ int run(const Options& o) {
         if (!searching && !ready.empty()) {
           const std::size_t first = ready.front();
           ready.pop_front();
-          Try next = first_try ? *std::move(first_try) : try_window(first, tilt_x, tilt_y, crew);
-          first_try.reset();
+          Try next = try_window(first, tilt_x, tilt_y, crew);
           const double begin_s = std::max(window_end_s(first), prior_free_s);
           searching = Search{first, begin_s + next.cpu_s, std::move(next)};
           continue;
@@ -282,13 +281,13 @@ int run(const Options& o) {
         return;
       }
     };
-    // The odometry thread, scan by scan from the start.
+    // The odometry thread, scan by scan after the first window (none with --retry-s 0: one try).
     int skip = 0;
     int in_window = 0;
     std::size_t window_first = start.scan;
-    for (std::size_t j = start.scan; j < scans.size(); ++j) {
-      advance_prior(o.retry_s > 0.0 ? std::min(stamp_s(j), t0 + o.retry_s) : stamp_s(j));
-      if (found || (o.retry_s > 0.0 && stamp_s(j) - t0 > o.retry_s)) break;
+    for (std::size_t j = start.scan + static_cast<std::size_t>(o.scans); o.retry_s > 0.0 && j < scans.size(); ++j) {
+      advance_prior(std::min(stamp_s(j), t0 + o.retry_s));
+      if (found || stamp_s(j) - t0 > o.retry_s) break;
       if (ready.size() + (searching ? 1 : 0) >= 2) continue;  // both windows are the prior thread's
       if (pass_over > 0) skip = std::exchange(pass_over, 0);
       if (in_window == 0 && skip > 0) {
@@ -299,7 +298,6 @@ int run(const Options& o) {
       if (++in_window == o.scans) {
         ready.push_back(window_first);
         in_window = 0;
-        if (o.retry_s <= 0.0) break;  // one try
       }
     }
     if (!found) advance_prior(o.retry_s > 0.0 ? t0 + o.retry_s : std::numeric_limits<double>::infinity());
