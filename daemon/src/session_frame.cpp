@@ -18,8 +18,12 @@ namespace {
 
 constexpr const char* kKey = "prior_from_odometry";
 constexpr const char* kCorrectionKey = "graph_from_odometry";
-// The first line of a trajectory file moved into the prior's frame.
+// The first line of a trajectory file moved into the map's frame (any such line: placed).
+constexpr std::string_view kPlacedPrefix = "# frame: ";
 constexpr std::string_view kPlacedLine = "# frame: prior_map (prior_from_odometry of prior_frame.json applied)";
+constexpr std::string_view kCorrectedLine = "# frame: loops (the pose graph's correction applied, as to the map files)";
+constexpr std::string_view kPlacedCorrectedLine =
+    "# frame: prior_map (the pose graph's correction and prior_from_odometry of prior_frame.json applied)";
 
 nlohmann::json rows_of(const Eigen::Isometry3d& t) {
   nlohmann::json rows = nlohmann::json::array();
@@ -134,21 +138,29 @@ std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir) {
   return map_frame_of(anchor, correction);
 }
 
-bool place_trajectory_file(const std::filesystem::path& file, const Eigen::Isometry3d& frame) {
+bool place_trajectory_file(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& anchor,
+                           const slam::CorrectionTrack* track) {
   std::ifstream in(file);
   if (!in) {
     if (!std::filesystem::exists(file)) return false;
     throw InputError(file.string(), "", "cannot be read");
   }
+  if (track != nullptr && track->empty()) track = nullptr;
+  if (!anchor && track == nullptr) return true;  // nothing to move
   std::string first;
   std::getline(in, first);
-  if (first == kPlacedLine) return true;
+  if (first.starts_with(kPlacedPrefix)) return true;
   in.clear();
   in.seekg(0);
   slam::Trajectory t = slam::read_tum(in, file);
-  for (slam::Pose& p : t.poses) p = frame * p;
+  const Eigen::Isometry3d frame = anchor.value_or(Eigen::Isometry3d::Identity());
+  for (std::size_t i = 0; i < t.poses.size(); ++i) {
+    const auto stamp_ns = static_cast<std::int64_t>(std::llround(t.stamps[i] * 1e9));
+    t.poses[i] = track != nullptr ? frame * track->at(stamp_ns) * t.poses[i] : frame * t.poses[i];
+  }
   std::ostringstream out;
-  out << kPlacedLine << "\n# timestamp tx ty tz qx qy qz qw\n";
+  out << (track == nullptr ? kPlacedLine : anchor ? kPlacedCorrectedLine : kCorrectedLine)
+      << "\n# timestamp tx ty tz qx qy qz qw\n";
   slam::write_tum(out, t);
   write_durably(file, out.str());
   return true;

@@ -499,8 +499,10 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
       keyframes.poses.push_back(placed_by * (graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose));
     }
-    if (anchor)
-      for (const char* f : {"trajectory.tum", "map_trajectory.tum"}) place_trajectory_file(dir / f, *anchor);
+    // The trajectories as the map files: moved by the graph, in the prior's frame.
+    if (anchor || corrected)
+      for (const char* f : {"trajectory.tum", "map_trajectory.tum"})
+        place_trajectory_file(dir / f, anchor, corrected ? &track : nullptr);
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
     std::uintmax_t grid_bytes = 0;

@@ -20,6 +20,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <unordered_map>
 
@@ -34,6 +35,7 @@
 #include "adit/daemon/tile_spill.hpp"
 #include "adit/daemon/tile_store.hpp"
 #include "adit/protocol/tile_codec.hpp"
+#include "adit/slam/tum.hpp"
 #include "daemon_process.hpp"
 #include "map_readers.hpp"
 #include "point_match.hpp"
@@ -126,6 +128,27 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   ASSERT_GE(summary["loops"]["accepted"].get<int>(), 1) << "the drive closed no loop";
   EXPECT_TRUE(summary["loops"]["map_moved"].get<bool>());
   EXPECT_GT(frames_with_correction, 0U);
+  // The trajectories are moved with the map files: the map's poses at the
+  // keyframes' stamps are where the graph put the keyframes (keyframes.tum).
+  for (const char* name : {"trajectory.tum", "map_trajectory.tum"}) {
+    std::ifstream in(folder / name);
+    std::string first_line;
+    std::getline(in, first_line);
+    EXPECT_EQ(first_line.rfind("# frame: loops", 0), 0U) << name << ": " << first_line;
+  }
+  const slam::Trajectory map_poses = slam::read_tum(folder / "map_trajectory.tum");
+  const slam::Trajectory graph_poses = slam::read_tum(folder / "keyframes.tum");
+  ASSERT_GT(graph_poses.size(), 10U);
+  std::size_t matched = 0;
+  double worst_m = 0.0;
+  for (std::size_t k = 0, i = 0; k < graph_poses.size(); ++k) {
+    while (i < map_poses.size() && map_poses.stamps[i] < graph_poses.stamps[k] - 1e-4) ++i;
+    if (i == map_poses.size() || std::abs(map_poses.stamps[i] - graph_poses.stamps[k]) > 1e-4) continue;
+    ++matched;
+    worst_m = std::max(worst_m, (map_poses.poses[i].translation() - graph_poses.poses[k].translation()).norm());
+  }
+  EXPECT_EQ(matched, graph_poses.size());
+  EXPECT_LT(worst_m, 1e-4);
   // Tiles the sensor still sees go again anyway, placed by the latest
   // correction; the others are checked and go again if they moved.
   EXPECT_GE(summary["map"]["tiles_checked_for_loops"].get<std::size_t>(),

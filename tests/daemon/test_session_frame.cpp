@@ -4,7 +4,11 @@
 // corner below a moved map.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "adit/common/error.hpp"
 #include "adit/daemon/map_files.hpp"
@@ -124,6 +128,53 @@ TEST(SessionFrame, ATrajectoryIsMovedIntoThePriorsFrameOnce) {
     EXPECT_NEAR(back.stamps[i], t.stamps[i], 1e-6);
     EXPECT_LT(((sample_anchor() * t.poses[i]).translation() - back.poses[i].translation()).norm(), 2e-6) << i;
     EXPECT_TRUE((sample_anchor() * t.poses[i]).linear().isApprox(back.poses[i].linear(), 1e-6)) << i;
+  }
+}
+
+// With loop closure the map files are moved by the graph's correction C(t)
+// (slam::CorrectionTrack); the trajectories go with them, then into the
+// prior's frame when anchored: anchor·C(t)·T, once.
+TEST(SessionFrame, ATrajectoryIsMovedByTheGraphsCorrectionAsTheMapIs) {
+  const test::TempFolder dir;
+  slam::Trajectory t;
+  std::vector<std::int64_t> stamps_ns;
+  for (int i = 0; i < 5; ++i) {
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.linear() = Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    p.translation() = Eigen::Vector3d(0.5 * i, 0.1 * i, 0.0);
+    stamps_ns.push_back(1'700'000'000'000'000'000 + 100'000'000LL * i);
+    t.stamps.push_back(1e-9 * static_cast<double>(stamps_ns.back()));
+    t.poses.push_back(p);
+  }
+  // Keyframes 0 and 4: the graph levelled the first (pitched 0.3°) and moved the last 0.2 m up.
+  Eigen::Isometry3d first = t.poses[0];
+  first.linear() = Eigen::AngleAxisd(0.3 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix() * first.linear();
+  Eigen::Isometry3d last = t.poses[4];
+  last.translation().z() += 0.2;
+  const std::vector<std::int64_t> keyframes{stamps_ns[0], stamps_ns[4]};
+  const std::vector<Eigen::Isometry3d> graph{first, last};
+  const std::vector<Eigen::Isometry3d> odometry{t.poses[0], t.poses[4]};
+  const slam::CorrectionTrack track(keyframes, graph, odometry);
+  for (const bool anchored : {false, true}) {
+    const std::filesystem::path file = dir.path() / (anchored ? "anchored.tum" : "trajectory.tum");
+    slam::write_tum(file, t);
+    const Eigen::Isometry3d frame = anchored ? sample_anchor() : Eigen::Isometry3d::Identity();
+    const std::optional<Eigen::Isometry3d> anchor = anchored ? std::optional(frame) : std::nullopt;
+    ASSERT_TRUE(place_trajectory_file(file, anchor, &track));
+    ASSERT_TRUE(place_trajectory_file(file, anchor, &track));  // again: unchanged
+    std::ifstream in(file);
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line.rfind(anchored ? "# frame: prior_map (the pose graph's" : "# frame: loops", 0), 0U) << line;
+    const slam::Trajectory back = slam::read_tum(file);
+    ASSERT_EQ(back.size(), t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const Eigen::Isometry3d want = frame * track.at(stamps_ns[i]) * t.poses[i];
+      EXPECT_LT((want.translation() - back.poses[i].translation()).norm(), 2e-6) << i;
+      EXPECT_TRUE(want.linear().isApprox(back.poses[i].linear(), 1e-6)) << i;
+    }
+    EXPECT_TRUE((frame * graph[0]).isApprox(back.poses[0], 1e-6));  // where the graph put keyframe 0
+    EXPECT_NEAR((frame * graph[1]).translation().z(), back.poses[4].translation().z(), 2e-6);
   }
 }
 

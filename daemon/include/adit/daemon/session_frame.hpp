@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adit/daemon/map_frame.hpp"
+#include "adit/slam/correction_track.hpp"
 
 namespace adit::daemon {
 
@@ -39,12 +40,16 @@ std::optional<Eigen::Isometry3d> read_prior_frame(const std::filesystem::path& f
 // The same from the file's text; `name` is the file named in errors.
 Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& name);
 
-// Rewrites the TUM trajectory `file` with each pose T as frame·T, durably,
-// under a first line saying so; a file already under that line is left as it
-// is (a recovery after a crash between this and the summary does not move it
-// twice). Returns false when there is no such file; throws adit::InputError
-// naming a malformed one, std::runtime_error one that cannot be written.
-bool place_trajectory_file(const std::filesystem::path& file, const Eigen::Isometry3d& frame);
+// Rewrites the TUM trajectory `file` with each pose T at time t as
+// A·C(t)·T, durably, under a first line saying which: A is the prior map's
+// `anchor` (prior_from_odometry), C is `track`'s correction (the pose
+// graph's, as the map files are moved); each identity when absent. A file
+// already under such a line is left as it is (a recovery after a crash
+// between this and the summary does not move it twice). Returns false when
+// there is no such file; throws adit::InputError naming a malformed one,
+// std::runtime_error one that cannot be written.
+bool place_trajectory_file(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& anchor,
+                           const slam::CorrectionTrack* track = nullptr);
 
 // The graph's last correction C (graph <- odometry), written durably into
 // tiles_graph/; read back as read_prior_frame reads the anchor.
