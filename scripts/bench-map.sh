@@ -21,7 +21,7 @@ use_drives bench-map "$@"
 sum=0
 worst=100
 count=0
-printf '%-24s %10s %10s\n' drive points within-5cm
+printf '%-24s %10s %10s %9s\n' drive points within-5cm map-tilt
 for drive in "${drives[@]}"; do
   session=$(sim_session "$drive" "$runs") || exit $?
   name=$(basename "$session")
@@ -33,7 +33,9 @@ for drive in "${drives[@]}"; do
     { echo "bench-map: $drive: adit eval map failed ($work/eval.txt)" >&2; exit 1; }
   # "within 0.050 m    96.92 % (366992 points)"
   read -r within points < <(awk '/^within/ {print $4, substr($6, 2)}' "$work/eval.txt")
-  printf '%-24s %10s %9s%%\n' "$name" "$points" "$within"
+  # "map tilt          0.751° (...)": the map's own z from the vertical, which the placement removed
+  tilt=$(awk '/^map tilt/ {print $3}' "$work/eval.txt")
+  printf '%-24s %10s %9s%% %9s\n' "$name" "$points" "$within" "$tilt"
   sum=$(awk -v a="$sum" -v b="$within" 'BEGIN {print a + b}')
   worst=$(awk -v a="$worst" -v b="$within" 'BEGIN {print (b < a) ? b : a}')
   count=$((count + 1))

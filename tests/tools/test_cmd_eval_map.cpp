@@ -185,6 +185,10 @@ TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
   const auto by_origin = json_of(adit_eval(placed_by + " --json"));
   EXPECT_EQ(by_origin["placement"], "origin");
   EXPECT_GT(std::abs(by_origin["median_m"].get<double>() - 0.0495), 0.005) << "the first pose's 3° tilts the map";
+  // The map's own z is vertical (only turned about it): the fit says so; the
+  // first pose's 3° makes the placement tilt it by as much.
+  EXPECT_NEAR(fitted["map_tilt_deg"].get<double>(), 0.0, 1e-4);
+  EXPECT_NEAR(by_origin["map_tilt_deg"].get<double>(), 3.0, 1e-4);
 
   // Poses on one line fix no rotation: an input error naming the estimate.
   const TempFile line("100.0 0 0 0 0 0 0 1\n100.1 1 0 0 0 0 0 1\n100.2 2 0 0 0 0 0 1\n");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <span>
 #include <thread>
@@ -178,6 +179,13 @@ void run_eval_map(const MapEvalOptions& o) {
   std::vector<double> distances = distances_in_parallel(scene, points);
   const MapAccuracy a = summarize(distances, o.within);
   const double fraction = static_cast<double>(a.within) / static_cast<double>(a.points);
+  // How far the placement turned the map's z from the scene's vertical: the
+  // map's own tilt from gravity, which a placement by the trajectories
+  // removes (origin: with the reference's first attitude) and a map without
+  // one keeps.
+  const double map_tilt_deg =
+      std::acos(std::clamp((place.world_from_map.linear() * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0)) * 180.0 /
+      std::numbers::pi;
 
   if (o.json) {
     const nlohmann::json j{{"points", a.points},
@@ -188,7 +196,8 @@ void run_eval_map(const MapEvalOptions& o) {
                            {"mean_m", metres_or_null(a.mean)},
                            {"beyond_cap", a.beyond_cap},
                            {"cap_m", o.cap},
-                           {"placement", !place.by_trajectories ? "none" : o.align}};
+                           {"placement", !place.by_trajectories ? "none" : o.align},
+                           {"map_tilt_deg", map_tilt_deg}};
     fmt::print("{}\n", j.dump(2));
     return;
   }
@@ -205,6 +214,8 @@ void run_eval_map(const MapEvalOptions& o) {
   } else {
     fmt::print("placement         none (map taken as in the scene frame)\n");
   }
+  if (place.by_trajectories)
+    fmt::print("map tilt          {:.3f}° (the map's z from the vertical, removed by the placement)\n", map_tilt_deg);
   fmt::print("within {:.3f} m    {:.2f} % ({} points)\n", o.within, 100.0 * fraction, a.within);
   fmt::print("median            {}\n", metres_or_beyond(a.median, o.cap));
   fmt::print("p95               {}\n", metres_or_beyond(a.p95, o.cap));

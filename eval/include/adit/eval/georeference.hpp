@@ -42,14 +42,15 @@ enum class MatchBy { automatic, id, geometry };
 
 struct GeorefOptions {
   bool with_scale = false;
-  // Turn the map about the vertical only (4 parameters, 5 with scale): the
-  // map's z is up already (gravity from the IMU), so a tilt fitted on a few
-  // control points only carries the map's height drift far from them.
+  // Turn the map about the vertical only (4 parameters, 5 with scale): a tilt
+  // fitted on a few control points carries the map's height drift far from
+  // them. The map's z is the first pose's: it keeps the payload's starting
+  // tilt (docs/decisions/059-graph-keeps-the-first-poses-attitude.md).
   bool level = false;
   double tolerance_m = 0.05;        // a residual or leave-one-out residual above this is flagged
   double match_tolerance_m = 0.25;  // pairwise distances agree within this + 0.2 % of the distance
-  // aditd's map has z up (gravity from the IMU, or the start pose of a level
-  // platform): a fit that tilts it more than this is a wrong match or a mirror.
+  // aditd's map has z near up (the first pose's, within the payload's
+  // starting tilt): a fit that tilts it more than this is a wrong match or a mirror.
   double max_tilt_deg = 10.0;
   MatchBy match = MatchBy::automatic;
 };
