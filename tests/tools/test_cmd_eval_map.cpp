@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -160,21 +161,28 @@ TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
 // to the reference's, as a surveyor fits a map to control points: here the
 // estimate's first attitude is 3° off (the map itself is right), which
 // tilts the map placed by its first pose but not the fitted one.
-TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
-  Eigen::Isometry3d map_from_world = Eigen::Isometry3d::Identity();
-  map_from_world.translation() = Eigen::Vector3d(-1.0, 2.0, 0.3);
-  map_from_world.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+// A reference path (level body) and the estimate of it in the map frame
+// `map_from_world`, its first attitude off by `first_roll_rad` more.
+std::pair<std::string, std::string> path_texts(const Eigen::Isometry3d& map_from_world, double first_roll_rad) {
   std::string ref_text, est_text;
   const std::vector<Eigen::Vector3d> path{{1, 1, 0.5}, {3, 1, 0.5}, {5, 1, 0.6}, {5, 3, 0.5}, {5, 5, 0.4}, {3, 5, 0.5}};
   for (std::size_t i = 0; i < path.size(); ++i) {
     const Eigen::Vector3d m = map_from_world * path[i];
     Eigen::Quaterniond qm(map_from_world.linear());
-    if (i == 0) qm = qm * Eigen::AngleAxisd(3.0 * M_PI / 180, Eigen::Vector3d::UnitX());
+    if (i == 0) qm = qm * Eigen::AngleAxisd(first_roll_rad, Eigen::Vector3d::UnitX());
     const double t = 100.0 + 0.1 * static_cast<double>(i);
     ref_text += fmt::format("{:.1f} {} {} {} 0 0 0 1\n", t, path[i].x(), path[i].y(), path[i].z());
     est_text += fmt::format("{:.1f} {:.9f} {:.9f} {:.9f} {:.12f} {:.12f} {:.12f} {:.12f}\n", t, m.x(), m.y(), m.z(), qm.x(),
                             qm.y(), qm.z(), qm.w());
   }
+  return {ref_text, est_text};
+}
+
+TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
+  Eigen::Isometry3d map_from_world = Eigen::Isometry3d::Identity();
+  map_from_world.translation() = Eigen::Vector3d(-1.0, 2.0, 0.3);
+  map_from_world.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const auto [ref_text, est_text] = path_texts(map_from_world, 3.0 * M_PI / 180);
   const TempFile ref(ref_text), est(est_text), map("", ".ply");
   fill(map, map_from_world);
   const std::string placed_by = "map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) + " --est " + q(est);
@@ -196,6 +204,41 @@ TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
                                        " --est " + q(line) + " --align se3");
   EXPECT_EQ(degenerate.status, 2) << degenerate.output;
   EXPECT_NE(degenerate.output.find(line.path().string()), std::string::npos) << degenerate.output;
+}
+
+// --align heading keeps the map's own vertical: a first attitude 3° off
+// costs nothing (the map is level); a map whose z is 3° off plumb (its first
+// pose's, as aditd's) keeps its tilt and is scored with it, where the origin
+// placement hands it the reference's first attitude.
+TEST_F(AditEvalMap, PlacedByTheFirstPoseTurnedAboutTheVerticalOnly) {
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.translation() = Eigen::Vector3d(-1.0, 2.0, 0.3);
+  level.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Eigen::Isometry3d tilted = level;
+  tilted.linear() = Eigen::AngleAxisd(3.0 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix() * level.linear();
+  for (const bool map_tilted : {false, true}) {
+    const Eigen::Isometry3d map_from_world = map_tilted ? tilted : level;
+    const auto [ref_text, est_text] = path_texts(map_from_world, map_tilted ? 0.0 : 3.0 * M_PI / 180);
+    const TempFile ref(ref_text), est(est_text), map("", ".ply");
+    fill(map, map_from_world);
+    const std::string placed_by = "map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref) + " --est " + q(est);
+    const auto heading = json_of(adit_eval(placed_by + " --align heading --json"));
+    const auto origin = json_of(adit_eval(placed_by + " --json"));
+    EXPECT_EQ(heading["placement"], "heading");
+    EXPECT_NEAR(heading["map_tilt_deg"].get<double>(), 0.0, 1e-6);
+    if (!map_tilted) {
+      EXPECT_NEAR(heading["fraction_within"].get<double>(), 6.0 / 11.0, 1e-9);
+      EXPECT_NEAR(heading["median_m"].get<double>(), 0.0495, 1e-5);
+    } else {
+      EXPECT_NEAR(origin["fraction_within"].get<double>(), 6.0 / 11.0, 1e-9);  // given the true first attitude
+      EXPECT_NEAR(origin["map_tilt_deg"].get<double>(), 3.0, 1e-4);
+      EXPECT_LT(heading["fraction_within"].get<double>(), 5.0 / 11.0) << "the map's own 3° is scored";
+    }
+  }
+  const TempFile map("", ".ply");
+  fill(map, level);
+  EXPECT_NE(adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --align heading").status, 0)
+      << "heading needs --ref and --est";
 }
 
 TEST_F(AditEvalMap, BadFilesAreNamed) {

@@ -100,9 +100,10 @@ void add_map(CLI::App& eval, int& status) {
   ref->needs(est);
   est->needs(ref);
   cmd->add_option("--align", o->align,
-                  "Placement by the trajectories: origin (ref(t0) est(t0)^-1) or se3 (the rigid fit of all poses, as "
-                  "to control points; use the map's poses, map_trajectory.tum) (default origin)")
-      ->check(CLI::IsMember({"origin", "se3"}))
+                  "Placement by the trajectories: origin (ref(t0) est(t0)^-1), heading (the same turned about the "
+                  "vertical only: the map keeps its own tilt) or se3 (the rigid fit of all poses, as to control "
+                  "points; use the map's poses, map_trajectory.tum) (default origin)")
+      ->check(CLI::IsMember({"origin", "heading", "se3"}))
       ->needs(ref);
   cmd->add_option("--within", o->within, "Distance (m) a point must be within to count as accurate (default 0.05)")
       ->check(CLI::PositiveNumber);

@@ -53,7 +53,7 @@ struct TargetsEvalOptions {
 struct MapEvalOptions {
   std::string map, scene;
   std::string ref, est;  // both or neither: place the map by ref(t0) · est(t0)⁻¹ (origin)
-  std::string align = "origin";  // or "se3": by the rigid fit of est's positions to ref's
+  std::string align = "origin";  // "heading": turned about the vertical only; "se3": by the rigid fit of est's positions to ref's
   double within = 0.05;  // m
   double cap = 1.0;      // m: farther distances are counted, not computed
   bool json = false;

@@ -80,6 +80,19 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// `placement` with its rotation cut to the turn about the vertical nearest
+// it (the yaw ψ minimising ‖Rz(ψ) − R‖_F), still taking `origin` (the first
+// pose's position, map frame) where `placement` takes it: the map keeps its
+// own tilt, as a crew without control points gets it.
+Eigen::Isometry3d turned_about_the_vertical(const Eigen::Isometry3d& placement, const Eigen::Vector3d& origin) {
+  const Eigen::Matrix3d& r = placement.linear();
+  const double yaw = std::atan2(r(1, 0) - r(0, 1), r(0, 0) + r(1, 1));
+  Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+  turned.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  turned.translation() = placement * origin - turned.linear() * origin;
+  return turned;
+}
+
 struct Placement {
   Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
   double t0 = 0.0;  // s; the estimate's first stamp when placed by its origin
@@ -95,8 +108,10 @@ Placement placement(const MapEvalOptions& o) {
     p.world_from_map = world_from_map_fitted(o.ref, o.est, p.fitted_poses);
     return p;
   }
-  p.t0 = timed_trajectory(o.est).stamps.front();
+  const slam::Trajectory est = timed_trajectory(o.est);
+  p.t0 = est.stamps.front();
   p.world_from_map = world_from_map(o.ref, o.est);
+  if (o.align == "heading") p.world_from_map = turned_about_the_vertical(p.world_from_map, est.poses.front().translation());
   return p;
 }
 
@@ -209,8 +224,8 @@ void run_eval_map(const MapEvalOptions& o) {
                place.fitted_poses, t.x(), t.y(), t.z());
   } else if (place.by_trajectories) {
     const Eigen::Vector3d t = place.world_from_map.translation();
-    fmt::print("placement         ref(t0) est(t0)^-1 at t0 = {:.6f} s: map origin at ({:.3f}, {:.3f}, {:.3f}) m\n",
-               place.t0, t.x(), t.y(), t.z());
+    fmt::print("placement         ref(t0) est(t0)^-1 at t0 = {:.6f} s{}: map origin at ({:.3f}, {:.3f}, {:.3f}) m\n",
+               place.t0, o.align == "heading" ? ", turned about the vertical only" : "", t.x(), t.y(), t.z());
   } else {
     fmt::print("placement         none (map taken as in the scene frame)\n");
   }
