@@ -157,10 +157,6 @@ TEST_F(AditEvalMap, PlacedByTheTrajectoriesFirstPose) {
   EXPECT_NE(adit_eval("map --map "s + q(map) + " --scene " + q(scene) + " --ref " + q(ref)).status, 0);
 }
 
-// --align se3 places the map by the rigid fit of all the estimate's positions
-// to the reference's, as a surveyor fits a map to control points: here the
-// estimate's first attitude is 3° off (the map itself is right), which
-// tilts the map placed by its first pose but not the fitted one.
 // A reference path (level body) and the estimate of it in the map frame
 // `map_from_world`, its first attitude off by `first_roll_rad` more.
 std::pair<std::string, std::string> path_texts(const Eigen::Isometry3d& map_from_world, double first_roll_rad) {
@@ -178,6 +174,10 @@ std::pair<std::string, std::string> path_texts(const Eigen::Isometry3d& map_from
   return {ref_text, est_text};
 }
 
+// --align se3 places the map by the rigid fit of all the estimate's positions
+// to the reference's, as a surveyor fits a map to control points: here the
+// estimate's first attitude is 3° off (the map itself is right), which
+// tilts the map placed by its first pose but not the fitted one.
 TEST_F(AditEvalMap, PlacedByARigidFitOfTheTrajectories) {
   Eigen::Isometry3d map_from_world = Eigen::Isometry3d::Identity();
   map_from_world.translation() = Eigen::Vector3d(-1.0, 2.0, 0.3);
