@@ -15,7 +15,9 @@
 #include "adit/common/clock.hpp"
 #include "adit/common/log.hpp"
 #include "adit/daemon/extrinsics.hpp"
+#include "adit/daemon/session_frame.hpp"
 #include "adit/protocol/map_export.hpp"
+#include "adit/slam/levelling.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -88,6 +90,42 @@ void MappingStage::spill_to(const std::filesystem::path& tiles_dir, const std::f
   keyframes_dir_ = keyframes_dir;
 }
 
+std::optional<Eigen::Isometry3d> MappingStage::level() const {
+  const std::lock_guard lock(level_mutex_);
+  return level_;
+}
+
+void MappingStage::follow_level(const Eigen::Vector3d& up, std::int64_t stamp_ns) {
+  if (level_off_) return;
+  latest_up_ = up;
+  if (kept_up_ && (1e-9 * static_cast<double>(stamp_ns - kept_up_ns_) < kLevelPeriodS ||
+                   std::acos(std::clamp(up.normalized().dot(kept_up_->normalized()), -1.0, 1.0)) < kLevelTurnRad))
+    return;
+  kept_up_ns_ = stamp_ns;
+  keep_level();
+}
+
+// latest_up_'s level into level_ and level_file_ (durably: a recovery after
+// a crash levels the map by it). A failure is logged and ends the levelling.
+void MappingStage::keep_level() {
+  kept_up_ = latest_up_;
+  try {
+    const Eigen::Isometry3d level = slam::level_from_up(*latest_up_);
+    {
+      const std::lock_guard lock(level_mutex_);
+      level_ = level;
+    }
+    if (!level_file_.empty()) write_level_frame(level_file_, level);
+  } catch (const std::exception& e) {
+    log::warn("mapping: gravity's level not kept ({}); the exports stay in the odometry frame", e.what());
+    level_off_ = true;
+    std::error_code ignored;  // the exports stay unlevelled, as the recovery's would
+    if (!level_file_.empty()) std::filesystem::remove(level_file_, ignored);
+    const std::lock_guard lock(level_mutex_);
+    level_.reset();
+  }
+}
+
 void MappingStage::start() {
   thread_.start([this] { loop(); });
 }
@@ -129,6 +167,7 @@ void MappingStage::loop() {
   }
   if (have_pending_ && !thread_.stopping()) map_scan(pending_, velocity_);  // the last sweep: the last motion known
   have_pending_ = false;
+  if (latest_up_ && !level_off_ && (!kept_up_ || *kept_up_ != *latest_up_)) keep_level();  // the last up for the exports
   flush_tiles(true);
   flush_grid();
   map_trajectory_.flush();
@@ -137,6 +176,7 @@ void MappingStage::loop() {
 }
 
 void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity) {
+  if (slot.up) follow_level(*slot.up, slot.stamp_ns);
   points_.clear();
   times_.clear();
   intensities_.clear();

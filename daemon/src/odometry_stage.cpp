@@ -116,6 +116,7 @@ void OdometryStage::hand_to_mapping(const drivers::LidarScan& scan, const slam::
   m->times_s.assign(odometry_.body_times().begin(), odometry_.body_times().end());
   m->intensities.clear();
   for (const drivers::LidarPoint& p : scan.points) m->intensities.push_back(p.intensity);
+  m->up = odometry_.odometry().up();  // what the exports are levelled by (session_frame.hpp)
   if (result.inertial)
     m->sweep.assign(odometry_.odometry().sweep_motion().begin(), odometry_.odometry().sweep_motion().end());
   else

@@ -170,6 +170,7 @@ void Pipeline::start(const SessionFiles& files) {
   if (i.started) throw std::logic_error("Pipeline::start called twice");
   i.open_files(files.trajectory_file, files.map_trajectory_file, files.record_file);
   if (i.mapping) i.mapping->spill_to(files.tiles_dir, files.keyframes_dir);
+  if (i.mapping) i.mapping->write_level_to(files.level_frame_file);
   if (i.loops && !files.keyframes_dir.empty()) i.loops->spill_to(files.keyframes_dir / "loops");
   if (i.mapping && !files.journal_file.empty()) {
     i.journal.emplace(files.journal_file, i.config.session.journal_sync_s, i.stop);
@@ -251,6 +252,9 @@ std::vector<StageLoad> Pipeline::loads() const {
   return out;
 }
 
+std::optional<Eigen::Isometry3d> Pipeline::level() const {
+  return impl_->mapping ? impl_->mapping->level() : std::nullopt;
+}
 const slam::LiveGrid* Pipeline::grid() const { return impl_->mapping ? impl_->mapping->grid() : nullptr; }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }

@@ -11,6 +11,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/daemon/durable_file.hpp"
+#include "adit/slam/levelling.hpp"
 #include "adit/slam/tum.hpp"
 
 namespace adit::daemon {
@@ -18,12 +19,26 @@ namespace {
 
 constexpr const char* kKey = "prior_from_odometry";
 constexpr const char* kCorrectionKey = "graph_from_odometry";
+constexpr const char* kLevelKey = "level_from_odometry";
 // The first line of a trajectory file moved into the map's frame (any such line: placed).
 constexpr std::string_view kPlacedPrefix = "# frame: ";
 constexpr std::string_view kPlacedLine = "# frame: prior_map (prior_from_odometry of prior_frame.json applied)";
 constexpr std::string_view kCorrectedLine = "# frame: loops (the pose graph's correction applied, as to the map files)";
 constexpr std::string_view kPlacedCorrectedLine =
     "# frame: prior_map (the pose graph's correction and prior_from_odometry of prior_frame.json applied)";
+constexpr std::string_view kLevelLine = "# frame: level (level_from_odometry of level_frame.json applied: z is plumb)";
+constexpr std::string_view kLevelCorrectedLine =
+    "# frame: level (the pose graph's correction and level_from_odometry of level_frame.json applied: z is plumb)";
+
+// The first line of a trajectory placed by `source`, moved by the graph or not.
+std::string_view placed_line(ExportSource source, bool corrected) {
+  switch (source) {
+    case ExportSource::prior_map: return corrected ? kPlacedCorrectedLine : kPlacedLine;
+    case ExportSource::level: return corrected ? kLevelCorrectedLine : kLevelLine;
+    case ExportSource::odometry: break;
+  }
+  return kCorrectedLine;
+}
 
 nlohmann::json rows_of(const Eigen::Isometry3d& t) {
   nlohmann::json rows = nlohmann::json::array();
@@ -112,10 +127,26 @@ std::optional<Eigen::Isometry3d> read_graph_correction(const std::filesystem::pa
   return read_transform(file, kCorrectionKey, "a graph correction file");
 }
 
-std::optional<MapFrame> map_frame_of(const std::optional<Eigen::Isometry3d>& anchor,
-                                     const std::optional<Eigen::Isometry3d>& correction) {
-  if (!anchor && !correction) return std::nullopt;
-  const Eigen::Isometry3d tiles = anchor.value_or(Eigen::Isometry3d::Identity());
+void write_level_frame(const std::filesystem::path& file, const Eigen::Isometry3d& level_from_odometry) {
+  write_transform(file, kLevelKey, level_from_odometry,
+                  "gravity's level as the odometry measured it: this turns the odometry frame (the first scan's "
+                  "body frame) about its origin so that z is plumb; the session's exports are in the turned frame "
+                  "(summary.json \"frame\"), its tiles/ and live poses in the odometry's");
+}
+
+std::optional<Eigen::Isometry3d> read_level_frame(const std::filesystem::path& file) {
+  return read_transform(file, kLevelKey, "a level frame file");
+}
+
+ExportFrame export_frame(const std::optional<Eigen::Isometry3d>& anchor, const std::optional<Eigen::Isometry3d>& level) {
+  if (anchor) return {ExportSource::prior_map, *anchor};
+  if (level) return {ExportSource::level, *level};
+  return {};
+}
+
+std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optional<Eigen::Isometry3d>& correction) {
+  if (base.source == ExportSource::odometry && !correction) return std::nullopt;
+  const Eigen::Isometry3d& tiles = base.from_odometry;
   const Eigen::Isometry3d odometry = correction ? tiles * *correction : tiles;
   const auto put = [](const Eigen::Isometry3d& t, std::array<double, 3>& p, std::array<double, 4>& q) {
     const Eigen::Quaterniond r(t.linear());
@@ -123,7 +154,9 @@ std::optional<MapFrame> map_frame_of(const std::optional<Eigen::Isometry3d>& anc
     q = {r.w(), r.x(), r.y(), r.z()};
   };
   MapFrame f;
-  f.source = anchor ? kFrameSourcePriorMap : kFrameSourceLoops;
+  f.source = base.source == ExportSource::prior_map ? kFrameSourcePriorMap
+             : base.source == ExportSource::level   ? kFrameSourceLevel
+                                                    : kFrameSourceLoops;
   put(odometry, f.position, f.orientation);
   put(tiles, f.tiles_position, f.tiles_orientation);
   return f;
@@ -131,14 +164,15 @@ std::optional<MapFrame> map_frame_of(const std::optional<Eigen::Isometry3d>& anc
 
 std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir) {
   const std::optional<Eigen::Isometry3d> anchor = read_prior_frame(dir / "prior_frame.json");
+  const std::optional<Eigen::Isometry3d> level = anchor ? std::nullopt : read_level_frame(dir / "level_frame.json");
   const std::optional<Eigen::Isometry3d> correction =
       std::filesystem::is_directory(dir / kGraphTilesFolder)
           ? read_graph_correction(dir / kGraphTilesFolder / kGraphCorrectionFile)
           : std::nullopt;
-  return map_frame_of(anchor, correction);
+  return map_frame_of(export_frame(anchor, level), correction);
 }
 
-bool place_trajectory_file(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& anchor,
+bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
                            const slam::CorrectionTrack* track) {
   std::ifstream in(file);
   if (!in) {
@@ -146,29 +180,35 @@ bool place_trajectory_file(const std::filesystem::path& file, const std::optiona
     throw InputError(file.string(), "", "cannot be read");
   }
   if (track != nullptr && track->empty()) track = nullptr;
-  if (!anchor && track == nullptr) return true;  // nothing to move
+  if (frame.source == ExportSource::odometry && track == nullptr) return true;  // nothing to move
   std::string first;
   std::getline(in, first);
   if (first.starts_with(kPlacedPrefix)) return true;
   in.clear();
   in.seekg(0);
   slam::Trajectory t = slam::read_tum(in, file);
-  const Eigen::Isometry3d frame = anchor.value_or(Eigen::Isometry3d::Identity());
+  const Eigen::Isometry3d& a = frame.from_odometry;
   for (std::size_t i = 0; i < t.poses.size(); ++i) {
     const auto stamp_ns = static_cast<std::int64_t>(std::llround(t.stamps[i] * 1e9));
-    t.poses[i] = track != nullptr ? frame * track->at(stamp_ns) * t.poses[i] : frame * t.poses[i];
+    t.poses[i] = track != nullptr ? a * track->at(stamp_ns) * t.poses[i] : a * t.poses[i];
   }
   std::ostringstream out;
-  out << (track == nullptr ? kPlacedLine : anchor ? kPlacedCorrectedLine : kCorrectedLine)
-      << "\n# timestamp tx ty tz qx qy qz qw\n";
+  out << placed_line(frame.source, track != nullptr) << "\n# timestamp tx ty tz qx qy qz qw\n";
   slam::write_tum(out, t);
   write_durably(file, out.str());
   return true;
 }
 
-nlohmann::json frame_summary(const std::optional<Eigen::Isometry3d>& prior_from_odometry) {
-  if (!prior_from_odometry) return {{"name", "odometry"}};
-  return {{"name", "prior_map"}, {kKey, rows_of(*prior_from_odometry)}};
+nlohmann::json frame_summary(const ExportFrame& frame) {
+  switch (frame.source) {
+    case ExportSource::prior_map: return {{"name", "prior_map"}, {kKey, rows_of(frame.from_odometry)}};
+    case ExportSource::level:
+      return {{"name", "level"},
+              {kLevelKey, rows_of(frame.from_odometry)},
+              {"tilt_deg", slam::tilt_of(frame.from_odometry) * 180.0 / M_PI}};
+    case ExportSource::odometry: break;
+  }
+  return {{"name", "odometry"}};
 }
 
 }  // namespace adit::daemon

@@ -96,7 +96,7 @@ nlohmann::json summary_of(const RecoveryReport& r, double voxel_m, double tile_s
                          {"problem", r.problem}}},
           {"map", {{"points", r.points}, {"tiles", r.tiles}, {"voxel_m", voxel_m}, {"tile_size_m", tile_size_m},
                    {"keyframes", r.keyframes}}},
-          {"frame", frame_summary(r.prior_from_odometry)},
+          {"frame", frame_summary(r.frame)},
           {"files", r.files}};
 }
 
@@ -207,13 +207,20 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
           odometry_end && !map_poses.stamps.empty())
         r.lost_s = std::max(0.0, *odometry_end - r.last_stamp_s);
 
-      // Anchored to a prior map, the exports go into its frame, as at a normal end.
-      try {
-        r.prior_from_odometry = read_prior_frame(dir / "prior_frame.json");
-      } catch (const std::exception& e) {
-        log::warn("session {}: {}; its exports stay in the odometry frame", r.session, e.what());
-      }
-      const Eigen::Isometry3d placed_by = r.prior_from_odometry.value_or(Eigen::Isometry3d::Identity());
+      // Anchored to a prior map, the exports go into its frame, as at a
+      // normal end; levelled when the end had got as far as levelling them.
+      const auto read_frame = [&](const char* name, auto read) -> std::optional<Eigen::Isometry3d> {
+        try {
+          return read(dir / name);
+        } catch (const std::exception& e) {
+          log::warn("session {}: {}; left out of its exports' frame", r.session, e.what());
+          return std::nullopt;
+        }
+      };
+      const std::optional<Eigen::Isometry3d> anchor = read_frame("prior_frame.json", read_prior_frame);
+      r.frame = export_frame(anchor, anchor ? std::nullopt : read_frame("level_frame.json", read_level_frame));
+      const bool placed = r.frame.source != ExportSource::odometry;
+      const Eigen::Isometry3d& placed_by = r.frame.from_odometry;
       // A crash during the session's end may have left the graph's tiles
       // (whole or in part): the recovered map does not follow the graph, so
       // they would not match its map files.
@@ -235,7 +242,7 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
           samples.push_back({Eigen::Vector3f(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)),
                              p.intensity, p.time});
         if (const std::string problem = tiles.write(c, samples); !problem.empty()) throw std::runtime_error(problem);
-        if (r.prior_from_odometry)  // tiles/ stays in the odometry frame; the map files go into the prior's
+        if (placed)  // tiles/ stays in the odometry frame; the map files go into the export frame
           for (protocol::MapPoint& p : points) {
             const Eigen::Vector3d q = placed_by * Eigen::Vector3d(p.x, p.y, p.z);
             p.x = q.x();
@@ -247,10 +254,10 @@ RecoveryReport recover_session(const std::filesystem::path& dir, const std::vect
                                 read_tile);
       r.files.insert(r.files.begin(), "tiles/");
     }
-    if (r.prior_from_odometry) {
-      for (slam::Pose& p : map_poses.poses) p = *r.prior_from_odometry * p;
-      for (slam::Pose& p : keyframes.poses) p = *r.prior_from_odometry * p;
-      place_trajectory_file(dir / "trajectory.tum", *r.prior_from_odometry);
+    if (r.frame.source != ExportSource::odometry) {
+      for (slam::Pose& p : map_poses.poses) p = r.frame.from_odometry * p;
+      for (slam::Pose& p : keyframes.poses) p = r.frame.from_odometry * p;
+      place_trajectory_file(dir / "trajectory.tum", r.frame);
     }
     slam::write_tum(dir / "map_trajectory.tum", map_poses);
     slam::write_tum(dir / "keyframes.tum", keyframes);

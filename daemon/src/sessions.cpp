@@ -86,12 +86,15 @@ nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& sou
           {"unconfirmed_tries", s.unconfirmed.load()}};
 }
 
-// The running session's map frame for frame_t: the prior's once found, the
-// tiles placed by the graph's latest correction when they follow it
-// (`loops`: map.loops_move_map; map_frame.hpp).
-MapFrame session_frame(const PriorLocaliser* prior, const LoopClosureStage* loops) {
+// The running session's map frame for frame_t: the prior's once found, else
+// gravity's level once the odometry has an up (`level`), the tiles placed by
+// the graph's latest correction when they follow it (`loops`:
+// map.loops_move_map; map_frame.hpp).
+MapFrame session_frame(const PriorLocaliser* prior, const std::optional<Eigen::Isometry3d>& level,
+                       const LoopClosureStage* loops) {
   const std::shared_ptr<const slam::CorrectionTrack> track = loops != nullptr ? loops->live().latest() : nullptr;
-  return map_frame_of(prior != nullptr ? prior->anchor() : std::nullopt,
+  const std::optional<Eigen::Isometry3d> anchor = prior != nullptr ? prior->anchor() : std::nullopt;
+  return map_frame_of(export_frame(anchor, anchor ? std::nullopt : level),
                       track != nullptr && !track->empty() ? std::optional(track->corrections().back()) : std::nullopt)
       .value_or(MapFrame{});
 }
@@ -341,6 +344,7 @@ std::string Sessions::start_locked() {
   try {
     if (!pipeline) pipeline = build_pipeline();  // the last one could not be built ahead
     if (pipeline->prior_localiser() != nullptr) files.prior_frame_file = dir / "prior_frame.json";
+    files.level_frame_file = dir / "level_frame.json";
     pipeline->start(files);
   } catch (...) {
     std::filesystem::remove_all(dir, ec);  // nothing was recorded: leave no empty session behind
@@ -429,10 +433,17 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     const LoopClosureStage* loops = pipeline->loop_closure();
     const slam::CorrectionTrack track = loops != nullptr ? loops->correction() : slam::CorrectionTrack{};
     const bool corrected = loops != nullptr && config_.map.loops_move_map && loops->closer().stats().accepted > 0;
-    // Anchored to a prior map, every export is in the prior's frame.
+    // Anchored to a prior map, every export is in the prior's frame; else,
+    // when the odometry measured gravity, in the odometry frame levelled by
+    // it (the mapping thread's last level, also in level_frame.json, which a
+    // recovery after a crash reads: session_frame.hpp).
     const std::optional<Eigen::Isometry3d> anchor =
         pipeline->prior_localiser() != nullptr ? pipeline->prior_localiser()->anchor() : std::nullopt;
-    const Eigen::Isometry3d placed_by = anchor.value_or(Eigen::Isometry3d::Identity());
+    const std::optional<Eigen::Isometry3d> level = anchor ? std::nullopt : pipeline->level();
+    if (std::filesystem::exists(dir / "level_frame.json")) files.push_back("level_frame.json");
+    const ExportFrame frame = export_frame(anchor, level);
+    const Eigen::Isometry3d& placed_by = frame.from_odometry;
+    const bool placed = frame.source != ExportSource::odometry;
     double margin = 0.0;  // the corner stays at or below every moved point
     if (corrected) {
       double reach = 0.0;
@@ -442,7 +453,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
     }
     std::vector<slam::MapSample> read_back;
     std::vector<slam::MapSample> moved;
-    std::vector<slam::MapSample> placed;
+    std::vector<slam::MapSample> moved_out;  // into the export frame
     // The tiles as the graph placed them last go to tiles_graph/ too, whole
     // before it takes that name: a download after a restart is served from
     // there (load_tiles), as the live tiles were. A failure there (a full
@@ -469,9 +480,9 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         samples = moved;
         if (graph_problem.empty()) graph_problem = graph_tiles.write(c, samples);
       }
-      if (anchor) {
-        slam::correct_samples(samples, nullptr, placed_by, placed);
-        samples = placed;
+      if (placed) {
+        slam::correct_samples(samples, nullptr, placed_by, moved_out);
+        samples = moved_out;
       }
       points = map_points_of(samples);
     };
@@ -499,10 +510,9 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       keyframes.stamps.push_back(1e-9 * static_cast<double>(k.stamp_ns));
       keyframes.poses.push_back(placed_by * (graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose));
     }
-    // The trajectories as the map files: moved by the graph, in the prior's frame.
-    if (anchor || corrected)
-      for (const char* f : {"trajectory.tum", "map_trajectory.tum"})
-        place_trajectory_file(dir / f, anchor, corrected ? &track : nullptr);
+    // The trajectories as the map files: moved by the graph, in the export frame.
+    for (const char* f : {"trajectory.tum", "map_trajectory.tum"})
+      place_trajectory_file(dir / f, frame, corrected ? &track : nullptr);
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
     std::uintmax_t grid_bytes = 0;
@@ -549,7 +559,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
         {"host_clock", {{"steps", s.clock_steps.load()}, {"last_step_s", 1e-9 * static_cast<double>(s.last_clock_step_ns.load())}}},
         {"loops", loops_summary(loops, track, corrected)},
         {"prior_map", prior_summary(pipeline->prior_localiser(), pipeline->prior_source())},
-        {"frame", frame_summary(anchor)},
+        {"frame", frame_summary(frame)},
         {"journal", journal_summary(journal)},
         {"map", {{"points", map.size()}, {"tiles", map.tile_count()}, {"voxel_m", config_.map.voxel_m},
                  {"tile_size_m", config_.map.tile_size_m}, {"keyframes", pipeline->keyframes().size()},
@@ -795,7 +805,7 @@ StatusSample Sessions::status_sample() {
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
   const LoopClosureStage* moving = config_.map.loops_move_map ? pipeline_->loop_closure() : nullptr;
-  sample.frame = session_frame(pipeline_->prior_localiser(), moving);
+  sample.frame = session_frame(pipeline_->prior_localiser(), pipeline_->level(), moving);
   if (moving != nullptr) sample.graph = moving->live().latest();
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;

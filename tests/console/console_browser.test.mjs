@@ -153,10 +153,15 @@ try {
   figures.coverage_top = await mapCoverage(page);
   assert.ok(figures.coverage_top > 0.02, `the map covers ${(100 * figures.coverage_top).toFixed(1)} % of the view`);
   await page.click('#camera-modes button[data-mode="follow"]');
-  // The payload's frame (frame_t: a prior map's anchor) places the whole view:
-  // the pose marker moves with it, and back. This drive has no prior: identity.
-  assert.equal(await page.evaluate(() => window.adit.metrics.mapFrame?.source), 'odometry',
-               await page.evaluate(async () => JSON.stringify((await (await fetch('/api/state')).json()).frame)));
+  // The payload's frame (frame_t: a prior map's anchor, or gravity's level)
+  // places the whole view: the pose marker moves with it, and back. This drive
+  // has no prior and an accelerometer: the level, a turn of under 1° about a
+  // horizontal axis through the first pose (decision 060).
+  const mapFrame = await page.evaluate(() => window.adit.metrics.mapFrame);
+  const frameText = JSON.stringify(mapFrame);
+  assert.equal(mapFrame?.source, 'level', frameText);
+  assert.deepEqual(mapFrame.p, [0, 0, 0], frameText);
+  assert.ok(Math.abs(mapFrame.q[3]) < 1e-9 && 2 * Math.acos(Math.min(1, Math.abs(mapFrame.q[0]))) < Math.PI / 180, frameText);
   const shift = await page.evaluate(() => {
     const v = window.adit.view;
     const before = v.markerPosition();

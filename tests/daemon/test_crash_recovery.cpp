@@ -5,7 +5,9 @@
 // come back: marked recovered, downloadable over LCM with the points its
 // summary counts, its map reaching to within 1 s of the last pose the tablet
 // received before the kill, and every point of it one the uninterrupted run
-// put in its map (the map's accuracy unchanged).
+// put in its map (the map's accuracy unchanged), compared in one frame: each
+// map is levelled by gravity (decision 060) once its session had written its
+// level_frame.json.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -14,6 +16,7 @@
 #include <random>
 #include <thread>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -27,6 +30,28 @@
 
 namespace adit::test {
 namespace {
+
+// The rotation summary.json's "frame" levelled a session's exports by
+// (identity when they are in the odometry frame).
+Eigen::Matrix3d level_of(const nlohmann::json& summary) {
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  if (summary["frame"]["name"] != "level") return r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = summary["frame"]["level_from_odometry"][i][j].get<double>();
+  return r;
+}
+
+// `points` turned from the frame `from` levelled them by into the one `to` does.
+std::vector<XyzI> relevelled(std::vector<XyzI> points, const Eigen::Matrix3d& from, const Eigen::Matrix3d& to) {
+  const Eigen::Matrix3d r = to * from.transpose();
+  for (XyzI& p : points) {
+    const Eigen::Vector3d q = r * Eigen::Vector3d(p.x, p.y, p.z);
+    p.x = q.x();
+    p.y = q.y();
+    p.z = q.z();
+  }
+  return points;
+}
 
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
@@ -80,6 +105,10 @@ TEST(CrashRecovery, KilledAtRandomInstantsEverySessionIsRecoveredWholeToWithinOn
     if (e.path().filename() == "map.ply") reference_maps.push_back(e.path());
   ASSERT_EQ(reference_maps.size(), 1U) << "the uninterrupted run wrote no map (reference.log)";
   const std::vector<XyzI> reference = read_ply(reference_maps[0]);
+  const nlohmann::json reference_summary =
+      nlohmann::json::parse(std::ifstream(reference_maps[0].parent_path() / "summary.json"));
+  ASSERT_EQ(reference_summary["frame"]["name"], "level") << "the drive's accelerometer levels its map";
+  const Eigen::Matrix3d reference_level = level_of(reference_summary);
 
   const std::string client = fmt::format("--payload {} --lcm-url '{}' --timeout 5", payload, url);
   const double truth_start = first_stamp(session / "truth_body.tum");
@@ -143,7 +172,11 @@ TEST(CrashRecovery, KilledAtRandomInstantsEverySessionIsRecoveredWholeToWithinOn
         run_adit(fmt::format("download {} --session {} --format ply --out {} --quiet", client, k.id, out.string()));
     ASSERT_EQ(download.status, 0) << download.output;
     EXPECT_NE(download.output.find(fmt::format("{} points", points)), std::string::npos) << download.output;
-    const std::vector<XyzI> recovered = read_ply(dir / "map.ply");
+    // Levelled once the level had been written before the kill (by the up
+    // the odometry had then: compared in the uninterrupted run's frame).
+    EXPECT_EQ(summary["frame"]["name"], std::filesystem::exists(dir / "level_frame.json") ? "level" : "odometry");
+    const Eigen::Matrix3d level = level_of(summary);
+    const std::vector<XyzI> recovered = relevelled(read_ply(dir / "map.ply"), level, reference_level);
     ASSERT_EQ(recovered.size(), points);
     // Within 2 mm: the uninterrupted run's evicted tiles went through their 1 mm files.
     const std::size_t missing = unmatched(recovered, reference, 0.002);

@@ -111,19 +111,36 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   Sessions sessions(config::load_config(config_file), outputs);
   const std::string id = sessions.start();
   const auto deadline = std::chrono::steady_clock::now() + 300s;
+  std::optional<MapFrame> last_frame;
   while (!sessions.poll() && std::chrono::steady_clock::now() < deadline) {
-    // The status's frame: the poses placed by the latest correction, the tiles by none (no prior map).
+    // The status's frame: the poses placed by the latest correction, then by
+    // gravity's level when the odometry has an up (decision 060); the tiles by
+    // the level alone (no prior map): a turn about the first pose's position.
     const StatusSample status = sessions.status_sample();
-    if (status.frame && status.frame->source == 2) {
-      ++frames_with_correction;
+    if (status.frame && (status.frame->source == kFrameSourceLoops || status.frame->source == kFrameSourceLevel)) {
+      last_frame = status.frame;
       EXPECT_EQ(status.frame->tiles_position, (std::array<double, 3>{0, 0, 0}));
-      EXPECT_EQ(status.frame->tiles_orientation, (std::array<double, 4>{1, 0, 0, 0}));
-      EXPECT_NE(status.graph, nullptr) << "the graph's path (graph_path_t) goes with its correction";
+      if (status.frame->source == kFrameSourceLoops) {
+        EXPECT_EQ(status.frame->tiles_orientation, (std::array<double, 4>{1, 0, 0, 0}));
+      }
+      if (status.frame->position != status.frame->tiles_position) {
+        ++frames_with_correction;
+        EXPECT_NE(status.graph, nullptr) << "the graph's path (graph_path_t) goes with its correction";
+      }
     }
     std::this_thread::sleep_for(20ms);
   }
   sessions.stop_and_wait();
   const std::filesystem::path folder = sessions.folder(id);
+  // The drive's accelerometer levels the exports; the live tiles are placed by that level.
+  const std::optional<Eigen::Isometry3d> level = read_level_frame(folder / "level_frame.json");
+  ASSERT_TRUE(level.has_value()) << "no level_frame.json in " << folder;
+  ASSERT_TRUE(last_frame.has_value());
+  EXPECT_EQ(last_frame->source, kFrameSourceLevel);
+  const Eigen::Quaterniond tiles_turn(last_frame->tiles_orientation[0], last_frame->tiles_orientation[1],
+                                      last_frame->tiles_orientation[2], last_frame->tiles_orientation[3]);
+  EXPECT_LT(tiles_turn.angularDistance(Eigen::Quaterniond(level->linear())), 1e-6)
+      << "the status's last frame places the tiles by the level the exports are in";
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(folder / "summary.json"));
   ASSERT_GE(summary["loops"]["accepted"].get<int>(), 1) << "the drive closed no loop";
   EXPECT_TRUE(summary["loops"]["map_moved"].get<bool>());
@@ -134,7 +151,7 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
     std::ifstream in(folder / name);
     std::string first_line;
     std::getline(in, first_line);
-    EXPECT_EQ(first_line.rfind("# frame: loops", 0), 0U) << name << ": " << first_line;
+    EXPECT_EQ(first_line.rfind("# frame: level (the pose graph's correction", 0), 0U) << name << ": " << first_line;
   }
   const slam::Trajectory map_poses = slam::read_tum(folder / "map_trajectory.tum");
   const slam::Trajectory graph_poses = slam::read_tum(folder / "keyframes.tum");
@@ -172,7 +189,7 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   // the same points, each within the 2 cm a tile may move unsent.
   std::vector<Eigen::Vector3d> live;
   for (const auto& [tile, points] : newest)
-    for (const protocol::MapPoint& p : points) live.emplace_back(p.x, p.y, p.z);
+    for (const protocol::MapPoint& p : points) live.push_back(*level * Eigen::Vector3d(p.x, p.y, p.z));
   const std::vector<test::XyzI> exported = test::read_ply(folder / "map.ply");
   EXPECT_EQ(live.size(), exported.size());
   const std::vector<double> d = nearest_distances(live, exported);
@@ -205,7 +222,7 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
       ASSERT_EQ(protocol::decode_segment(frame, protocol::tile_key(tile_id), tile.params.tile_size_m,
                                          tile.params.quantum_m, tile.params.centred, points),
                 "");
-      for (const protocol::MapPoint& p : points) downloaded.emplace_back(p.x, p.y, p.z);
+      for (const protocol::MapPoint& p : points) downloaded.push_back(*level * Eigen::Vector3d(p.x, p.y, p.z));
     }
   EXPECT_EQ(downloaded.size(), exported.size());
   const std::vector<double> e = nearest_distances(downloaded, exported);
@@ -214,8 +231,13 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   EXPECT_LT(quantile(e, 1.0), 0.002);  // the same points: each quantised to 1 mm in the tile, to float in the file
   const std::optional<MapFrame> placed = restarted.stored_frame(id);
   ASSERT_TRUE(placed.has_value());
-  EXPECT_EQ(placed->source, kFrameSourceLoops);
+  EXPECT_EQ(placed->source, kFrameSourceLevel);
   EXPECT_EQ(placed->tiles_position, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_LT(Eigen::Quaterniond(placed->tiles_orientation[0], placed->tiles_orientation[1], placed->tiles_orientation[2],
+                               placed->tiles_orientation[3])
+                .angularDistance(Eigen::Quaterniond(level->linear())),
+            1e-9)
+      << "the level the exports are in";
   EXPECT_GT(std::hypot(placed->position[0], placed->position[1], placed->position[2]), 0.0)
       << "the poses are placed by the graph's last correction";
 }
@@ -282,7 +304,12 @@ TEST(LiveTilesFollowLoops, AGraphTilesFolderThatCannotBeWrittenCostsNoMapFile) {
   TileStore stored(stored_tile_params(20.0));
   ASSERT_EQ(restarted.load_tiles(id, stored), "");
   EXPECT_EQ(stored.total_points(), static_cast<std::int64_t>(exported.size())) << "tiles/ holds the map's points";
-  EXPECT_FALSE(restarted.stored_frame(id).has_value()) << "tiles/ is in the odometry frame: no frame to place it";
+  // tiles/ is in the odometry frame: placed by gravity's level alone, not the graph's correction.
+  const std::optional<MapFrame> placed = restarted.stored_frame(id);
+  ASSERT_TRUE(placed.has_value());
+  EXPECT_EQ(placed->source, kFrameSourceLevel);
+  EXPECT_EQ(placed->orientation, placed->tiles_orientation);
+  EXPECT_EQ(placed->position, placed->tiles_position);
 }
 
 }  // namespace

@@ -118,11 +118,14 @@ void expect_every_point_everywhere(const SessionRun& run, const std::filesystem:
   EXPECT_EQ(run.published.size(), non_empty);
 
   // The session's journal holds the same map through every eviction, reload
-  // and compaction: rebuilt from it alone, as after a crash, it has every point.
+  // and compaction: rebuilt from it alone, as after a crash, it has every point
+  // (levelled as the session's end did, by the level_frame.json a crash leaves too).
   const std::filesystem::path copy = run.folder.parent_path().parent_path() / "recovered" / run.folder.filename();
   std::filesystem::remove_all(copy);
   std::filesystem::create_directories(copy);
   std::filesystem::copy_file(run.folder / "journal.adj", copy / "journal.adj");
+  if (std::filesystem::exists(run.folder / "level_frame.json"))
+    std::filesystem::copy_file(run.folder / "level_frame.json", copy / "level_frame.json");
   const RecoveryReport recovery = recover_session(copy, {"ply"}, 20.0);
   ASSERT_TRUE(recovery.recovered) << recovery.problem;
   EXPECT_TRUE(recovery.ended_cleanly);

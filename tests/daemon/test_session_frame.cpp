@@ -10,9 +10,12 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "adit/common/error.hpp"
 #include "adit/daemon/map_files.hpp"
 #include "adit/daemon/session_frame.hpp"
+#include "adit/slam/levelling.hpp"
 #include "adit/slam/tum.hpp"
 #include "temp_file.hpp"
 
@@ -34,8 +37,27 @@ TEST(SessionFrame, TheAnchorIsReadBackAsWritten) {
   const std::optional<Eigen::Isometry3d> back = read_prior_frame(dir.path() / "prior_frame.json");
   ASSERT_TRUE(back.has_value());
   EXPECT_TRUE(back->isApprox(sample_anchor(), 1e-12));
-  EXPECT_EQ(frame_summary(back)["name"], "prior_map");
-  EXPECT_EQ(frame_summary(std::nullopt)["name"], "odometry");
+  EXPECT_EQ(frame_summary(export_frame(back, std::nullopt))["name"], "prior_map");
+  EXPECT_EQ(frame_summary(ExportFrame{})["name"], "odometry");
+}
+
+// Gravity's level (decision 060): kept beside the anchor, which wins over it.
+TEST(SessionFrame, TheLevelIsReadBackAsWrittenAndTheAnchorComesFirst) {
+  const test::TempFolder dir;
+  EXPECT_FALSE(read_level_frame(dir.path() / "level_frame.json").has_value());
+  const Eigen::Vector3d up = Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d(1.0, 1.0, 0.0).normalized())
+                                 .toRotationMatrix() * Eigen::Vector3d::UnitZ();
+  const Eigen::Isometry3d level = slam::level_from_up(up);
+  write_level_frame(dir.path() / "level_frame.json", level);
+  const std::optional<Eigen::Isometry3d> back = read_level_frame(dir.path() / "level_frame.json");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_TRUE(back->isApprox(level, 1e-12));
+  const nlohmann::json summary = frame_summary(export_frame(std::nullopt, back));
+  EXPECT_EQ(summary["name"], "level");
+  EXPECT_NEAR(summary["tilt_deg"].get<double>(), 0.5, 1e-9);
+  EXPECT_EQ(export_frame(sample_anchor(), back).source, ExportSource::prior_map);
+  EXPECT_TRUE(export_frame(sample_anchor(), back).from_odometry.isApprox(sample_anchor()));
+  EXPECT_THROW(read_prior_frame(dir.path() / "level_frame.json"), InputError) << "one file's key is not the other's";
 }
 
 TEST(SessionFrame, ABadFileIsNamedWithItsKey) {
@@ -119,9 +141,10 @@ TEST(SessionFrame, ATrajectoryIsMovedIntoThePriorsFrameOnce) {
     t.poses.push_back(p);
   }
   slam::write_tum(file, t);
-  EXPECT_FALSE(place_trajectory_file(dir.path() / "none.tum", sample_anchor()));
-  ASSERT_TRUE(place_trajectory_file(file, sample_anchor()));
-  ASSERT_TRUE(place_trajectory_file(file, sample_anchor()));  // again (a recovery after a crash here): unchanged
+  const ExportFrame anchored = export_frame(sample_anchor(), std::nullopt);
+  EXPECT_FALSE(place_trajectory_file(dir.path() / "none.tum", anchored));
+  ASSERT_TRUE(place_trajectory_file(file, anchored));
+  ASSERT_TRUE(place_trajectory_file(file, anchored));  // again (a recovery after a crash here): unchanged
   const slam::Trajectory back = slam::read_tum(file);
   ASSERT_EQ(back.size(), t.size());
   for (std::size_t i = 0; i < t.size(); ++i) {
@@ -155,17 +178,23 @@ TEST(SessionFrame, ATrajectoryIsMovedByTheGraphsCorrectionAsTheMapIs) {
   const std::vector<Eigen::Isometry3d> graph{first, last};
   const std::vector<Eigen::Isometry3d> odometry{t.poses[0], t.poses[4]};
   const slam::CorrectionTrack track(keyframes, graph, odometry);
-  for (const bool anchored : {false, true}) {
-    const std::filesystem::path file = dir.path() / (anchored ? "anchored.tum" : "trajectory.tum");
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.linear() = Eigen::AngleAxisd(0.4 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (const ExportSource source : {ExportSource::odometry, ExportSource::prior_map, ExportSource::level}) {
+    const std::filesystem::path file = dir.path() / fmt::format("trajectory-{}.tum", static_cast<int>(source));
     slam::write_tum(file, t);
-    const Eigen::Isometry3d frame = anchored ? sample_anchor() : Eigen::Isometry3d::Identity();
-    const std::optional<Eigen::Isometry3d> anchor = anchored ? std::optional(frame) : std::nullopt;
-    ASSERT_TRUE(place_trajectory_file(file, anchor, &track));
-    ASSERT_TRUE(place_trajectory_file(file, anchor, &track));  // again: unchanged
+    const ExportFrame placed = export_frame(source == ExportSource::prior_map ? std::optional(sample_anchor()) : std::nullopt,
+                                            source == ExportSource::level ? std::optional(level) : std::nullopt);
+    const Eigen::Isometry3d& frame = placed.from_odometry;
+    ASSERT_TRUE(place_trajectory_file(file, placed, &track));
+    ASSERT_TRUE(place_trajectory_file(file, placed, &track));  // again: unchanged
     std::ifstream in(file);
     std::string line;
     std::getline(in, line);
-    EXPECT_EQ(line.rfind(anchored ? "# frame: prior_map (the pose graph's" : "# frame: loops", 0), 0U) << line;
+    const char* expected = source == ExportSource::prior_map ? "# frame: prior_map (the pose graph's"
+                           : source == ExportSource::level   ? "# frame: level (the pose graph's"
+                                                             : "# frame: loops";
+    EXPECT_EQ(line.rfind(expected, 0), 0U) << line;
     const slam::Trajectory back = slam::read_tum(file);
     ASSERT_EQ(back.size(), t.size());
     for (std::size_t i = 0; i < t.size(); ++i) {

@@ -124,21 +124,12 @@ void register_download_commands(CLI::App& app, int& status) {
       return;
     }
     auto points = tiles.points();
-    // Placed as the payload's frame_t places the tiles (the prior map's once
-    // anchored, as the session's own map files are written; decisions 049, 054).
-    const Eigen::Isometry3d placed = result.frame ? map_from_tiles(*result.frame) : Eigen::Isometry3d::Identity();
-    const bool moved = !placed.isApprox(Eigen::Isometry3d::Identity());
-    if (moved)
-      for (protocol::MapPoint& p : points) {
-        const Eigen::Vector3d q = placed * Eigen::Vector3d(p.x, p.y, p.z);
-        p.x = q.x();
-        p.y = q.y();
-        p.z = q.z();
-      }
+    const bool moved = place_downloaded_points(points, result.frame);
     protocol::write_map(o->out, format, points);
     const auto& c = tiles.counts();
     const char* frame = !moved ? "the session's own frame"
                         : result.frame->source == frame_t::SOURCE_PRIOR_MAP ? "the prior map's frame"
+                        : result.frame->source == frame_t::SOURCE_LEVEL     ? "the frame levelled by gravity"
                                                                             : "the map frame";
     fmt::print("{} points in {} tiles written to {} in {} ({} requests, {} duplicate and {} stale segments ignored)\n",
                points.size(), tiles.tile_count(), o->out, frame, result.requests, c.duplicate, c.stale);

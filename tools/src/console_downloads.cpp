@@ -96,7 +96,8 @@ void MapDownloads::run(Job& job) {
       }
     });
     if (!result.ok) throw std::runtime_error(result.error);
-    const auto points = tiles.points();
+    auto points = tiles.points();
+    place_downloaded_points(points, result.frame);  // as `adit download` writes it
     const std::filesystem::path dir = folder_ / job.session;
     std::filesystem::create_directories(dir);
     const std::filesystem::path final_file = dir / ("map." + job.format);

@@ -78,6 +78,7 @@ nlohmann::json frame_json(const frame_t& f) {
   return {{"session", f.session_id},
           {"source", f.source == frame_t::SOURCE_PRIOR_MAP ? "prior_map"
                      : f.source == frame_t::SOURCE_LOOPS  ? "loops"
+                     : f.source == frame_t::SOURCE_LEVEL  ? "level"
                                                           : "odometry"},
           {"p", {f.position[0], f.position[1], f.position[2]}},
           {"q", {f.orientation[0], f.orientation[1], f.orientation[2], f.orientation[3]}},

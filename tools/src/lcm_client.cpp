@@ -155,6 +155,18 @@ Eigen::Isometry3d map_from_tiles(const frame_t& frame) {
   return frame.schema >= 2 ? isometry_of(frame.tiles_position, frame.tiles_orientation) : map_from_odometry(frame);
 }
 
+bool place_downloaded_points(std::vector<protocol::MapPoint>& points, const std::optional<frame_t>& frame) {
+  const Eigen::Isometry3d placed = frame ? map_from_tiles(*frame) : Eigen::Isometry3d::Identity();
+  if (placed.isApprox(Eigen::Isometry3d::Identity())) return false;
+  for (protocol::MapPoint& p : points) {
+    const Eigen::Vector3d q = placed * Eigen::Vector3d(p.x, p.y, p.z);
+    p.x = q.x();
+    p.y = q.y();
+    p.z = q.z();
+  }
+  return true;
+}
+
 void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool()>& until) {
   // Subscribes `channel` for as long as the follow lasts, when `handler` is set.
   const auto listen = [this]<typename Message>(Channel channel, const std::function<void(const Message&)>& handler) {

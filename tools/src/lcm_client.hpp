@@ -40,6 +40,10 @@ Eigen::Isometry3d map_from_odometry(const frame_t& frame);
 // The same for the tiles, map <- tiles: schema 2's own transform (the tiles
 // follow the pose graph with map.loops_move_map), schema 1's map <- odometry.
 Eigen::Isometry3d map_from_tiles(const frame_t& frame);
+// A downloaded map's points placed as its session's `frame` places the tiles
+// (the prior map's frame, or gravity's level, as the session's own map files:
+// decisions 049, 054, 060); false when that moved nothing (no frame, or identity).
+bool place_downloaded_points(std::vector<protocol::MapPoint>& points, const std::optional<frame_t>& frame);
 
 class LcmClient {
  public:

@@ -17,10 +17,12 @@
 // stage (live, its hand-off drops the oldest scan; a replay waits).
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -56,6 +58,15 @@ class MappingStage {
   // the file); where evicted tiles and old keyframes' scans go (empty = RAM).
   void write_map_trajectory_to(const std::filesystem::path& file);
   void spill_to(const std::filesystem::path& tiles_dir, const std::filesystem::path& keyframes_dir);
+  // Before start(): gravity's level (session_frame.hpp) is written to `file`
+  // (a failure is logged) from the odometry's first up, again when it has
+  // turned by kLevelTurnRad and kLevelPeriodS have passed, and at the end;
+  // empty = kept in RAM only (level()).
+  void write_level_to(const std::filesystem::path& file) { level_file_ = file; }
+  static constexpr double kLevelTurnRad = 0.005 * M_PI / 180.0;  // 4 mm over 50 m
+  static constexpr double kLevelPeriodS = 2.0;
+  // Any thread: the level last kept (slam::level_from_up of the odometry's up); nullopt before.
+  std::optional<Eigen::Isometry3d> level() const;
   // Before start(): each keyframe also goes to `loops` (the loop-closure stage's queue).
   void feed_loops(KeyframeQueue* loops) { loops_ = loops; }
   // Before start(): the tiles sent go placed by the loop closure's latest
@@ -111,6 +122,8 @@ class MappingStage {
   void flush_grid();
   void journal_new_points();
   void tile_file_error(const std::string& problem);
+  void follow_level(const Eigen::Vector3d& up, std::int64_t stamp_ns);
+  void keep_level();
 
   const config::MapSection config_;
   const config::GridSection grid_config_;
@@ -126,6 +139,13 @@ class MappingStage {
   slam::TileEviction eviction_;
   std::optional<TileSpill> spill_;        // with a tiles folder and map.evict_after_keyframes
   std::filesystem::path keyframes_dir_;   // empty = keyframe scans stay in RAM
+  std::filesystem::path level_file_;
+  std::optional<Eigen::Vector3d> latest_up_;  // the odometry's, from the last slot that had one
+  std::optional<Eigen::Vector3d> kept_up_;    // the one level_ was made from
+  std::int64_t kept_up_ns_ = 0;
+  bool level_off_ = false;  // keeping it failed: the session stays in the odometry frame
+  mutable std::mutex level_mutex_;            // kept a few times a session, read by the status at 2 Hz
+  std::optional<Eigen::Isometry3d> level_;
   std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
   std::uint64_t keyframe_bytes_ = 0;
   KeyframeQueue* loops_ = nullptr;

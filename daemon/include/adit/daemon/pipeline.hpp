@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,9 @@ struct SessionFiles {
   // Where the odometry frame's place in the prior map is written once aditd
   // localised against it (prior_map.dir; prior_localiser.hpp); empty = not written.
   std::filesystem::path prior_frame_file;
+  // Where gravity's level is written once the odometry's up has settled
+  // (session_frame.hpp); empty = not written, the exports stay in the odometry frame.
+  std::filesystem::path level_frame_file;
 };
 
 class Pipeline {
@@ -110,6 +114,9 @@ class Pipeline {
   const slam::TiledVoxelMap& map() const;
   const TileSpill* tile_spill() const;  // null without SessionFiles::tiles_dir
   const std::vector<slam::Keyframe>& keyframes() const;
+  // Any thread: gravity's level as the mapping thread last kept it
+  // (MappingStage::level); nullopt before the odometry had an up, or without one.
+  std::optional<Eigen::Isometry3d> level() const;
   // The live 2D grid (grid.enabled), complete after join(); null without it.
   const slam::LiveGrid* grid() const;
   // The loop-closure stage (map.loop_closure), complete after join(); null without it.

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -53,6 +54,9 @@ struct MapSlot {
   // IMU's, after the scan's update; slam::Odometry::sweep_motion); empty:
   // the mapping deskews with the constant velocity between its pose and the next.
   std::vector<slam::TimedPose> sweep;
+  // Gravity's up in the odometry frame as the odometry measures it now
+  // (slam::Odometry::up); nullopt before it has one, or without an IMU or accelerometer.
+  std::optional<Eigen::Vector3d> up;
 };
 
 // Where results leave the pipeline. Each runs on one pipeline thread and must

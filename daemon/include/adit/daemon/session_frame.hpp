@@ -1,10 +1,14 @@
 #pragma once
 // The frame a session's exports are written in (docs/PRIOR-MAP.md, "The
 // session's frame"): the prior map's once the odometry anchored to it, else
-// the odometry's own. The anchor, prior_from_odometry, is kept in the
-// session's prior_frame.json the moment it is found; at the session's end, and
-// on its recovery after a crash, the map files and the trajectories are
-// written through it, and summary.json's "frame" says which frame they are in.
+// gravity's level when the odometry measured gravity (an IMU's or the
+// accelerometer's up: the odometry frame turned about its origin so that z
+// is plumb, decision 060), else the odometry's own. The anchor,
+// prior_from_odometry, is kept in the session's prior_frame.json the moment
+// it is found; the level, level_from_odometry, in level_frame.json by the
+// mapping thread as the odometry's up settles. At the session's end, and on
+// a recovery after a crash, the map files and the trajectories are written
+// through it, and summary.json's "frame" says which frame they are in.
 // The tiles/ folder stays in the odometry frame; the live tiles too, unless
 // map.loops_move_map moves them by the loop closure's graph (the live
 // frame_t places them either way; docs/LOOPS.md "Live tiles"). Then, at the
@@ -40,15 +44,20 @@ std::optional<Eigen::Isometry3d> read_prior_frame(const std::filesystem::path& f
 // The same from the file's text; `name` is the file named in errors.
 Eigen::Isometry3d parse_prior_frame(std::string_view text, const std::string& name);
 
+// Gravity's level (slam::level_from_up of the odometry's up), as
+// write_prior_frame and read_prior_frame keep the anchor.
+void write_level_frame(const std::filesystem::path& file, const Eigen::Isometry3d& level_from_odometry);
+std::optional<Eigen::Isometry3d> read_level_frame(const std::filesystem::path& file);
+
 // Rewrites the TUM trajectory `file` with each pose T at time t as
-// A·C(t)·T, durably, under a first line saying which: A is the prior map's
-// `anchor` (prior_from_odometry), C is `track`'s correction (the pose
-// graph's, as the map files are moved); each identity when absent. A file
-// already under such a line is left as it is (a recovery after a crash
+// A·C(t)·T, durably, under a first line saying which: A is `frame`'s
+// (the prior's anchor or gravity's level), C is `track`'s correction (the
+// pose graph's, as the map files are moved); each identity when absent. A
+// file already under such a line is left as it is (a recovery after a crash
 // between this and the summary does not move it twice). Returns false when
 // there is no such file; throws adit::InputError naming a malformed one,
 // std::runtime_error one that cannot be written.
-bool place_trajectory_file(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& anchor,
+bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
                            const slam::CorrectionTrack* track = nullptr);
 
 // The graph's last correction C (graph <- odometry), written durably into
@@ -63,7 +72,9 @@ std::optional<Eigen::Isometry3d> read_graph_correction(const std::filesystem::pa
 std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir);
 
 // summary.json's "frame": {"name": "prior_map", "prior_from_odometry": 4 × 4}
-// with an anchor, {"name": "odometry"} without.
-nlohmann::json frame_summary(const std::optional<Eigen::Isometry3d>& prior_from_odometry);
+// with an anchor, {"name": "level", "level_from_odometry": 4 × 4, "tilt_deg"}
+// levelled (tilt_deg: how far the odometry frame's z was from plumb),
+// {"name": "odometry"} else.
+nlohmann::json frame_summary(const ExportFrame& frame);
 
 }  // namespace adit::daemon

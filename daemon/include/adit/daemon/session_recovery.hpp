@@ -16,6 +16,8 @@
 
 #include <Eigen/Geometry>
 
+#include "adit/daemon/session_frame.hpp"
+
 namespace adit::daemon {
 
 struct RecoveryReport {
@@ -37,9 +39,11 @@ struct RecoveryReport {
   // How far the odometry's trajectory.tum went past the journal's last map
   // pose: the part of the session the map lost (0 when it did not).
   double lost_s = 0.0;
-  // The session's prior_frame.json: the exports are in the prior map's frame
-  // (session_frame.hpp). Unset without one, or when it could not be read (logged).
-  std::optional<Eigen::Isometry3d> prior_from_odometry;
+  // The frame the exports are in (session_frame.hpp): the prior's
+  // (prior_frame.json), else gravity's level (level_frame.json, written when
+  // the session was ending), else the odometry's; a file that could not be
+  // read is logged and left out.
+  ExportFrame frame;
   std::vector<std::string> files;
 };
 

@@ -1,0 +1,117 @@
+// The mapping stage keeping gravity's level (MappingStage::write_level_to,
+// decision 060): from the odometry's first up, on the disk for a recovery and
+// in RAM for the status; the last up at the end; an up it cannot level by
+// ends the levelling, leaving the session in the odometry frame.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "adit/daemon/mapping_stage.hpp"
+#include "adit/daemon/session_frame.hpp"
+#include "adit/slam/levelling.hpp"
+#include "temp_file.hpp"
+
+namespace adit::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Gravity's up seen in an odometry frame tilted by `deg` about x.
+Eigen::Vector3d up_tilted(double deg) {
+  return Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix() * Eigen::Vector3d::UnitZ();
+}
+
+bool same_turn(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() < 1e-9;
+}
+
+// A still sensor before a wall; each scan with its up (none: nullopt).
+class LevelRun {
+ public:
+  explicit LevelRun(const std::filesystem::path& file)
+      : scans_(4, Overflow::wait, [] { return MapSlot{}; }),
+        stage_(config(), slam::OdometryConfig{}, scans_, 100, {}, stats_, stop_) {
+    stage_.write_level_to(file);
+    stage_.start();
+  }
+  void push(double t_s, const std::optional<Eigen::Vector3d>& up) {
+    MapSlot* slot = scans_.acquire_or_wait([] { return true; });
+    ASSERT_NE(slot, nullptr);
+    slot->stamp_ns = static_cast<std::int64_t>(t_s * 1e9);
+    slot->valid = true;
+    slot->points.assign(10, Eigen::Vector3f(5.0F, 0.0F, 0.0F));
+    slot->times_s.assign(10, 0.0F);
+    slot->intensities.assign(10, 1.0F);
+    slot->up = up;
+    scans_.publish(slot);
+  }
+  void end() {
+    scans_.close();
+    stage_.join();
+  }
+  const MappingStage& stage() const { return stage_; }
+
+ private:
+  static config::Config config() {
+    config::Config c;
+    c.map.refine = false;
+    c.grid.enabled = false;
+    return c;
+  }
+  std::atomic<bool> stop_{false};
+  PipelineStats stats_;
+  Handoff<MapSlot> scans_;
+  MappingStage stage_;
+};
+
+TEST(MappingLevel, TheOdometrysUpIsKeptFromTheFirstAndTheLastAtTheEnd) {
+  const test::TempFolder dir;
+  const std::filesystem::path file = dir.path() / "level_frame.json";
+  LevelRun run(file);
+  EXPECT_FALSE(run.stage().level().has_value());
+  run.push(1.0, std::nullopt);  // before the odometry had an up
+  run.push(1.1, up_tilted(0.5));
+  run.push(1.2, up_tilted(0.5));  // the stage maps a scan once the next one came: 1.1 s is mapped now
+  for (int i = 0; i < 300 && !std::filesystem::exists(file); ++i) std::this_thread::sleep_for(10ms);
+  const std::optional<Eigen::Isometry3d> first = read_level_frame(file);
+  ASSERT_TRUE(first.has_value()) << "the first up was not kept on the disk";
+  EXPECT_TRUE(same_turn(*first, slam::level_from_up(up_tilted(0.5))));
+  // The status reads it from another thread (ThreadSanitizer runs this test).
+  std::optional<Eigen::Isometry3d> seen;
+  for (int i = 0; i < 300 && !seen; ++i) {
+    seen = run.stage().level();
+    if (!seen) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(seen.has_value());
+  EXPECT_TRUE(same_turn(*seen, *first));
+  // The filter's gravity moves on; the up at the end is what the exports get.
+  run.push(2.0, up_tilted(0.3));
+  run.push(5.0, up_tilted(0.2));   // kept: 2 s on and turned
+  run.push(5.5, up_tilted(0.25));  // not yet (within kLevelPeriodS): kept at the end
+  run.push(5.6, std::nullopt);     // a scan without an up changes nothing
+  run.end();
+  const std::optional<Eigen::Isometry3d> last = read_level_frame(file);
+  ASSERT_TRUE(last.has_value());
+  EXPECT_TRUE(same_turn(*last, slam::level_from_up(up_tilted(0.25))));
+  ASSERT_TRUE(run.stage().level().has_value());
+  EXPECT_TRUE(same_turn(*run.stage().level(), *last));
+}
+
+TEST(MappingLevel, AnUpThatCannotLevelEndsTheLevellingAndNoFileIsLeft) {
+  const test::TempFolder dir;
+  const std::filesystem::path file = dir.path() / "level_frame.json";
+  LevelRun run(file);
+  run.push(1.0, up_tilted(0.5));
+  run.push(1.1, up_tilted(0.5));
+  run.push(4.0, Eigen::Vector3d(0.0, 0.0, -1.0));  // a sign error: down, not a tilt
+  run.push(7.0, up_tilted(0.4));                   // not taken after it
+  run.push(7.1, up_tilted(0.4));
+  run.end();
+  EXPECT_FALSE(std::filesystem::exists(file)) << "the first level kept would leave the exports half levelled";
+  EXPECT_FALSE(run.stage().level().has_value());
+}
+
+}  // namespace
+}  // namespace adit::daemon
