@@ -4,7 +4,8 @@
 # map points within 5 cm of the true scene; then the mean and the worst. The
 # map is placed by its first pose (the figure of record) and again by that
 # pose's position and heading only (`--align heading`): there it keeps its own
-# vertical, the first pose's, and its tilt from plumb (printed) counts.
+# vertical (levelled by the odometry's gravity, decision 060), and its tilt
+# from plumb (printed) counts.
 #
 # One drive is not enough to judge a change: its figure moves by 10-40 points
 # with a tenth of a degree of tilt, and a change that helps one seed can cost

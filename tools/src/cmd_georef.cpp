@@ -158,7 +158,7 @@ void register_georef_commands(CLI::App& app, int& status) {
   cmd->add_option("--control", c->control, "Total-station CSV: id,E,N,H (header optional, names the column order)")->required();
   cmd->add_option("--targets", c->targets, "Targets found in the map: id,x,y,z[,sigma_m] (default SESSION/products/targets.csv)");
   cmd->add_flag("--scale", c->options.with_scale, "Fit a scale too (similarity), not only rotation and translation");
-  cmd->add_flag("--level", c->options.level, "Turn the map about the vertical only (keeps the map's own tilt: its z is the first pose's); H by a shift");
+  cmd->add_flag("--level", c->options.level, "Turn the map about the vertical only (keeps the map's own tilt: aditd levels it by gravity); H by a shift");
   cmd->add_option("--tolerance", c->options.tolerance_m, "Flag residuals and check residuals above this (m, default 0.05)");
   cmd->add_option("--match", c->match, "How control points find their targets: auto (ids if they all match), id, geometry")
       ->check(CLI::IsMember({"auto", "id", "geometry"}));

@@ -44,13 +44,14 @@ struct GeorefOptions {
   bool with_scale = false;
   // Turn the map about the vertical only (4 parameters, 5 with scale): a tilt
   // fitted on a few control points carries the map's height drift far from
-  // them. The map's z is the first pose's: it keeps the payload's starting
-  // tilt (docs/decisions/059-graph-keeps-the-first-poses-attitude.md).
+  // them. It trusts the map's z: aditd levels its exports by the odometry's
+  // gravity (decision 060); without an IMU or accelerometer their z is the
+  // first pose's, tilted as the payload started (decision 059).
   bool level = false;
   double tolerance_m = 0.05;        // a residual or leave-one-out residual above this is flagged
   double match_tolerance_m = 0.25;  // pairwise distances agree within this + 0.2 % of the distance
-  // aditd's map has z near up (the first pose's, within the payload's
-  // starting tilt): a fit that tilts it more than this is a wrong match or a mirror.
+  // aditd's map has z near up (gravity's, or the first pose's within the
+  // payload's starting tilt): a fit that tilts it more than this is a wrong match or a mirror.
   double max_tilt_deg = 10.0;
   MatchBy match = MatchBy::automatic;
 };
