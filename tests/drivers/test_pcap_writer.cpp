@@ -7,12 +7,13 @@
 
 #include "adit/drivers/pcap_reader.hpp"
 #include "adit/drivers/pcap_writer.hpp"
+#include "shared_data.hpp"
 
 namespace adit::drivers {
 namespace {
 
 TEST(PcapWriter, DatagramsComeBackWholeThroughFragmentation) {
-  const auto file = std::filesystem::path(ADIT_BINARY_DIR) / "test-pcap-writer.pcap";
+  const auto file = ::adit::test::binary_dir() / "test-pcap-writer.pcap";
   std::vector<std::vector<std::uint8_t>> sent;
   for (const std::size_t size : {1206u, 1472u, 1473u, 8000u, 0u}) {
     std::vector<std::uint8_t> payload(size);

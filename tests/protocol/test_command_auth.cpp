@@ -15,6 +15,7 @@
 #include "adit/common/error.hpp"
 #include "adit/protocol/command_auth.hpp"
 #include "adit/protocol/command_gate.hpp"
+#include "shared_data.hpp"
 
 namespace adit::protocol {
 namespace {
@@ -200,7 +201,7 @@ TEST(CommandAuth, RotationAcceptsEveryListedKey) {
 TEST(CommandAuth, FuzzSeedsAreSignedCommandsTheKeyedGateExecutes) {
   CommandGate gate = keyed_gate();
   for (int i = 0; i < 3; ++i) {
-    const auto path = std::filesystem::path(ADIT_SOURCE_DIR) / fmt::format("tests/fuzz/seeds/protocol/signed_{}.bin", i);
+    const auto path = ::adit::test::source_dir() / fmt::format("tests/fuzz/seeds/protocol/signed_{}.bin", i);
     std::ifstream in(path, std::ios::binary);
     const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     ASSERT_FALSE(bytes.empty()) << path;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "adit/sim/session.hpp"
+#include "shared_data.hpp"
 
 namespace adit::sim::test {
 
@@ -14,7 +15,7 @@ inline SimOptions short_session(const std::string& name) {
   o.scene = "mine";
   o.duration_s = 11.0;  // the robot's shortest: 1 s still, two legs with ramps, the turn
   o.seed = 7;
-  o.out = std::filesystem::path(ADIT_BINARY_DIR) / "test-sessions" / name;
+  o.out = ::adit::test::binary_dir() / "test-sessions" / name;
   return o;
 }
 

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "shared_data.hpp"
+
 namespace adit::test {
 
 struct ProgramResult {
@@ -76,7 +78,7 @@ struct CommandRun {
 // `adit ARGUMENTS` through the shell (arguments may hold redirections and
 // globs), stdout and stderr combined.
 inline CommandRun run_adit(const std::string& arguments) {
-  const std::string command = (ADIT_BINARY_DIR "/bin/adit ") + arguments + " 2>&1";
+  const std::string command = (binary_dir() / "bin/adit").string() + " " + arguments + " 2>&1";
   CommandRun run;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return run;

@@ -1,6 +1,8 @@
 #pragma once
-// Locating ../shared/data for realdata tests. ADIT_SHARED_DATA in the
-// environment wins; otherwise the folder beside the source tree.
+// Locating ../shared/data for realdata tests, and this build's source and
+// build trees. ADIT_SHARED_DATA in the environment wins; otherwise the folder
+// beside the source tree. The paths are defined in the file CMake generates
+// from test_paths.cpp.in.
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,15 +12,16 @@
 
 namespace adit::test {
 
+std::filesystem::path source_dir();
+std::filesystem::path binary_dir();
+std::filesystem::path shared_data_default();  // ../shared/data beside the source tree
+
 inline std::optional<std::filesystem::path> shared_data_dir() {
   const char* env = std::getenv("ADIT_SHARED_DATA");
-  const std::filesystem::path dir = env != nullptr ? env : ADIT_SHARED_DATA_DEFAULT;
+  const std::filesystem::path dir = env != nullptr ? env : shared_data_default();
   if (std::filesystem::is_directory(dir)) return std::filesystem::canonical(dir);
   return std::nullopt;
 }
-
-inline std::filesystem::path source_dir() { return ADIT_SOURCE_DIR; }
-inline std::filesystem::path binary_dir() { return ADIT_BINARY_DIR; }
 
 }  // namespace adit::test
 
