@@ -72,7 +72,7 @@ struct SessionFiles {
   // Where the odometry frame's place in the prior map is written once aditd
   // localised against it (prior_map.dir; prior_localiser.hpp); empty = not written.
   std::filesystem::path prior_frame_file;
-  // Where gravity's level is written once the odometry's up has settled
+  // Where gravity's level is written from the odometry's first up, again as it turns
   // (session_frame.hpp); empty = not written, the exports stay in the odometry frame.
   std::filesystem::path level_frame_file;
 };
