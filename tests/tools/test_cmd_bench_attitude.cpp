@@ -11,6 +11,7 @@
 #include "printed_figure.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
+#include "sim_sessions.hpp"
 
 namespace {
 
@@ -19,18 +20,8 @@ CommandRun adit(const std::string& arguments) { return adit::test::run_adit(argu
 
 using adit::test::printed_figure;
 
-std::filesystem::path simulated_drive() {
-  const auto dir = adit::test::binary_dir() / "test-sessions" / "bench-attitude";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim =
-        adit("sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out " + dir.string());
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
-
 TEST(CmdBenchAttitude, RegistrationAgainstTheTrueMapRecoversTheTilt) {
-  const auto d = simulated_drive();
+  const auto d = adit::test::mine_drive_12s();
   const CommandRun run = adit("bench attitude --pcap " + (d / "lidar.pcap").string() + " --model VLP-16 --calibration " +
                               (d / "VLP16.yaml").string() + " --truth " + (d / "truth_sensor.tum").string());
   ASSERT_EQ(run.status, 0) << run.output;
@@ -47,7 +38,7 @@ TEST(CmdBenchAttitude, RegistrationAgainstTheTrueMapRecoversTheTilt) {
 }
 
 TEST(CmdBenchAttitude, AMissingTruthExitsWithStatus2NamingIt) {
-  const auto d = simulated_drive();
+  const auto d = adit::test::mine_drive_12s();
   const CommandRun run = adit("bench attitude --pcap " + (d / "lidar.pcap").string() + " --model VLP-16 --calibration " +
                               (d / "VLP16.yaml").string() + " --truth /nonexistent/truth.tum");
   EXPECT_EQ(run.status, 2) << run.output;

@@ -11,6 +11,7 @@
 
 #include "run_program.hpp"
 #include "shared_data.hpp"
+#include "sim_sessions.hpp"
 #include "temp_file.hpp"
 
 namespace {
@@ -18,19 +19,9 @@ namespace {
 using adit::test::CommandRun;
 CommandRun adit(const std::string& arguments) { return adit::test::run_adit(arguments); }
 
-std::filesystem::path simulated_drive() {
-  const auto dir = adit::test::binary_dir() / "test-sessions" / "bench-loops";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim =
-        adit("sim --scene mine --platform robot --sensor VLP-16 --duration 12 --seed 7 --out " + dir.string());
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
-}
-
 TEST(CmdBenchLoops, TimesEveryKeyframeAndTheGraph) {
   const CommandRun run =
-      adit("bench loops --session " + simulated_drive().string() + " --graph-keyframes 600 --graph-runs 1 --json");
+      adit("bench loops --session " + adit::test::mine_drive_12s().string() + " --graph-keyframes 600 --graph-runs 1 --json");
   ASSERT_EQ(run.status, 0) << run.output;
   const auto j = nlohmann::json::parse(run.output.substr(run.output.find('{')));
   const int keyframes = j["keyframes"].get<int>();

@@ -13,6 +13,7 @@
 #include "printed_figure.hpp"
 #include "run_program.hpp"
 #include "shared_data.hpp"
+#include "sim_sessions.hpp"
 
 namespace {
 
@@ -21,14 +22,10 @@ CommandRun adit(const std::string& arguments) { return adit::test::run_adit(argu
 
 using adit::test::printed_figure;
 
+// A 15 s hand-held walk through the mine with a VLP-16 and the CAN IMU (seed 1).
 std::filesystem::path simulated_walk() {
-  const auto dir = adit::test::binary_dir() / "test-sessions" / "bench-odometry-handheld";
-  if (!std::filesystem::exists(dir / "lidar.pcap")) {
-    const CommandRun sim =
-        adit("sim --scene mine --platform handheld --sensor VLP-16 --duration 15 --seed 1 --out " + dir.string());
-    EXPECT_EQ(sim.status, 0) << sim.output;
-  }
-  return dir;
+  return adit::test::simulated_session("test-sessions/bench-odometry-handheld",
+                                       "--scene mine --platform handheld --sensor VLP-16 --duration 15 --seed 1");
 }
 
 CommandRun bench(const std::filesystem::path& d, const std::string& imu) {

@@ -13,6 +13,7 @@
 
 #include "run_program.hpp"
 #include "shared_data.hpp"
+#include "sim_sessions.hpp"
 
 namespace {
 
@@ -69,12 +70,9 @@ std::array<double, 3> printed(const std::string& output, const std::string& key)
 class CmdCalibrateMounting : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    session_ = adit::test::binary_dir() / "test-sessions" / "cmd-calibrate-mounting";
-    if (fs::exists(session_ / "truth_sensor.tum")) return;
-    fs::remove_all(session_);
-    const CommandRun run = adit("sim --scene building --platform robot --sensor VLP-16 --duration 60 --seed 2 "
-                                "--mount-rpy-deg 2 -4 3 --out " + session_.string());
-    ASSERT_EQ(run.status, 0) << run.output;
+    session_ = adit::test::simulated_session(
+        "test-sessions/cmd-calibrate-mounting",
+        "--scene building --platform robot --sensor VLP-16 --duration 60 --seed 2 --mount-rpy-deg 2 -4 3");
   }
   static fs::path session_;
 };
