@@ -66,9 +66,12 @@ std::string GridMosaic::put(const std::string& session_id, float resolution_m, s
   return {};
 }
 
-GridImage GridMosaic::image() const {
-  GridImage image;
-  if (patches_.empty()) return image;
+GridImage GridMosaic::image() const { return bounding_image(true); }
+
+GridImage GridMosaic::extent() const { return bounding_image(false); }
+
+GridImage GridMosaic::bounding_image(bool cells) const {
+  if (patches_.empty()) return {};
   std::int32_t min_x = std::numeric_limits<std::int32_t>::max(), min_y = min_x;
   std::int32_t max_x = std::numeric_limits<std::int32_t>::min(), max_y = max_x;
   for (const auto& [coord, patch] : patches_) {
@@ -77,6 +80,55 @@ GridImage GridMosaic::image() const {
     min_y = std::min(min_y, coord.second);
     max_y = std::max(max_y, coord.second);
   }
+  return image_of(min_x, min_y, max_x, max_y, cells);
+}
+
+namespace {
+
+// The block of patch coordinate c: floor(c / n), for negative c too.
+std::int32_t block_of(std::int32_t c, std::int32_t n) { return c >= 0 ? c / n : -((-c + n - 1) / n); }
+
+}  // namespace
+
+std::vector<GridBlock> GridMosaic::blocks(std::int32_t block_patches) const {
+  std::map<std::pair<std::int32_t, std::int32_t>, GridBlock> blocks;
+  for (const auto& [coord, patch] : patches_) {
+    const std::int32_t bx = block_of(coord.first, block_patches), by = block_of(coord.second, block_patches);
+    GridBlock& b = blocks[{bx, by}];
+    b.x = bx;
+    b.y = by;
+    b.version += patch.version;
+    ++b.patches;
+  }
+  std::vector<GridBlock> out;
+  out.reserve(blocks.size());
+  for (const auto& [coord, block] : blocks) out.push_back(block);
+  return out;
+}
+
+GridImage GridMosaic::block_image(std::int32_t block_patches, std::int32_t x, std::int32_t y) const {
+  // The bounding box of the block's patches: a block at the grid's edge is
+  // not padded to its full size with unknown cells (a texture upload saved).
+  std::int32_t min_x = std::numeric_limits<std::int32_t>::max(), min_y = min_x;
+  std::int32_t max_x = std::numeric_limits<std::int32_t>::min(), max_y = max_x;
+  const std::int32_t x0 = x * block_patches, y0 = y * block_patches;
+  const std::int32_t x1 = x0 + (block_patches - 1), y1 = y0 + (block_patches - 1);
+  for (auto it = patches_.lower_bound({x0, std::numeric_limits<std::int32_t>::min()});
+       it != patches_.end() && it->first.first <= x1; ++it) {
+    const auto [px, py] = it->first;
+    if (py < y0 || py > y1) continue;
+    min_x = std::min(min_x, px);
+    max_x = std::max(max_x, px);
+    min_y = std::min(min_y, py);
+    max_y = std::max(max_y, py);
+  }
+  if (min_x > max_x) return {};
+  return image_of(min_x, min_y, max_x, max_y, true);
+}
+
+GridImage GridMosaic::image_of(std::int32_t min_x, std::int32_t min_y, std::int32_t max_x, std::int32_t max_y,
+                               bool cells) const {
+  GridImage image;
   const int n = patch_cells_;
   // The message's float, to the micrometre: 0.05 is written 0.05, not 0.0500000007.
   image.resolution_m = std::round(static_cast<double>(resolution_m_) * 1e6) / 1e6;
@@ -84,8 +136,12 @@ GridImage GridMosaic::image() const {
   image.origin_y = static_cast<double>(min_y) * n * image.resolution_m;
   image.width = (max_x - min_x + 1) * n;
   image.height = (max_y - min_y + 1) * n;
+  if (!cells) return image;
   image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
-  for (const auto& [coord, patch] : patches_) {
+  for (auto it = patches_.lower_bound({min_x, std::numeric_limits<std::int32_t>::min()});
+       it != patches_.end() && it->first.first <= max_x; ++it) {
+    const auto& [coord, patch] = *it;
+    if (coord.second < min_y || coord.second > max_y) continue;
     const int col0 = (coord.first - min_x) * n;
     const int row0 = (coord.second - min_y) * n;
     for (int r = 0; r < n; ++r)

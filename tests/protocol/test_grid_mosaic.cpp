@@ -1,4 +1,5 @@
 // The live grid's patches: coded, checked and assembled into one image.
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -75,6 +76,66 @@ TEST(GridMosaic, KeepsTheNewestVersionOfEachPatchAndDrawsThemInPlace) {
   EXPECT_EQ(at(1, kCells + 1), 0);
   EXPECT_EQ(at(0, 0), -1);             // patch (-1, 0) never came
   EXPECT_EQ(at(kCells, kCells), -1);   // nor (0, 1)
+}
+
+// Blocks of 2 × 2 patches: patch -1 is in block -1, patches 0 and 1 in block 0.
+TEST(GridMosaic, BlocksHoldTheirPatchesInPlaceAndSumTheirVersions) {
+  GridMosaic mosaic;
+  EXPECT_TRUE(mosaic.blocks(2).empty());
+  EXPECT_TRUE(mosaic.block_image(2, 0, 0).cells.empty());
+  ASSERT_EQ(mosaic.accept(patch_message("s1", -1, 0, 3, 0)), "");
+  ASSERT_EQ(mosaic.accept(patch_message("s1", 0, 0, 1, 0)), "");
+  ASSERT_EQ(mosaic.accept(patch_message("s1", 1, 1, 2, -1)), "");
+  ASSERT_EQ(mosaic.accept(patch_message("s1", 2, -3, 1, 0)), "");
+  const std::vector<GridBlock> blocks = mosaic.blocks(2);
+  ASSERT_EQ(blocks.size(), 3U);
+  EXPECT_EQ(blocks[0].x, -1);
+  EXPECT_EQ(blocks[0].y, 0);
+  EXPECT_EQ(blocks[0].version, 3);
+  EXPECT_EQ(blocks[1].x, 0);
+  EXPECT_EQ(blocks[1].y, 0);
+  EXPECT_EQ(blocks[1].version, 3) << "patches (0, 0) version 1 and (1, 1) version 2";
+  EXPECT_EQ(blocks[1].patches, 2U);
+  EXPECT_EQ(blocks[2].x, 1);
+  EXPECT_EQ(blocks[2].y, -2) << "patch y -3 lies in block -2 (patches -4 and -3)";
+
+  const GridImage b = mosaic.block_image(2, 0, 0);
+  ASSERT_EQ(b.width, 2 * kCells);
+  ASSERT_EQ(b.height, 2 * kCells);
+  EXPECT_DOUBLE_EQ(b.origin_x, 0.0);
+  EXPECT_DOUBLE_EQ(b.origin_y, 0.0);
+  const auto at = [&](const GridImage& image, int col, int row) {
+    return image.cells[static_cast<std::size_t>(row * image.width + col)];
+  };
+  EXPECT_EQ(at(b, 0, 0), 100);                    // patch (0, 0)'s first cell
+  EXPECT_EQ(at(b, 1, 0), 0);
+  EXPECT_EQ(at(b, kCells, kCells), 100);          // patch (1, 1)'s first cell
+  EXPECT_EQ(at(b, kCells + 1, kCells), -1);       // patch (1, 1): unknown
+  EXPECT_EQ(at(b, kCells, 0), -1);                // patch (1, 0) never came
+  // A block is cut to its patches' bounding box: block -1 holds patch (-1, 0) only.
+  const GridImage left = mosaic.block_image(2, -1, 0);
+  EXPECT_DOUBLE_EQ(left.origin_x, -2.0);          // patch -1 at 4 cells of 0.5 m
+  EXPECT_EQ(left.width, kCells);
+  EXPECT_EQ(left.height, kCells);
+  EXPECT_EQ(at(left, 0, 0), 100);                 // patch (-1, 0)'s first cell
+  EXPECT_TRUE(mosaic.block_image(2, 5, 5).cells.empty()) << "a block without patches";
+
+  // Every block's cells are the whole image's there.
+  const GridImage whole = mosaic.image();
+  for (const GridBlock& block : blocks) {
+    const GridImage part = mosaic.block_image(2, block.x, block.y);
+    const int col0 = static_cast<int>(std::lround((part.origin_x - whole.origin_x) / whole.resolution_m));
+    const int row0 = static_cast<int>(std::lround((part.origin_y - whole.origin_y) / whole.resolution_m));
+    for (int row = 0; row < part.height; ++row)
+      for (int col = 0; col < part.width; ++col) {
+        const int c = col0 + col, r = row0 + row;
+        if (c < 0 || r < 0 || c >= whole.width || r >= whole.height) {
+          EXPECT_EQ(at(part, col, row), -1);
+          continue;
+        }
+        ASSERT_EQ(at(part, col, row), at(whole, c, r)) << "block (" << block.x << ", " << block.y << ")";
+      }
+  }
 }
 
 TEST(GridMosaic, RefusesMalformedPatchesAndStartsAgainForANewSession) {

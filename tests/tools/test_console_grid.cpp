@@ -1,7 +1,8 @@
 // adit console's live 2D grid end to end: the daemon's LCM endpoint sends
 // grid patches (as aditd's mapping thread does) over real LCM on loopback,
 // `adit console` runs as a child process, and the test reads what a browser
-// reads: GET /api/grid (a PNG and where it lies), the snapshot and the event
+// reads: GET /api/grid (a PNG and where it lies), its blocks
+// (GET /api/grid/blocks, /api/grid/block/X/Y), the snapshot and the event
 // stream. The PNG is decoded here with libpng's own reader, independently of
 // the console's encoder, and compared cell for cell with what was sent. The
 // session's frame (frame_t) and the pose graph's path (graph_path_t) travel
@@ -13,6 +14,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <mutex>
 #include <thread>
@@ -171,6 +173,50 @@ void expect_cells(const Decoded& grid, int x, int y, const std::vector<std::int8
   EXPECT_EQ(wrong, 0) << "patch (" << x << ", " << y << ")";
 }
 
+// Every block the console lists, decoded, holds the whole grid's cells where
+// they overlap and unknown elsewhere; the blocks' versions as listed.
+void expect_blocks_match(const Harness& h, const Decoded& whole, double origin_x, double origin_y,
+                         const nlohmann::json& versions) {
+  const auto r = h.http().Get("/api/grid/blocks");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200);
+  const nlohmann::json index = nlohmann::json::parse(r->body);
+  ASSERT_EQ(index["block_cells"], 1024) << "32 patches of 32 cells";
+  EXPECT_NEAR(index["origin_x"].get<double>(), origin_x, 1e-6);
+  EXPECT_NEAR(index["origin_y"].get<double>(), origin_y, 1e-6);
+  EXPECT_EQ(index["width"], whole.width);
+  EXPECT_EQ(index["height"], whole.height);
+  ASSERT_EQ(index["blocks"], versions) << index.dump();
+  for (const nlohmann::json& b : index["blocks"]) {
+    const int bx = b[0], by = b[1];
+    const auto block = h.http().Get(fmt::format("/api/grid/block/{}/{}", bx, by));
+    ASSERT_TRUE(block);
+    ASSERT_EQ(block->status, 200);
+    EXPECT_EQ(block->get_header_value("X-Grid-Version"), std::to_string(b[2].get<int>()));
+    const double bx0 = std::stod(block->get_header_value("X-Grid-Origin-X"));
+    const double by0 = std::stod(block->get_header_value("X-Grid-Origin-Y"));
+    // Cut to its patches: at most 1024 cells a side, within its block.
+    const Decoded cells = decode(block->body);
+    ASSERT_EQ(cells.error, "");
+    EXPECT_GE(bx0, bx * 1024 * kResolution - 1e-3);
+    EXPECT_GE(by0, by * 1024 * kResolution - 1e-3);
+    EXPECT_LE(bx0 + cells.width * kResolution, (bx + 1) * 1024 * kResolution + 1e-3);
+    EXPECT_LE(by0 + cells.height * kResolution, (by + 1) * 1024 * kResolution + 1e-3);
+    EXPECT_EQ(cells.width % kCells, 0);
+    EXPECT_EQ(cells.height % kCells, 0);
+    const int col0 = static_cast<int>(std::lround((bx0 - origin_x) / kResolution));
+    const int row0 = static_cast<int>(std::lround((by0 - origin_y) / kResolution));
+    int wrong = 0;
+    for (int row = 0; row < cells.height; ++row)
+      for (int col = 0; col < cells.width; ++col) {
+        const int c = col0 + col, rr = row0 + row;
+        const bool inside = c >= 0 && rr >= 0 && c < whole.width && rr < whole.height;
+        if (cells.at(col, row) != (inside ? whole.at(c, rr) : -1)) ++wrong;
+      }
+    EXPECT_EQ(wrong, 0) << "block (" << bx << ", " << by << ")";
+  }
+}
+
 // A browser's event stream until an event named `name` whose data holds `text` (or 8 s).
 std::string wait_for_event(const Harness& h, const std::string& name, const std::string& text) {
   std::string seen;
@@ -218,6 +264,16 @@ TEST(ConsoleGrid, ThePayloadsGridIsServedAtApiGridCellForCellAndEachChangeIsAnno
   for (int x = -1; x <= 1; ++x)
     for (int y = 0; y <= 1; ++y) expect_cells(grid, x, y, patch_cells(x, y));
   EXPECT_LT(r->body.size(), 2000U) << "compressed: " << 96 * 64 << " cells";
+  // In blocks, as the page fetches it: patch x -1 in block -1, x 0 and 1 in block 0.
+  expect_blocks_match(h, grid, -3.2, 0.0, nlohmann::json::parse("[[-1, 0, 2], [0, 0, 4]]"));
+  {
+    const auto none = h.http().Get("/api/grid/block/5/5");
+    ASSERT_TRUE(none);
+    EXPECT_EQ(none->status, 204) << "no such block";
+    const auto bad = h.http().Get("/api/grid/block/99999999999/0");
+    ASSERT_TRUE(bad);
+    EXPECT_EQ(bad->status, 400);
+  }
 
   // The snapshot names the grid's version; a patch that changes is announced
   // on the event stream and served at the new version.
@@ -238,6 +294,8 @@ TEST(ConsoleGrid, ThePayloadsGridIsServedAtApiGridCellForCellAndEachChangeIsAnno
   ASSERT_EQ(grid2.width, 3 * kCells);
   expect_cells(grid2, 0, 1, changed);
   expect_cells(grid2, 1, 1, patch_cells(1, 1));
+  // Only block 0's version moved.
+  expect_blocks_match(h, grid2, -3.2, 0.0, nlohmann::json::parse("[[-1, 0, 2], [0, 0, 6]]"));
   EXPECT_EQ(h.console->stop(), 0);
 }
 
@@ -261,6 +319,12 @@ TEST(ConsoleGrid, ANewSessionStartsAnEmptyGrid) {
   const auto none = h.http().Get("/api/grid");
   ASSERT_TRUE(none);
   EXPECT_EQ(none->status, 204);
+  const auto no_blocks = h.http().Get("/api/grid/blocks");
+  ASSERT_TRUE(no_blocks);
+  EXPECT_EQ(no_blocks->status, 204);
+  const auto old_block = h.http().Get("/api/grid/block/0/0");
+  ASSERT_TRUE(old_block);
+  EXPECT_EQ(old_block->status, 204) << "s1's block is not served for s2";
 
   h.publish(2, -1, 4, patch_cells(2, -1));
   const auto r = h.grid_when(1, 4);

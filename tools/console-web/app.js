@@ -2,11 +2,11 @@
 // snapshot (`hello`), poses, status, tile and grid changes, link and download
 // news; tiles are fetched as binary, only the segments changed since the
 // version held, decimated to a point budget so the view stays smooth on a
-// tablet; the live 2D grid as one PNG when its version moves.
+// tablet; the live 2D grid's changed blocks when its version moves.
 // A reconnecting stream starts with a snapshot and the page fetches only the
 // tiles whose version moved: the map is not loaded again.
 import { MapView } from './map_view.js';
-import { fetchGrid } from './grid_layer.js';
+import { fetchGridBlock, fetchGridBlocks } from './grid_layer.js';
 import { HealthPanel } from './health.js';
 import { SessionsPanel } from './sessions.js';
 
@@ -17,7 +17,7 @@ const pointBudget = Number(params.get('budget')) || 300000;
 
 // What the browser tests read (tests/console): latencies, poses, frames.
 const metrics = { latencies: [], poses: 0, lastSeq: -1, frames: 0, frameTimes: [], tileFetches: 0, tileBytes: 0,
-                  hellos: 0, errors: [], gridFetches: 0, gridBytes: 0, mapFrame: null, graphPaths: 0, graphPath: null };
+                  hellos: 0, errors: [], gridFetches: 0, gridBlocks: 0, gridBytes: 0, mapFrame: null, graphPaths: 0, graphPath: null };
 window.adit = { metrics };
 
 const view = new MapView(el('map'));
@@ -105,20 +105,21 @@ async function fetchTile(id) {
   el('map-text').textContent = `${drawn.toLocaleString()} of ${Math.max(mapPoints, drawn).toLocaleString()} points drawn`;
 }
 
-// ---- the live 2D grid: one fetch at a time, again if its version moved meanwhile.
+// ---- the live 2D grid: one update at a time, again if its version moved meanwhile.
 // Its version (the sum of its patches' versions) only grows within a session,
 // and is the same for the same grid in any console: a restarted console that
 // holds less of it so far is not fetched from until it has caught up.
-// At most one fetch per kGridIntervalMs: each new grid is a texture upload,
+// An update fetches the block list, then each block whose version moved.
+// At most one update per kGridIntervalMs: each new block is a texture upload,
 // which in software rendering delays the frame it lands in (docs/CONSOLE.md).
 const kGridIntervalMs = 3000;
 let gridWanted = 0;  // the newest version announced and not fetched since
 let gridFetching = false;
-let gridLastFetch = -Infinity;  // performance.now() of the last fetch
+let gridLastFetch = -Infinity;  // performance.now() of the last update
 let gridTimer = null;
 function wantGrid(g) {
   // None held, or none newer than the page's (a restarted console catching
-  // up): a fetch still waiting out the interval is dropped, not sent to a 404.
+  // up): an update still waiting out the interval is dropped, not sent to a 204.
   if (!g || g.v <= view.gridVersion()) {
     gridWanted = 0;
     return;
@@ -137,8 +138,8 @@ async function pumpGrid() {
   gridFetching = true;
   gridLastFetch = performance.now();
   try {
-    const grid = await fetchGrid();  // null: not held (a new session without a patch yet)
-    if (grid && grid.v > view.gridVersion() && (!mapSession || grid.session === mapSession)) showGrid(grid);
+    const index = await fetchGridBlocks();  // null: not held (a new session without a patch yet)
+    if (index && index.v > view.gridVersion() && (!mapSession || index.session === mapSession)) await updateGrid(index);
   } catch (e) {
     metrics.errors.push(String(e));
   }
@@ -146,13 +147,36 @@ async function pumpGrid() {
   gridFetching = false;
   pumpGrid();
 }
-function showGrid(grid) {
+// The blocks whose versions moved, then the list: the page's version is the
+// list's once every block it names is held as listed (or newer). A block
+// listed older than the page holds it comes from a console restarted since
+// (it holds fewer of the block's patches so far): fetched too, so the page
+// shows what the console has; blocks of one console only grow. The blocks go to
+// the GPU together, in one frame: in software rendering each upload delays the
+// frame it lands in, and one delayed frame every 3 s costs the pose latency
+// less than several.
+async function updateGrid(index) {
+  const current = () => !mapSession || index.session === mapSession;
+  const fetched = [];
+  const drop = () => { for (const b of fetched) b.bitmap.close(); };
+  for (const [x, y, v] of index.blocks) {
+    if (v === view.gridBlockVersion(x, y)) continue;
+    const block = await fetchGridBlock(x, y);
+    if (block) fetched.push(block);
+    // Another session began meanwhile, or the console moved on: its grid comes with its event.
+    if (!current() || !block || block.session !== index.session) { drop(); return; }
+    metrics.gridBlocks += 1;
+    metrics.gridBytes += block.bytes;
+  }
+  if (!current()) { drop(); return; }
+  for (const block of fetched) {
+    view.setGridBlock(block);
+  }
   metrics.gridFetches += 1;
-  metrics.gridBytes += grid.bytes;
-  view.setGrid(grid);
+  view.setGridIndex(index);
   el('grid-toggle').hidden = false;
-  const m = (n) => (n * grid.resolution).toFixed(0);
-  el('grid-text').textContent = ` · grid ${m(grid.width)} × ${m(grid.height)} m`;
+  const m = (n) => (n * index.resolution).toFixed(0);
+  el('grid-text').textContent = ` · grid ${m(index.width)} × ${m(index.height)} m`;
   el('grid-text').hidden = false;
 }
 function clearGrid() {

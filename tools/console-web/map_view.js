@@ -1,8 +1,8 @@
 // adit console: the live 3D view. Tiles from the console become one
 // THREE.Points each, coloured by height in the shader (so every tile shares
 // one colour scale that follows the map's extent without recolouring); the
-// path is a line, the current pose a cone; the live 2D grid a textured plane
-// under the points (grid_layer.js); cameras: follow, top, free (orbit with a
+// path is a line, the current pose a cone; the live 2D grid textured planes
+// under the points, a block each (grid_layer.js); cameras: follow, top, free (orbit with a
 // finger or the mouse, pinch or wheel to zoom). The path and the pose are in
 // the session's odometry frame, the tiles and the grid in the tiles' frame
 // (the odometry's, or the pose graph's when the loop closure moves the map),
@@ -143,11 +143,16 @@ export class MapView {
   markerPosition() { this.world.updateMatrixWorld(); return this.marker.getWorldPosition(new THREE.Vector3()); }
   markerQuaternion() { this.world.updateMatrixWorld(); return this.marker.getWorldQuaternion(new THREE.Quaternion()); }
 
-  // The live 2D grid (grid_layer.js fetchGrid's answer), and whether it shows.
-  setGrid(grid) {
-    this.grid.set(grid);
+  // The live 2D grid's blocks and their list (grid_layer.js), and whether it shows.
+  setGridBlock(block) {
+    this.grid.setBlock(block);
     this.dirty = true;
   }
+  setGridIndex(index) {
+    this.grid.setIndex(index);
+    this.dirty = true;
+  }
+  gridBlockVersion(x, y) { return this.grid.blockVersion(x, y); }
   gridVersion() { return this.grid.version(); }
   showGrid(on) {
     this.grid.setVisible(on);

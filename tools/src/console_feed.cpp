@@ -136,6 +136,7 @@ void LiveFeed::switch_session(const std::string& session) {
   grid_ = {};
   grid_changed_ = false;
   grid_png_.reset();
+  block_pngs_.clear();
   frame_.reset();
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
 }
@@ -378,26 +379,69 @@ std::optional<TileBytes> LiveFeed::tile(std::int64_t id, std::int32_t held_versi
 
 std::shared_ptr<const GridBytes> LiveFeed::grid() const {
   protocol::GridImage image;
-  GridBytes out;
+  std::string session;
+  std::int64_t version = 0;
+  std::size_t patches = 0;
   {
     const std::lock_guard lock(mutex_);
     if (grid_.patch_count() == 0) return nullptr;
     if (grid_png_ && grid_png_->session == session_ && grid_png_->version == grid_.version_sum()) return grid_png_;
     image = grid_.image();
-    out.session = session_;
-    out.version = grid_.version_sum();
-    out.patches = grid_.patch_count();
+    session = session_;
+    version = grid_.version_sum();
+    patches = grid_.patch_count();
   }
   // Encoded without the lock: the feed's thread goes on receiving meanwhile.
-  out.resolution_m = image.resolution_m;
-  out.origin_x = image.origin_x;
-  out.origin_y = image.origin_y;
-  out.width = image.width;
-  out.height = image.height;
-  out.png = grid_png(image);
-  auto encoded = std::make_shared<const GridBytes>(std::move(out));
+  auto encoded = std::make_shared<const GridBytes>(grid_bytes(image, std::move(session), version, patches));
   const std::lock_guard lock(mutex_);
   if (encoded->session == session_ && (!grid_png_ || grid_png_->version < encoded->version)) grid_png_ = encoded;
+  return encoded;
+}
+
+std::optional<nlohmann::json> LiveFeed::grid_blocks() const {
+  const std::lock_guard lock(mutex_);
+  if (grid_.patch_count() == 0) return std::nullopt;
+  const std::int32_t block_patches = grid_block_patches(grid_.patch_cells());
+  const protocol::GridImage extent = grid_.extent();
+  nlohmann::json blocks = nlohmann::json::array();
+  for (const protocol::GridBlock& b : grid_.blocks(block_patches)) blocks.push_back({b.x, b.y, b.version});
+  return nlohmann::json{{"session", session_},
+                        {"v", grid_.version_sum()},
+                        {"patches", grid_.patch_count()},
+                        {"resolution", extent.resolution_m},
+                        {"block_cells", block_patches * grid_.patch_cells()},
+                        {"origin_x", extent.origin_x},
+                        {"origin_y", extent.origin_y},
+                        {"width", extent.width},
+                        {"height", extent.height},
+                        {"blocks", blocks}};
+}
+
+std::shared_ptr<const GridBytes> LiveFeed::grid_block(std::int32_t x, std::int32_t y) const {
+  protocol::GridImage image;
+  std::string session;
+  protocol::GridBlock block;
+  {
+    const std::lock_guard lock(mutex_);
+    if (grid_.patch_count() == 0) return nullptr;
+    const std::int32_t block_patches = grid_block_patches(grid_.patch_cells());
+    const std::vector<protocol::GridBlock> blocks = grid_.blocks(block_patches);
+    const auto listed = std::find_if(blocks.begin(), blocks.end(),
+                                     [&](const protocol::GridBlock& b) { return b.x == x && b.y == y; });
+    if (listed == blocks.end()) return nullptr;
+    block = *listed;
+    if (const auto held = block_pngs_.find({x, y}); held != block_pngs_.end() && held->second->version == block.version)
+      return held->second;
+    image = grid_.block_image(block_patches, x, y);
+    session = session_;
+  }
+  // Encoded without the lock, as grid().
+  auto encoded = std::make_shared<const GridBytes>(grid_bytes(image, std::move(session), block.version, block.patches));
+  const std::lock_guard lock(mutex_);
+  if (encoded->session == session_) {
+    std::shared_ptr<const GridBytes>& held = block_pngs_[{x, y}];
+    if (!held || held->version < encoded->version) held = encoded;
+  }
   return encoded;
 }
 

@@ -71,6 +71,14 @@ class LiveFeed {
   // The current session's grid as a PNG (encoded once per version, when a
   // browser asks), or null when no patch is held.
   std::shared_ptr<const GridBytes> grid() const;
+  // The grid's blocks for GET /api/grid/blocks: {session, v, patches,
+  // resolution, block_cells, origin_x, origin_y, width, height (the whole
+  // grid's, as GET /api/grid), blocks: [[x, y, v], ...]}; null when no patch
+  // is held.
+  std::optional<nlohmann::json> grid_blocks() const;
+  // Block (x, y) as a PNG (encoded once per block version, when a browser
+  // asks), or null when the grid holds no patch in it.
+  std::shared_ptr<const GridBytes> grid_block(std::int32_t x, std::int32_t y) const;
 
  private:
   void run();
@@ -124,6 +132,7 @@ class LiveFeed {
   bool grid_changed_ = false;  // not yet announced
   std::int64_t last_grid_event_ms_ = 0;
   mutable std::shared_ptr<const GridBytes> grid_png_;  // the last one encoded
+  mutable std::map<std::pair<std::int32_t, std::int32_t>, std::shared_ptr<const GridBytes>> block_pngs_;  // each block's last
 
   std::unique_ptr<LcmClient> client_;  // used by the feed's thread only (request_tiles)
   std::thread thread_;

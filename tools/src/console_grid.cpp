@@ -13,6 +13,12 @@ namespace adit::tools::console {
 // grid's rows, which mostly repeat the row below.
 constexpr int kCompressionLevel = 3;
 
+std::int32_t grid_block_patches(std::int32_t patch_cells) {
+  std::int32_t n = 1;
+  while (2 * n * std::max(patch_cells, 1) <= kGridBlockCells) n *= 2;
+  return n;
+}
+
 // nav_msgs/OccupancyGrid: -1 unknown, 0..100 the occupancy in percent. Any
 // other negative value is unknown, anything above 100 is occupied.
 std::uint8_t grid_grey(std::int8_t cell) {
@@ -35,6 +41,19 @@ std::string grid_png(const protocol::GridImage& grid) {
       pixels[2 * static_cast<std::size_t>(col) + 1] = grid_alpha(cells[col]);
     }
   });
+}
+
+GridBytes grid_bytes(const protocol::GridImage& image, std::string session, std::int64_t version,
+                     std::size_t patches) {
+  return {.session = std::move(session),
+          .version = version,
+          .patches = patches,
+          .resolution_m = image.resolution_m,
+          .origin_x = image.origin_x,
+          .origin_y = image.origin_y,
+          .width = image.width,
+          .height = image.height,
+          .png = grid_png(image)};
 }
 
 }  // namespace adit::tools::console

@@ -49,6 +49,20 @@ void reply_error(httplib::Response& res, int status, const std::string& message)
   reply_json(res, status, {{"error", message}});
 }
 
+// A grid or block PNG and where it lies (docs/CONSOLE.md).
+void reply_grid(httplib::Response& res, const GridBytes& grid) {
+  res.set_header("X-Grid-Session", grid.session);
+  res.set_header("X-Grid-Version", std::to_string(grid.version));
+  res.set_header("X-Grid-Patches", std::to_string(grid.patches));
+  res.set_header("X-Grid-Resolution", fmt::format("{}", grid.resolution_m));
+  res.set_header("X-Grid-Origin-X", fmt::format("{}", grid.origin_x));
+  res.set_header("X-Grid-Origin-Y", fmt::format("{}", grid.origin_y));
+  res.set_header("X-Grid-Width", std::to_string(grid.width));
+  res.set_header("X-Grid-Height", std::to_string(grid.height));
+  res.set_header("Cache-Control", "no-store");
+  res.set_content(grid.png, "image/png");
+}
+
 std::optional<nlohmann::json> body_json(const httplib::Request& req, httplib::Response& res) {
   try {
     auto j = nlohmann::json::parse(req.body);
@@ -227,8 +241,8 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
     res.set_content(tile->body, "application/octet-stream");
   });
 
-  // The live 2D grid as one PNG (console_grid.hpp) and where it lies: the
-  // page fetches it when a `grid` event or the snapshot names another version.
+  // The live 2D grid as one PNG (console_grid.hpp) and where it lies, for a
+  // person or a tool; the page fetches it in blocks (below).
   server.Get("/api/grid", [&](const httplib::Request&, httplib::Response& res) {
     std::shared_ptr<const GridBytes> grid;
     try {
@@ -242,16 +256,44 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
       res.set_header("X-Grid-Problem", "no grid held: the payload has sent no grid patch for this session");
       return;
     }
-    res.set_header("X-Grid-Session", grid->session);
-    res.set_header("X-Grid-Version", std::to_string(grid->version));
-    res.set_header("X-Grid-Patches", std::to_string(grid->patches));
-    res.set_header("X-Grid-Resolution", fmt::format("{}", grid->resolution_m));
-    res.set_header("X-Grid-Origin-X", fmt::format("{}", grid->origin_x));
-    res.set_header("X-Grid-Origin-Y", fmt::format("{}", grid->origin_y));
-    res.set_header("X-Grid-Width", std::to_string(grid->width));
-    res.set_header("X-Grid-Height", std::to_string(grid->height));
-    res.set_header("Cache-Control", "no-store");
-    res.set_content(grid->png, "image/png");
+    reply_grid(res, *grid);
+  });
+
+  // The grid's blocks and their versions: the page fetches this when a `grid`
+  // event or the snapshot names a version it does not hold, then the blocks
+  // whose versions moved.
+  server.Get("/api/grid/blocks", [&](const httplib::Request&, httplib::Response& res) {
+    const std::optional<nlohmann::json> blocks = feed.grid_blocks();
+    if (!blocks) {
+      res.status = 204;
+      res.set_header("X-Grid-Problem", "no grid held: the payload has sent no grid patch for this session");
+      return;
+    }
+    reply_json(res, 200, *blocks);
+  });
+
+  server.Get(R"(/api/grid/block/(-?\d+)/(-?\d+))", [&](const httplib::Request& req, httplib::Response& res) {
+    std::int32_t x = 0, y = 0;
+    try {
+      x = std::stoi(req.matches[1]);
+      y = std::stoi(req.matches[2]);
+    } catch (const std::exception&) {
+      reply_error(res, 400, "a block's x and y are 32-bit integers");
+      return;
+    }
+    std::shared_ptr<const GridBytes> block;
+    try {
+      block = feed.grid_block(x, y);
+    } catch (const std::runtime_error& e) {
+      reply_error(res, 500, e.what());
+      return;
+    }
+    if (!block) {  // a new session can empty a block the page was told of: not an error
+      res.status = 204;
+      res.set_header("X-Grid-Problem", fmt::format("no grid block ({}, {}) held", x, y));
+      return;
+    }
+    reply_grid(res, *block);
   });
 
   server.Post("/api/unlock", [&](const httplib::Request& req, httplib::Response& res) {

@@ -25,6 +25,15 @@ struct GridImage {
   std::vector<std::int8_t> cells;
 };
 
+// A square of block_patches × block_patches patches, aligned on multiples of
+// block_patches: what a viewer fetches and redraws as one piece, so a change
+// costs one block and no image grows past a GPU's largest texture.
+struct GridBlock {
+  std::int32_t x = 0, y = 0;   // block (x, y) holds patches [x·n, (x+1)·n) × [y·n, (y+1)·n), n = block_patches
+  std::int64_t version = 0;    // the sum of its patches' versions
+  std::size_t patches = 0;
+};
+
 struct GridMosaicCounts {
   std::uint64_t accepted = 0;  // a new patch or a newer version
   std::uint64_t stale = 0;     // a version already held (refresh) or older
@@ -40,7 +49,17 @@ class GridMosaic {
   std::string put(const std::string& session_id, float resolution_m, std::int32_t patch_cells, std::int32_t x,
                   std::int32_t y, std::int32_t version, std::vector<std::int8_t> cells);
 
+  // The patches' bounding box as one image.
   GridImage image() const;
+  // image()'s size and place, without its cells.
+  GridImage extent() const;
+  // The blocks that hold a patch, in (x, y) order. block_patches is a power
+  // of two, so every block's patches lie within int32.
+  std::vector<GridBlock> blocks(std::int32_t block_patches) const;
+  // Block (x, y) as one image over the bounding box of its patches, -1 where
+  // no patch is (an image of no cells when the block holds none).
+  GridImage block_image(std::int32_t block_patches, std::int32_t x, std::int32_t y) const;
+  std::int32_t patch_cells() const { return patch_cells_; }
   const std::string& session_id() const { return session_id_; }
   std::size_t patch_count() const { return patches_.size(); }
   // The sum of the patches' versions: it grows with every change within a
@@ -53,6 +72,12 @@ class GridMosaic {
     std::int32_t version = 0;
     std::vector<std::int8_t> cells;
   };
+  // Patches [min_x, max_x] × [min_y, max_y] as one image, with its cells or without.
+  GridImage image_of(std::int32_t min_x, std::int32_t min_y, std::int32_t max_x, std::int32_t max_y,
+                     bool cells) const;
+  // image_of() over the patches' bounding box.
+  GridImage bounding_image(bool cells) const;
+
   std::string session_id_;
   float resolution_m_ = 0.0F;
   std::int32_t patch_cells_ = 0;
