@@ -74,6 +74,7 @@ MappingStage::MappingStage(const config::Config& config, const slam::OdometryCon
   if (config.grid.enabled) {
     grid_.emplace(grid_config_of(config.grid));
     grid_cells_.resize(static_cast<std::size_t>(config.grid.patch_cells) * static_cast<std::size_t>(config.grid.patch_cells));
+    grid_points_.reserve(max_points);
   }
   for (std::vector<Eigen::Vector3f>* v : {&points_, &deskewed_, &keyframe_points_, &pending_.points}) v->reserve(max_points);
   for (std::vector<float>* v : {&times_, &intensities_, &pending_.times_s, &pending_.intensities}) v->reserve(max_points);
@@ -218,7 +219,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   for (Eigen::Vector3f& p : deskewed_) p = pose * p;
   if (grid_) {
     const std::int64_t grid_start_ns = monotonic_ns();
-    grid_->insert(pose * sensor_in_body_, deskewed_);
+    insert_into_grid(slot.stamp_ns, pose * sensor_in_body_);
     if (grid_ms_ != nullptr && grid_ms_->size() < kTimingCapacity)
       grid_ms_->push_back(1e-6 * static_cast<double>(monotonic_ns() - grid_start_ns));
   }
@@ -243,6 +244,20 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   stats_.resident_tiles.store(map_.resident_tile_count(), std::memory_order_relaxed);
   stats_.dropped_in_evicted.store(map_.dropped_in_evicted(), std::memory_order_relaxed);
   if (keyframe) stats_.map_bytes.store(map_.memory_bytes(), std::memory_order_relaxed);  // a walk over the tiles
+}
+
+// The scan (deskewed_, map frame) into the live grid: placed by the loop
+// closure's latest correction when following the graph, as its tiles are.
+void MappingStage::insert_into_grid(std::int64_t stamp_ns, const Eigen::Vector3f& origin) {
+  const std::shared_ptr<const slam::CorrectionTrack> correction = graph_ != nullptr ? graph_->latest() : nullptr;
+  if (correction == nullptr || correction->empty()) {
+    grid_->insert(origin, deskewed_);
+    return;
+  }
+  const Eigen::Isometry3f c = correction->at(stamp_ns).cast<float>();
+  grid_points_.clear();
+  for (const Eigen::Vector3f& p : deskewed_) grid_points_.push_back(c * p);
+  grid_->insert(c * origin, grid_points_);
 }
 
 // The points each resident tile confirmed since its last journal record.

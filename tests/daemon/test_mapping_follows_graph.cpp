@@ -5,6 +5,7 @@
 // the correction moves by less than MappingStage::kTileMoveM is not sent again.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -53,6 +54,24 @@ struct Sent {
 struct StageRun {
   Sent sent;
   PipelineStats stats;
+  bool grid = false;  // with the live grid, its patches as last sent:
+  std::mutex grid_mutex;
+  std::map<slam::GridPatchCoord, std::vector<std::int8_t>> patches;
+  int patch_cells = 0;
+  float resolution_m = 0.0F;
+
+  // The occupied cells' centres (x, y), map frame.
+  std::vector<Eigen::Vector2f> occupied() {
+    const std::lock_guard lock(grid_mutex);
+    std::vector<Eigen::Vector2f> out;
+    for (const auto& [c, cells] : patches)
+      for (int row = 0; row < patch_cells; ++row)
+        for (int col = 0; col < patch_cells; ++col)
+          if (cells[static_cast<std::size_t>(row * patch_cells + col)] == slam::kGridOccupied)
+            out.emplace_back((static_cast<float>(c.x * patch_cells + col) + 0.5F) * resolution_m,
+                             (static_cast<float>(c.y * patch_cells + row) + 0.5F) * resolution_m);
+    return out;
+  }
 };
 
 // Scans at 1 s and 2 s; once their tiles went out, `correction` is posted (if
@@ -62,7 +81,8 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   config.map.refine = false;  // the poses as given
   config.map.min_hits = 1;
   config.map.publish_period_s = 0.05;
-  config.grid.enabled = false;
+  config.grid.enabled = run.grid;
+  config.grid.publish_period_s = 0.05;
   std::atomic<bool> stop{false};
   constexpr std::size_t kMaxPoints = 2000;
   Handoff<MapSlot> scans(4, Overflow::wait, [] {
@@ -81,6 +101,12 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
       },
       run.stats, stop);
   stage.follow_graph(&board);
+  run.patch_cells = config.grid.patch_cells;
+  run.resolution_m = static_cast<float>(config.grid.resolution_m);
+  stage.publish_grid_to([&run](slam::GridPatchCoord c, std::int32_t, std::span<const std::int8_t> cells, std::size_t) {
+    const std::lock_guard lock(run.grid_mutex);
+    run.patches[c].assign(cells.begin(), cells.end());
+  });
   stage.start();
   const auto push = [&](std::int64_t stamp_ns) {
     MapSlot* slot = scans.acquire_or_wait([] { return true; });
@@ -138,6 +164,40 @@ TEST(MappingFollowsGraph, ACorrectionBelowTheThresholdSendsNothingAgain) {
   run_stage(without, std::nullopt);
   EXPECT_EQ(without.stats.tiles_checked_for_loops.load(), 0U);
   EXPECT_EQ(without.sent.count(), run.sent.count());
+}
+
+// The live grid goes on where the tiles are: scans mapped after a correction
+// are placed by it (the first scan was mapped before it, the second and the
+// third after), and the cells put before stay where they were.
+TEST(MappingFollowsGraph, ScansAfterACorrectionGoIntoTheGridPlacedByIt) {
+  const std::vector<std::int64_t> stamps{1'000'000'000, 3'000'000'000};
+  const std::vector<Eigen::Isometry3d> odometry{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  const slam::CorrectionTrack track(stamps, std::vector{shifted(0, 0.7), shifted(0, 0.7)}, odometry);
+  const auto wall_span = [](StageRun& run) {
+    float low = 1e9F, high = -1e9F;
+    std::size_t n = 0;
+    for (const Eigen::Vector2f& c : run.occupied()) {
+      EXPECT_NEAR(c.x(), 5.0F, 0.1F) << "an obstacle off the wall at (" << c.x() << ", " << c.y() << ")";
+      low = std::min(low, c.y());
+      high = std::max(high, c.y());
+      ++n;
+    }
+    EXPECT_GT(n, 30U);
+    return std::pair{low, high};
+  };
+  StageRun followed;
+  followed.grid = true;
+  run_stage(followed, track);
+  const auto [low, high] = wall_span(followed);
+  EXPECT_NEAR(high, 3.0F + 0.7F, 0.1F) << "the later scans' wall, moved by the correction";
+  EXPECT_NEAR(low, -3.0F, 0.1F) << "the first scan's wall, where it was put";
+
+  StageRun unmoved;
+  unmoved.grid = true;
+  run_stage(unmoved, std::nullopt);
+  const auto [low0, high0] = wall_span(unmoved);
+  EXPECT_NEAR(high0, 3.0F, 0.1F);
+  EXPECT_NEAR(low0, -3.0F, 0.1F);
 }
 
 }  // namespace

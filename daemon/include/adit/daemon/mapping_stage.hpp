@@ -74,6 +74,9 @@ class MappingStage {
   // moved by the correction at its scan's time, and a tile sent before a new
   // correction sent again when any of its points moves by more than
   // kTileMoveM (a few tiles each flush, at most kReplaceBudgetMs of it).
+  // Each scan goes into the live grid placed by the latest correction too (at
+  // its time: the newest keyframe's, held), so the grid goes on where the
+  // tiles are; cells already in the grid stay where they were put.
   void follow_graph(const CorrectionBoard* graph) { graph_ = graph; }
   static constexpr double kTileMoveM = 0.02;
   static constexpr std::int64_t kReplaceBudgetMs = 20;
@@ -120,6 +123,7 @@ class MappingStage {
   void send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples);
   void replace_moved_tiles(bool all);
   void flush_grid();
+  void insert_into_grid(std::int64_t stamp_ns, const Eigen::Vector3f& origin);
   void journal_new_points();
   void tile_file_error(const std::string& problem);
   void follow_level(const Eigen::Vector3d& up, std::int64_t stamp_ns);
@@ -165,6 +169,7 @@ class MappingStage {
   PipelineSinks::GridSink grid_sink_;
   std::vector<double>* grid_ms_ = nullptr;
   std::vector<std::int8_t> grid_cells_;      // one patch, for the sink
+  std::vector<Eigen::Vector3f> grid_points_; // a scan placed by the graph's correction, for the grid
   slam::TumWriter map_trajectory_;
   // Per-scan buffers, reserved for the largest scan.
   std::vector<Eigen::Vector3f> points_;
