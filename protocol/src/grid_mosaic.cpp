@@ -106,24 +106,40 @@ std::vector<GridBlock> GridMosaic::blocks(std::int32_t block_patches) const {
   return out;
 }
 
-GridImage GridMosaic::block_image(std::int32_t block_patches, std::int32_t x, std::int32_t y) const {
-  // The bounding box of the block's patches: a block at the grid's edge is
-  // not padded to its full size with unknown cells (a texture upload saved).
-  std::int32_t min_x = std::numeric_limits<std::int32_t>::max(), min_y = min_x;
-  std::int32_t max_x = std::numeric_limits<std::int32_t>::min(), max_y = max_x;
+GridMosaic::BlockSpan GridMosaic::span_of_block(std::int32_t block_patches, std::int32_t x, std::int32_t y) const {
+  BlockSpan span;
+  span.block.x = x;
+  span.block.y = y;
+  span.min_x = span.min_y = std::numeric_limits<std::int32_t>::max();
+  span.max_x = span.max_y = std::numeric_limits<std::int32_t>::min();
   const std::int32_t x0 = x * block_patches, y0 = y * block_patches;
   const std::int32_t x1 = x0 + (block_patches - 1), y1 = y0 + (block_patches - 1);
   for (auto it = patches_.lower_bound({x0, std::numeric_limits<std::int32_t>::min()});
        it != patches_.end() && it->first.first <= x1; ++it) {
     const auto [px, py] = it->first;
     if (py < y0 || py > y1) continue;
-    min_x = std::min(min_x, px);
-    max_x = std::max(max_x, px);
-    min_y = std::min(min_y, py);
-    max_y = std::max(max_y, py);
+    span.min_x = std::min(span.min_x, px);
+    span.max_x = std::max(span.max_x, px);
+    span.min_y = std::min(span.min_y, py);
+    span.max_y = std::max(span.max_y, py);
+    span.block.version += it->second.version;
+    ++span.block.patches;
   }
-  if (min_x > max_x) return {};
-  return image_of(min_x, min_y, max_x, max_y, true);
+  return span;
+}
+
+std::optional<GridBlock> GridMosaic::block(std::int32_t block_patches, std::int32_t x, std::int32_t y) const {
+  const BlockSpan span = span_of_block(block_patches, x, y);
+  if (span.block.patches == 0) return std::nullopt;
+  return span.block;
+}
+
+GridImage GridMosaic::block_image(std::int32_t block_patches, std::int32_t x, std::int32_t y) const {
+  // The bounding box of the block's patches: a block at the grid's edge is
+  // not padded to its full size with unknown cells (a texture upload saved).
+  const BlockSpan span = span_of_block(block_patches, x, y);
+  if (span.block.patches == 0) return {};
+  return image_of(span.min_x, span.min_y, span.max_x, span.max_y, true);
 }
 
 GridImage GridMosaic::image_of(std::int32_t min_x, std::int32_t min_y, std::int32_t max_x, std::int32_t max_y,

@@ -119,6 +119,17 @@ TEST(GridMosaic, BlocksHoldTheirPatchesInPlaceAndSumTheirVersions) {
   EXPECT_EQ(left.height, kCells);
   EXPECT_EQ(at(left, 0, 0), 100);                 // patch (-1, 0)'s first cell
   EXPECT_TRUE(mosaic.block_image(2, 5, 5).cells.empty()) << "a block without patches";
+  // One block alone, as the list gives it; none where no patch is.
+  for (const GridBlock& listed : blocks) {
+    const std::optional<GridBlock> one = mosaic.block(2, listed.x, listed.y);
+    ASSERT_TRUE(one.has_value());
+    EXPECT_EQ(one->x, listed.x);
+    EXPECT_EQ(one->y, listed.y);
+    EXPECT_EQ(one->version, listed.version);
+    EXPECT_EQ(one->patches, listed.patches);
+  }
+  EXPECT_FALSE(mosaic.block(2, 5, 5).has_value());
+  EXPECT_FALSE(mosaic.block(2, 1, 0).has_value()) << "beside patch (2, -3)'s block, not in it";
 
   // Every block's cells are the whole image's there.
   const GridImage whole = mosaic.image();

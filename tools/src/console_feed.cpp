@@ -425,10 +425,8 @@ std::shared_ptr<const GridBytes> LiveFeed::grid_block(std::int32_t x, std::int32
     const std::lock_guard lock(mutex_);
     if (grid_.patch_count() == 0) return nullptr;
     const std::int32_t block_patches = grid_block_patches(grid_.patch_cells());
-    const std::vector<protocol::GridBlock> blocks = grid_.blocks(block_patches);
-    const auto listed = std::find_if(blocks.begin(), blocks.end(),
-                                     [&](const protocol::GridBlock& b) { return b.x == x && b.y == y; });
-    if (listed == blocks.end()) return nullptr;
+    const std::optional<protocol::GridBlock> listed = grid_.block(block_patches, x, y);
+    if (!listed) return nullptr;
     block = *listed;
     if (const auto held = block_pngs_.find({x, y}); held != block_pngs_.end() && held->second->version == block.version)
       return held->second;

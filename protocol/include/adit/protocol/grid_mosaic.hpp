@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,6 +57,9 @@ class GridMosaic {
   // The blocks that hold a patch, in (x, y) order. block_patches is a power
   // of two, so every block's patches lie within int32.
   std::vector<GridBlock> blocks(std::int32_t block_patches) const;
+  // Block (x, y) as blocks() lists it, walking only its own patches; none
+  // when it holds no patch.
+  std::optional<GridBlock> block(std::int32_t block_patches, std::int32_t x, std::int32_t y) const;
   // Block (x, y) as one image over the bounding box of its patches, -1 where
   // no patch is (an image of no cells when the block holds none).
   GridImage block_image(std::int32_t block_patches, std::int32_t x, std::int32_t y) const;
@@ -77,6 +81,12 @@ class GridMosaic {
                      bool cells) const;
   // image_of() over the patches' bounding box.
   GridImage bounding_image(bool cells) const;
+  // Block (x, y)'s patches: their bounding box, version sum and count.
+  struct BlockSpan {
+    std::int32_t min_x = 0, min_y = 0, max_x = -1, max_y = -1;
+    GridBlock block;
+  };
+  BlockSpan span_of_block(std::int32_t block_patches, std::int32_t x, std::int32_t y) const;
 
   std::string session_id_;
   float resolution_m_ = 0.0F;
