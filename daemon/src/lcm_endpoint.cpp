@@ -28,6 +28,7 @@
 #include "adit/frame_t.hpp"
 #include "adit/graph_path_t.hpp"
 #include "adit/grid_patch_t.hpp"
+#include "adit/loop_status_t.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
 #include "adit/tile_index_t.hpp"
@@ -418,6 +419,9 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   void drain_status() {
     StatusSample s;
     while (take_from(statuses, s)) {
+      // Before the status it goes with: a client that shows both at each
+      // status has this period's loops.
+      if (s.loops && !session_id.empty()) send_loop_status(s.utime, *s.loops);
       status_t m;
       m.utime = s.utime;
       m.schema = 1;
@@ -449,6 +453,24 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
         ++counters.graph_paths_published;
       }
     }
+  }
+
+  void send_loop_status(std::int64_t utime, const LoopStatus& loops) {
+    loop_status_t m;
+    m.utime = utime;
+    m.schema = 1;
+    m.payload_id = options.payload_id;
+    m.session_id = session_id;
+    m.keyframes = loops.keyframes;
+    m.candidates = loops.candidates;
+    m.accepted = loops.accepted;
+    m.rejected = loops.rejected;
+    m.last_loop_utime = loops.last_loop_utime;
+    m.correction_m = loops.correction_m;
+    m.correction_deg = loops.correction_deg;
+    m.moves_map = loops.moves_map ? 1 : 0;
+    send(Channel::loops, m);
+    ++counters.loop_statuses_published;
   }
 
   // The new graph's keyframes for a client that draws the path with the map

@@ -91,6 +91,8 @@ void LoopClosureStage::update_stats() {
   const slam::LoopClosureStats& s = closer_.stats();
   stats_.loop_keyframes.store(s.keyframes, std::memory_order_relaxed);
   stats_.loop_candidates.store(s.candidates, std::memory_order_relaxed);
+  if (s.accepted > stats_.loops_accepted.load(std::memory_order_relaxed))
+    stats_.last_loop_realtime_ns.store(realtime_ns(), std::memory_order_relaxed);
   stats_.loops_accepted.store(s.accepted, std::memory_order_relaxed);
   stats_.loops_rejected.store(s.rejected_verification + s.rejected_inconsistent, std::memory_order_relaxed);
 }

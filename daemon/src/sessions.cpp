@@ -26,6 +26,7 @@
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/daemon/loop_closure_stage.hpp"
+#include "adit/daemon/loop_status.hpp"
 #include "adit/daemon/prior_localiser.hpp"
 #include "adit/daemon/map_files.hpp"
 #include "adit/daemon/durable_file.hpp"
@@ -804,9 +805,11 @@ StatusSample Sessions::status_sample() {
   }
   last_sample_ns_ = now;
   last_datagrams_ = datagrams;
-  const LoopClosureStage* moving = config_.map.loops_move_map ? pipeline_->loop_closure() : nullptr;
+  const LoopClosureStage* loops = pipeline_->loop_closure();
+  const LoopClosureStage* moving = config_.map.loops_move_map ? loops : nullptr;
   sample.frame = session_frame(pipeline_->prior_localiser(), pipeline_->level(), moving);
   if (moving != nullptr) sample.graph = moving->live().latest();
+  if (loops != nullptr) sample.loops = loop_status_of(s, loops->live().latest().get(), moving != nullptr);
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);
   return sample;
 }

@@ -29,6 +29,7 @@ std::string_view channel_kind(Channel channel) {
     case Channel::grid: return "GRID";
     case Channel::frame: return "FRAME";
     case Channel::graph_path: return "GRAPH_PATH";
+    case Channel::loops: return "LOOPS";
   }
   return "UNKNOWN";
 }

@@ -113,6 +113,7 @@ const std::vector<Field>& layout(LcmType type) {
   static const std::vector<Field> frame{I64,           I16,           STR,           STR,          I8,
                                         {Kind::f64, 3}, {Kind::f64, 4}, {Kind::f64, 3}, {Kind::f64, 4}};
   static const std::vector<Field> graph_path{I64, I16, STR, STR, I32, I32, I32, {Kind::nested, 1, 6, &kXyz}};
+  static const std::vector<Field> loop_status{I64, I16, STR, STR, I32, I32, I32, I32, I64, F32, F32, I8};
   switch (type) {
     case LcmType::pose: return pose;
     case LcmType::status: return status;
@@ -126,6 +127,7 @@ const std::vector<Field>& layout(LcmType type) {
     case LcmType::grid_patch: return grid_patch;
     case LcmType::frame: return frame;
     case LcmType::graph_path: return graph_path;
+    case LcmType::loop_status: return loop_status;
   }
   return pose;
 }

@@ -1,6 +1,7 @@
 // adit console in a real browser (Debian's chromium, headless, software
 // WebGL), against aditd replaying a simulated mine drive on loopback LCM:
-//   - the page loads with no console errors; poses advance; the health shows MAPPING;
+//   - the page loads with no console errors; poses advance; the health shows MAPPING
+//     and the loop closure;
 //   - a START without the passphrase is refused with a visible message and changes nothing;
 //   - unlocked, START and STOP by clicking work; two browsers watch at once;
 //   - a hint typed in the form reaches the payload, whose refusal (no prior map) shows;
@@ -125,6 +126,14 @@ try {
   assert.ok(m1.lastSeq > m0.lastSeq + minPoses, `poses advance at scan rate: seq ${m0.lastSeq} -> ${m1.lastSeq} in 3 s`);
   const o1 = await metrics(other);
   assert.ok(o1.poses > 10, `the second browser gets poses too (${o1.poses})`);
+  // The loop closure runs (map.loop_closure, the default): the health says
+  // what it found (loop_status_t, carried in the status).
+  const loopsLine = await page.evaluate(() => {
+    const dt = [...document.querySelectorAll('#health-figures dt')].find((d) => d.textContent === 'loops');
+    return dt ? dt.nextElementSibling.textContent : null;
+  });
+  assert.match(loopsLine || '', /^\d+ closed, \d+ refused \(\d+ candidates, \d+ keyframes\)/,
+               `the health shows the loop closure: ${loopsLine}`);
 
   step('A hint');
   // A hint goes from the form to the payload and its answer comes back: this

@@ -282,6 +282,43 @@ TEST(LcmEndpoint, PosesAndStatusArriveInWatch) {
   EXPECT_LE(poses, 21u);
   const auto status = h.adit({"status"}, 1);
   EXPECT_EQ(status.exit_status, 1) << "nobody publishes status any more: " << status.out;
+  EXPECT_EQ(r.out.find("loops"), std::string::npos) << "no loop closure, no loops: " << r.out;
+  EXPECT_EQ(h.endpoint->counters().loop_statuses_published.load(), 0U);
+}
+
+// A session's loop closure goes out as loop_status_t with each status;
+// `adit watch` shows it on the status's line, `adit status` on a line of its own.
+TEST(LcmEndpoint, LoopsGoOutWithTheStatusAndWatchAndStatusShowThem) {
+  Harness h;
+  ASSERT_EQ(h.adit({"start"}).exit_status, 0);
+  test::ProgramResult r, status;
+  feed_while(
+      h, [](int i) { return std::array<double, 3>{0.1 * i, 0, 1}; },
+      [](int, std::int64_t utime) {
+        StatusSample s;
+        s.sensors.push_back({"lidar0", 10.0f, 0, utime, 0.0f});
+        LoopStatus loops;
+        loops.keyframes = 40;
+        loops.candidates = 6;
+        loops.accepted = 3;
+        loops.rejected = 2;
+        loops.last_loop_utime = utime;
+        loops.correction_m = 0.25F;
+        loops.moves_map = true;
+        s.loops = loops;
+        return s;
+      },
+      [&] {
+        r = h.adit({"watch", "--duration", "2"});
+        status = h.adit({"status"});
+      });
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("| loops 3 closed, 2 refused, correction 0.25 m"), std::string::npos) << r.out;
+  ASSERT_EQ(status.exit_status, 0) << status.err;
+  EXPECT_NE(status.out.find("loops     3 closed, 2 refused (6 candidates, 40 keyframes); correction 0.25 m"),
+            std::string::npos)
+      << status.out;
+  EXPECT_GE(h.endpoint->counters().loop_statuses_published.load(), 3U);
 }
 
 // Once the session is anchored to a prior map, its frame_t goes out with the

@@ -123,9 +123,17 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
       if (status.frame->source == kFrameSourceLoops) {
         EXPECT_EQ(status.frame->tiles_orientation, (std::array<double, 4>{1, 0, 0, 0}));
       }
+      // The loop closure's progress (loop_status_t) goes with every status.
+      EXPECT_TRUE(status.loops.has_value());
       if (status.frame->position != status.frame->tiles_position) {
         ++frames_with_correction;
         EXPECT_NE(status.graph, nullptr) << "the graph's path (graph_path_t) goes with its correction";
+        if (status.loops) {
+          EXPECT_GT(status.loops->accepted, 0) << "a correction comes from a loop";
+          EXPECT_GT(status.loops->last_loop_utime, 0);
+          EXPECT_GT(status.loops->correction_m + status.loops->correction_deg, 0.0F);
+          EXPECT_TRUE(status.loops->moves_map);
+        }
       }
     }
     std::this_thread::sleep_for(20ms);

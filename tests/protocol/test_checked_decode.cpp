@@ -116,6 +116,14 @@ TEST(CheckedDecode, EveryTypeEncodedByLcmPasses) {
   path.positions = {{1.0F, 2.0F, 3.0F}, {4.0F, 5.0F, 6.0F}};
   path.n = 2;
   expect_round_trip(path);
+
+  loop_status_t loops{};
+  loops.payload_id = "rig1";
+  loops.session_id = "s1";
+  loops.accepted = 3;
+  loops.correction_m = 0.25F;
+  loops.moves_map = 1;
+  expect_round_trip(loops);
 }
 
 // Byte offset of n_args in sample_command(): hash, utime, schema, request id,

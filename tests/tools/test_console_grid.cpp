@@ -5,8 +5,9 @@
 // (GET /api/grid/blocks, /api/grid/block/X/Y), the snapshot and the event
 // stream. The PNG is decoded here with libpng's own reader, independently of
 // the console's encoder, and compared cell for cell with what was sent. The
-// session's frame (frame_t) and the pose graph's path (graph_path_t) travel
-// the same way to the page's snapshot and events.
+// session's frame (frame_t), the pose graph's path (graph_path_t) and the
+// loop closure's progress (loop_status_t) travel the same way to the page's
+// snapshot and events.
 #include <gtest/gtest.h>
 
 #include <httplib.h>
@@ -429,6 +430,43 @@ TEST(ConsoleGraphPath, TheGraphsPathReplacesThePosesPathUpToItsNewestKeyframe) {
   const std::string seen = announced.get();
   EXPECT_NE(seen.find("\"rev\":2"), std::string::npos) << seen.substr(0, 2000);
   EXPECT_NEAR(h.state()["graph_path"]["points"][10][1].get<double>(), 0.4, 1e-3);
+}
+
+// The session's loop closure (loop_status_t, sent just before each status)
+// reaches the page inside the status, as "loops"; a status without it has none.
+TEST(ConsoleLoops, TheStatusCarriesTheSessionsLoopClosure) {
+  Harness h;
+  ASSERT_TRUE(h.console_listens()) << "adit console did not listen on " << h.port;
+  ASSERT_EQ(h.adit("start").exit_status, 0);
+  h.endpoint->publish_status(daemon::StatusSample{});
+  for (int i = 0; i < 50 && h.state()["status"].is_null(); ++i) std::this_thread::sleep_for(100ms);
+  ASSERT_FALSE(h.state()["status"].is_null());
+  EXPECT_FALSE(h.state()["status"].contains("loops")) << h.state()["status"].dump();
+
+  daemon::StatusSample with_loops;
+  daemon::LoopStatus loops;
+  loops.keyframes = 31;
+  loops.candidates = 4;
+  loops.accepted = 2;
+  loops.rejected = 1;
+  loops.last_loop_utime = 1'700'000'000'000'000;
+  loops.correction_m = 0.5F;
+  loops.correction_deg = 1.5F;
+  loops.moves_map = true;
+  with_loops.loops = loops;
+  h.endpoint->publish_status(std::move(with_loops));
+  for (int i = 0; i < 50 && !h.state()["status"].contains("loops"); ++i) std::this_thread::sleep_for(100ms);
+  const nlohmann::json l = h.state()["status"]["loops"];
+  ASSERT_FALSE(l.is_null()) << h.state()["status"].dump();
+  EXPECT_EQ(l["session"], "s1");
+  EXPECT_EQ(l["keyframes"], 31);
+  EXPECT_EQ(l["candidates"], 4);
+  EXPECT_EQ(l["accepted"], 2);
+  EXPECT_EQ(l["rejected"], 1);
+  EXPECT_EQ(l["last_loop_us"], 1'700'000'000'000'000);
+  EXPECT_DOUBLE_EQ(l["correction_m"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(l["correction_deg"].get<double>(), 1.5);
+  EXPECT_EQ(l["moves_map"], true);
 }
 
 }  // namespace

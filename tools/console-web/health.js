@@ -1,6 +1,7 @@
 // adit console: the health panel from status_t (2 Hz): state, sensor rates and
 // drops, the IMU, threads' loads and queues, disk free and the recording
-// budget (disk free over the rate it fell at while mapping), the fault text.
+// budget (disk free over the rate it fell at while mapping), the loops closed
+// (loop_status_t, which the console adds to the status), the fault text.
 
 const el = (id) => document.getElementById(id);
 
@@ -15,6 +16,19 @@ function cell(text, bad) {
   td.textContent = text;
   if (bad) td.className = 'bad';
   return td;
+}
+
+// The loop closure's line (status.loops: loop_status_t), 'off' without one.
+export function loopsText(loops, nowMs) {
+  if (!loops) return 'off';
+  let text = `${loops.accepted} closed, ${loops.rejected} refused (${loops.candidates} candidates, ${loops.keyframes} keyframes)`;
+  if (loops.accepted > 0) {
+    const age = loops.last_loop_us > 0 ? Math.max(0, nowMs - loops.last_loop_us / 1000) / 1000 : NaN;
+    text += `; last ${Number.isFinite(age) ? `${age.toFixed(0)} s ago` : 'at start'}`;
+    text += `, correction ${loops.correction_m.toFixed(2)} m ${loops.correction_deg.toFixed(1)}°`;
+    if (!loops.moves_map) text += ' (applied to the exports only)';
+  }
+  return text;
 }
 
 export class HealthPanel {
@@ -47,6 +61,7 @@ export class HealthPanel {
       ['disk free', bytes(status.disk_free)],
       ['recording', this.budget(status, nowMs)],
       ['IMU', imu.length ? imu.map((s) => `${s.name} ${s.rate_hz.toFixed(0)} Hz`).join(', ') : 'none configured'],
+      ['loops', loopsText(status.loops, nowMs)],
     ];
     const dl = el('health-figures');
     dl.replaceChildren(...figures.flatMap(([k, v]) => {

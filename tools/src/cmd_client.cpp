@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,10 +60,15 @@ std::string pose_flags(std::int32_t flags) {
   return out;
 }
 
-std::string status_line(const status_t& s) {
+// The status on one line; with the session's loop closure (`loops`, its
+// latest loop_status_t, or null) before any fault.
+std::string status_line(const status_t& s, const loop_status_t* loops) {
   std::string line = fmt::format("{} {}", state_text(s.state), s.session_id.empty() ? "-" : s.session_id);
   for (const auto& h : s.sensors) line += fmt::format(" | {} {:.1f} Hz drop {}", h.name, h.packet_rate_hz, h.packets_dropped);
   line += fmt::format(" | map {} pts {} tiles | disk {:.1f} GB", s.map_points, s.map_tiles, s.disk_free_bytes / 1e9);
+  if (loops != nullptr && loops->session_id == s.session_id)
+    line += fmt::format(" | loops {} closed, {} refused, correction {:.2f} m", loops->accepted, loops->rejected,
+                        loops->correction_m);
   if (!s.fault.empty()) line += " | FAULT " + s.fault;
   return line;
 }
@@ -73,7 +79,24 @@ void register_status(CLI::App& app, int& status) {
   add_client_options(*sub, *options);
   sub->callback([options, &status] {
     LcmClient client(*options);
-    const auto s = client.wait_status();
+    // The status, with the session's loop closure when it runs: loop_status_t
+    // comes just before each status while mapping, so the wait goes on to a
+    // second status when the first came without one (0.5 s at most).
+    std::optional<status_t> s;
+    std::optional<loop_status_t> loops;
+    int statuses = 0;
+    LcmClient::FollowHandlers handlers;
+    handlers.loop_status = [&](const loop_status_t& l) { loops = l; };
+    handlers.status = [&](const status_t& m) {
+      s = m;
+      ++statuses;
+    };
+    const auto start = std::chrono::steady_clock::now();
+    client.follow(handlers, [&] {
+      const bool whole = s && (loops || statuses >= 2 || s->state != status_t::STATE_MAPPING);
+      return whole || std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+                          options->timeout_s;
+    });
     if (!s) {
       status = no_answer(*options);
       return;
@@ -86,6 +109,12 @@ void register_status(CLI::App& app, int& status) {
                  h.packets_dropped, h.time_offset_s);
     for (const auto& t : s->threads)
       fmt::print("thread    {}: load {:.0f}%, queue {}/{}\n", t.name, 100 * t.load, t.queue_depth, t.queue_capacity);
+    if (loops && loops->session_id == s->session_id)
+      fmt::print("loops     {} closed, {} refused ({} candidates, {} keyframes); correction {:.2f} m {:.1f} deg\n",
+                 loops->accepted, loops->rejected, loops->candidates, loops->keyframes, loops->correction_m,
+                 loops->correction_deg);
+    else if (s->state == status_t::STATE_MAPPING)
+      fmt::print("loops     off\n");
     fmt::print("fault     {}\n", s->fault.empty() ? "none" : s->fault);
     status = kExitOk;
   });
@@ -141,8 +170,12 @@ void register_watch(CLI::App& app, int& status) {
       }
       if (elapsed(last_print) >= 0.1) print();
     };
+    std::optional<loop_status_t> loops;  // the newest; the daemon sends it just before its status
+    handlers.loop_status = [&](const loop_status_t& l) {
+      if (l.payload_id == options->payload_id) loops = l;
+    };
     handlers.status = [&](const status_t& s) {
-      health = status_line(s);
+      health = status_line(s, loops ? &*loops : nullptr);
       any = true;
       last_message = Clock::now();
       print();

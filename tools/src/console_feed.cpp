@@ -97,6 +97,18 @@ nlohmann::json graph_path_json(const graph_path_t& g) {
           {"points", std::move(points)}};
 }
 
+nlohmann::json loops_json(const loop_status_t& l) {
+  return {{"session", l.session_id},
+          {"keyframes", l.keyframes},
+          {"candidates", l.candidates},
+          {"accepted", l.accepted},
+          {"rejected", l.rejected},
+          {"last_loop_us", l.last_loop_utime},
+          {"correction_m", l.correction_m},
+          {"correction_deg", l.correction_deg},
+          {"moves_map", l.moves_map != 0}};
+}
+
 LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)
     : options_(std::move(options)), hub_(hub), client_(std::make_unique<LcmClient>(options_)) {
   last_status_ms_ = now_ms();  // silent since the console started, until a status arrives
@@ -115,7 +127,8 @@ void LiveFeed::run() {
                    .tile_segment = [this](const tile_segment_t& m) { on_segment(m); },
                    .grid_patch = [this](const grid_patch_t& m) { on_grid(m); },
                    .frame = [this](const frame_t& m) { on_frame(m); },
-                   .graph_path = [this](const graph_path_t& m) { on_graph_path(m); }},
+                   .graph_path = [this](const graph_path_t& m) { on_graph_path(m); },
+                   .loop_status = [this](const loop_status_t& m) { on_loop_status(m); }},
                   [this] {
                     tick();
                     return stop_.load();
@@ -138,6 +151,7 @@ void LiveFeed::switch_session(const std::string& session) {
   grid_png_.reset();
   block_pngs_.clear();
   frame_.reset();
+  loops_.reset();
   hub_.publish("session", nlohmann::json{{"session", session}}.dump());
 }
 
@@ -175,6 +189,7 @@ void LiveFeed::on_status(const status_t& s) {
   {
     const std::lock_guard lock(mutex_);
     if (!s.session_id.empty()) switch_session(s.session_id);
+    if (loops_) j["loops"] = *loops_;  // this session's (the daemon sends it just before the status)
     status_ = j;
     last_status_ms_ = now_ms();
     came_back = !link_up_;
@@ -182,6 +197,15 @@ void LiveFeed::on_status(const status_t& s) {
   }
   if (came_back) hub_.publish("link", nlohmann::json{{"up", true}}.dump());
   hub_.publish("status", j.dump());
+}
+
+// Kept for the next status event, which carries it to the page.
+void LiveFeed::on_loop_status(const loop_status_t& l) {
+  if (l.payload_id != options_.payload_id || l.session_id.empty()) return;
+  nlohmann::json j = loops_json(l);
+  const std::lock_guard lock(mutex_);
+  switch_session(l.session_id);
+  loops_ = std::move(j);
 }
 
 // Sent on to the page when it changes (frame_t comes at 2 Hz, changes once a session at most).

@@ -6,7 +6,8 @@
 // the map (protocol::TileAssembler), the live 2D grid (protocol::GridMosaic),
 // and publishes what changed as events:
 //   pose     every pose, with the console's receive time (for the latency)
-//   status   every status (2 Hz)
+//   status   every status (2 Hz), with the session's latest loop_status_t
+//            as "loops" while its loop closure runs
 //   tiles    the tiles completed at a new version, at most every 250 ms
 //   grid     the grid changed (its version), at most every 500 ms
 //   session  the payload's session changed (the browser clears its map)
@@ -44,6 +45,10 @@ nlohmann::json frame_json(const frame_t& f);
 // graph_path_t for the page: {"session", "rev", "utime" (the newest
 // keyframe's, µs), "n_keyframes", "points": [[x y z], ...]}.
 nlohmann::json graph_path_json(const graph_path_t& g);
+// loop_status_t for the page: {"session", "keyframes", "candidates",
+// "accepted", "rejected", "last_loop_us" (wall clock, 0: none yet),
+// "correction_m", "correction_deg", "moves_map"}.
+nlohmann::json loops_json(const loop_status_t& l);
 
 // A tile's points for a browser: segments `from` .. n-1 at `version`, every
 // `every`-th point (x y z as float32, little-endian, per segment a uint32
@@ -86,6 +91,7 @@ class LiveFeed {
   void on_status(const status_t& s);
   void on_frame(const frame_t& f);
   void on_graph_path(const graph_path_t& g);
+  void on_loop_status(const loop_status_t& l);
   void on_index(const tile_index_t& m);
   void on_segment(const tile_segment_t& m);
   void on_grid(const grid_patch_t& m);
@@ -101,6 +107,7 @@ class LiveFeed {
   std::optional<nlohmann::json> status_;
   std::optional<nlohmann::json> pose_;
   std::optional<nlohmann::json> frame_;  // the session's, once its frame_t came
+  std::optional<nlohmann::json> loops_;  // the session's latest loop_status_t
   // The path from the poses: a point per kPathStepM travelled, with its
   // pose's utime; from the graph's newest keyframe on once a graph path came.
   struct PathPoint {

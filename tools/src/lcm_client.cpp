@@ -184,6 +184,7 @@ void LcmClient::follow(const FollowHandlers& handlers, const std::function<bool(
   const auto grid = listen(Channel::grid, handlers.grid_patch);
   const auto frames = listen(Channel::frame, handlers.frame);
   const auto graph_paths = listen(Channel::graph_path, handlers.graph_path);
+  const auto loop_statuses = listen(Channel::loops, handlers.loop_status);
   while (!until()) impl_->handle_for(0.05);
 }
 

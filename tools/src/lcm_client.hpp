@@ -16,6 +16,7 @@
 #include "adit/command_ack_t.hpp"
 #include "adit/frame_t.hpp"
 #include "adit/graph_path_t.hpp"
+#include "adit/loop_status_t.hpp"
 #include "adit/grid_patch_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/protocol/tile_assembler.hpp"
@@ -69,6 +70,7 @@ class LcmClient {
     std::function<void(const grid_patch_t&)> grid_patch;
     std::function<void(const frame_t&)> frame;
     std::function<void(const graph_path_t&)> graph_path;
+    std::function<void(const loop_status_t&)> loop_status;
   };
   // Calls the handlers for every message until `until` returns true (checked
   // at least every 50 ms).

@@ -21,6 +21,7 @@
 #include "adit/protocol/session_state.hpp"
 #include "adit/protocol/tile_codec.hpp"
 #include "adit/daemon/grid_publisher.hpp"
+#include "adit/daemon/loop_status.hpp"
 #include "adit/daemon/map_frame.hpp"
 #include "adit/daemon/tile_store.hpp"
 
@@ -68,6 +69,9 @@ struct StatusSample {
   // keyframes go out as graph_path_t when it changes and every 5 s after
   // (kept, as the frame, once the session ended).
   std::shared_ptr<const slam::CorrectionTrack> graph;
+  // The loop closure's progress, sent as loop_status_t; none when the
+  // session runs no loop closure (or between sessions).
+  std::optional<LoopStatus> loops;
 };
 
 // The whole new content of one tile (after voxel downsampling).
@@ -128,6 +132,7 @@ struct EndpointCounters {
   std::atomic<std::uint64_t> status_published{0};
   std::atomic<std::uint64_t> frames_published{0};
   std::atomic<std::uint64_t> graph_paths_published{0};
+  std::atomic<std::uint64_t> loop_statuses_published{0};
   std::atomic<std::uint64_t> status_dropped{0};
   std::atomic<std::uint64_t> tiles_dropped{0};
   std::atomic<std::uint64_t> chunks_published{0};

@@ -94,6 +94,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> loop_candidates{0};      // found by place recognition
   std::atomic<std::uint64_t> loops_accepted{0};       // in the graph
   std::atomic<std::uint64_t> loops_rejected{0};       // refused by verification or the guard
+  std::atomic<std::int64_t> last_loop_realtime_ns{0};  // wall clock when the newest loop was accepted; 0: none
   std::atomic<std::uint64_t> wheel_priors{0};          // scans registered with the wheels' prior
   std::atomic<std::uint64_t> scans_without_wheels{0};  // wheels configured, but no samples around the scan
   std::atomic<std::uint64_t> scans_wheels_held{0};     // a wheel held for slip over the scan's interval: no wheel prior

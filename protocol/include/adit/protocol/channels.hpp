@@ -8,8 +8,9 @@
 
 namespace adit::protocol {
 
-enum class Channel { pose, status, command, ack, tile_index, tile, tile_request, file_request, file, imu_pose, grid, frame, graph_path };
-inline constexpr int kChannelCount = 13;
+enum class Channel { pose, status, command, ack, tile_index, tile, tile_request, file_request, file, imu_pose, grid, frame, graph_path,
+                     loops };
+inline constexpr int kChannelCount = 14;
 
 // Longest suffix "/TILE_REQUEST" plus "ADIT/" leaves 45 bytes; 32 is plenty.
 inline constexpr std::size_t kMaxPayloadIdLength = 32;

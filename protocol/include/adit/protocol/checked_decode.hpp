@@ -18,6 +18,7 @@
 #include "adit/frame_t.hpp"
 #include "adit/graph_path_t.hpp"
 #include "adit/grid_patch_t.hpp"
+#include "adit/loop_status_t.hpp"
 #include "adit/pose_t.hpp"
 #include "adit/status_t.hpp"
 #include "adit/tile_segment_t.hpp"
@@ -29,7 +30,7 @@ namespace adit::protocol {
 // Layout of each received type (must follow protocol/lcm/*.lcm; the tests
 // check it against encoded messages).
 enum class LcmType { pose, status, command, command_ack, tile_index, tile_segment, tile_request, file_request, file_chunk,
-                     grid_patch, frame, graph_path };
+                     grid_patch, frame, graph_path, loop_status };
 
 // True when `bytes` (hash included) has exactly the layout of `type`.
 bool lcm_layout_ok(LcmType type, std::span<const std::uint8_t> bytes);
@@ -46,6 +47,7 @@ inline constexpr LcmType lcm_type_of(const file_chunk_t*) { return LcmType::file
 inline constexpr LcmType lcm_type_of(const grid_patch_t*) { return LcmType::grid_patch; }
 inline constexpr LcmType lcm_type_of(const frame_t*) { return LcmType::frame; }
 inline constexpr LcmType lcm_type_of(const graph_path_t*) { return LcmType::graph_path; }
+inline constexpr LcmType lcm_type_of(const loop_status_t*) { return LcmType::loop_status; }
 
 // Decodes `size` bytes into `out`; false (and `out` unspecified) for anything
 // that is not exactly one well-formed `Message`.
