@@ -1,7 +1,7 @@
 // adit console in a real browser (Debian's chromium, headless, software
 // WebGL), against aditd replaying a simulated mine drive on loopback LCM:
 //   - the page loads with no console errors; poses advance; the health shows MAPPING
-//     and the loop closure;
+//     and the loop closure; the session's pictures are offered once the payload made them;
 //   - a START without the passphrase is refused with a visible message and changes nothing;
 //   - unlocked, START and STOP by clicking work; two browsers watch at once;
 //   - a hint typed in the form reaches the payload, whose refusal (no prior map) shows;
@@ -350,6 +350,24 @@ try {
   const tail = await fetch(trajectoryUrl, { headers: { Range: 'bytes=10-' } });
   assert.equal(tail.status, 206);
   assert.equal(await tail.text(), onDisk.slice(10));
+
+  step('The pictures');
+  // The payload makes the session's pictures after it stops (products, at idle
+  // priority): the list offers the top view once made, and it is the payload's file.
+  const topView = `${item} a[data-picture="top_view"]`;
+  await waitFor('the top view offered', async () => {
+    if ((await page.$(topView)) !== null) return true;
+    await page.click('#refresh-sessions');
+    await sleep(2000);
+    return false;
+  }, 120000, 0);
+  const picture = Buffer.from(await (await fetch(await page.$eval(topView, (a) => a.href))).arrayBuffer());
+  assert.ok(picture.subarray(0, 8).equals(Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a])), 'a PNG');
+  assert.ok(picture.equals(fs.readFileSync(path.join(work, 'state/sessions', id, 'products/top_view.png'))),
+            'the payload\'s top view, byte for byte');
+  figures.top_view_bytes = picture.length;
+  const sections = await page.$eval(`${item} a[data-picture="sections"]`, (a) => a.textContent);
+  assert.match(sections, /^Sections \(\d+\)$/, 'the cross-sections are offered');
 
   // Afterwards only the failures this test provokes: refused commands and a
   // wrong passphrase (403), the hint the payload refused (409) and the one out

@@ -1,6 +1,7 @@
 // adit console's parts without a network: the event hub's resume and
 // resynchronisation (a browser that reconnects), its wake-up across threads,
-// and the operator passphrase (hash, check, file errors, tokens).
+// the operator passphrase (hash, check, file errors, tokens), and which of a
+// session's files a browser may fetch.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,6 +11,7 @@
 #include "adit/common/error.hpp"
 #include "console_events.hpp"
 #include "console_passphrase.hpp"
+#include "console_sessions.hpp"
 #include "temp_file.hpp"
 
 namespace adit::tools::console {
@@ -100,6 +102,36 @@ TEST(ConsolePassphrase, ABadHashFileNamesTheFileAndWhatIsWrong) {
   EXPECT_NE(problem("pbkdf2-sha256$10$0011223344556677$00\n").find("outside"), std::string::npos);
   EXPECT_NE(problem("pbkdf2-sha256$1000$zz$00\n").find("salt"), std::string::npos);
   EXPECT_NE(problem("pbkdf2-sha256$1000$0011223344556677$abcd\n").find("32 bytes"), std::string::npos);
+}
+
+// A browser names a file; only these reach a path, each where the payload
+// writes it; the session list says which pictures are made.
+TEST(ConsoleSessions, OnlyTheSessionsOwnFilesAndPicturesAreServedFromWhereThePayloadWritesThem) {
+  EXPECT_EQ(session_file("trajectory.tum")->path, "trajectory.tum");
+  EXPECT_EQ(session_file("summary.json")->type, "application/json");
+  EXPECT_EQ(session_file("top_view.png")->path, "products/top_view.png");
+  EXPECT_EQ(session_file("top_view.png")->type, "image/png");
+  EXPECT_EQ(session_file("sections.csv")->path, "products/sections/sections.csv");
+  EXPECT_EQ(session_file("section_007.svg")->path, "products/sections/section_007.svg");
+  EXPECT_EQ(session_file("section_007.svg")->type, "image/svg+xml");
+  for (const char* refused : {"config.yaml", "lidar.pcap", "section_.svg", "section_0a1.svg", "section_1234567.svg",
+                              "section_001.png", "occupancy.bt", "../summary.json", ""})
+    EXPECT_FALSE(session_file(refused).has_value()) << refused;
+
+  const test::TempFolder root;
+  const ScanNames names(root.path() / "names.json");
+  std::filesystem::create_directories(root.path() / "s1");
+  std::filesystem::create_directories(root.path() / "s2" / "products" / "sections");
+  for (const char* f : {"products/top_view.png", "products/sections/section_000.svg",
+                        "products/sections/section_001.svg", "products/sections/sections.csv"})
+    std::ofstream(root.path() / "s2" / f) << "x";
+  const nlohmann::json listed = describe_sessions({"s1", "s2 recovered"}, names, root.path());
+  ASSERT_EQ(listed.size(), 2U);
+  EXPECT_EQ(listed[0]["top_view"], false) << "no products yet";
+  EXPECT_EQ(listed[0]["sections"], 0);
+  EXPECT_EQ(listed[1]["id"], "s2");
+  EXPECT_EQ(listed[1]["top_view"], true);
+  EXPECT_EQ(listed[1]["sections"], 2) << "the drawings, not the table";
 }
 
 }  // namespace

@@ -104,6 +104,24 @@ export class SessionsPanel {
         a.textContent = 'Trajectory';
         actions.append(a);
       }
+      // The pictures the payload made after the session (products/): the top view and the cross-sections.
+      if (s.top_view) {
+        const a = document.createElement('a');
+        a.href = `/files/${s.id}/top_view.png`;
+        a.download = `${s.name || s.id}-top_view.png`;
+        a.textContent = 'Top view';
+        a.dataset.picture = 'top_view';
+        actions.append(a);
+      }
+      if (s.sections > 0) {
+        const a = document.createElement('a');
+        a.href = `/files/${s.id}/sections.csv`;
+        a.download = `${s.name || s.id}-sections.csv`;
+        a.textContent = `Sections (${s.sections})`;
+        a.title = 'Width and height every interval along the path; one drawing each at /files/<session>/section_NNN.svg';
+        a.dataset.picture = 'sections';
+        actions.append(a);
+      }
       li.append(title, actions);
       return li;
     }));

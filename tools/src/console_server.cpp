@@ -385,7 +385,7 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
     reply_json(res, 200, downloads.list());
   });
 
-  server.Get(R"(/files/([A-Za-z0-9_-]{1,64})/([a-z_]+\.[a-z]+))", [&](const httplib::Request& req,
+  server.Get(R"(/files/([A-Za-z0-9_-]{1,64})/([a-z_0-9]+\.[a-z]+))", [&](const httplib::Request& req,
                                                                       httplib::Response& res) {
     const std::string session = req.matches[1];
     const std::string name = req.matches[2];
@@ -398,13 +398,18 @@ int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) 
       reply_file(res, file, "application/octet-stream");
       return;
     }
-    if (name == "trajectory.tum" || name == "map_trajectory.tum" || name == "summary.json") {
+    if (const std::optional<SessionFile> file = session_file(name)) {
       if (options.sessions_dir.empty()) {
         reply_error(res, 404, "this console does not run on the payload (no --sessions-dir): only maps");
         return;
       }
-      reply_file(res, options.sessions_dir / session / name,
-                 name.ends_with(".json") ? "application/json" : "text/plain");
+      const std::filesystem::path on_disk = options.sessions_dir / session / file->path;
+      if (*file->path.begin() == "products" && !std::filesystem::exists(on_disk)) {
+        reply_error(res, 404, fmt::format("{} of {} is not made (yet): the payload makes a session's pictures "
+                                          "after it stops (session.products)", name, session));
+        return;
+      }
+      reply_file(res, on_disk, file->type);
       return;
     }
     reply_error(res, 404, fmt::format("no file '{}'", name));

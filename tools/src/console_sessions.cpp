@@ -1,6 +1,8 @@
 #include "console_sessions.hpp"
 
+#include <algorithm>
 #include <fstream>
+#include <string_view>
 
 #include "adit/common/log.hpp"
 
@@ -59,6 +61,12 @@ nlohmann::json describe_sessions(const std::vector<std::string>& ids, const Scan
         if (f.is_regular_file(ec)) bytes += f.file_size(ec);
       entry["bytes"] = bytes;
       entry["trajectory"] = std::filesystem::exists(dir / "trajectory.tum", ec);
+      // Made by the payload after the session (products/, renamed into place when whole).
+      entry["top_view"] = std::filesystem::exists(dir / session_file("top_view.png")->path, ec);
+      std::size_t sections = 0;
+      for (const auto& f : std::filesystem::directory_iterator(dir / "products" / "sections", ec))
+        if (session_file(f.path().filename().string()) && f.path().extension() == ".svg") ++sections;
+      entry["sections"] = sections;
       std::ifstream in(dir / "summary.json");
       if (in) {
         try {
@@ -76,6 +84,22 @@ nlohmann::json describe_sessions(const std::vector<std::string>& ids, const Scan
     out.push_back(std::move(entry));
   }
   return out;
+}
+
+std::optional<SessionFile> session_file(const std::string& name) {
+  if (name == "trajectory.tum" || name == "map_trajectory.tum") return SessionFile{name, "text/plain"};
+  if (name == "summary.json") return SessionFile{name, "application/json"};
+  if (name == "top_view.png") return SessionFile{std::filesystem::path("products") / name, "image/png"};
+  if (name == "sections.csv") return SessionFile{std::filesystem::path("products") / "sections" / name, "text/csv"};
+  // section_NNN.svg (cross_sections.hpp numbers them from 000).
+  const std::string_view prefix = "section_", suffix = ".svg";
+  if (name.size() > prefix.size() + suffix.size() && name.size() <= prefix.size() + suffix.size() + 6 &&
+      name.starts_with(prefix) && name.ends_with(suffix)) {
+    const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return SessionFile{std::filesystem::path("products") / "sections" / name, "image/svg+xml"};
+  }
+  return std::nullopt;
 }
 
 }  // namespace adit::tools::console
