@@ -110,8 +110,6 @@ GridMosaic::BlockSpan GridMosaic::span_of_block(std::int32_t block_patches, std:
   BlockSpan span;
   span.block.x = x;
   span.block.y = y;
-  span.min_x = span.min_y = std::numeric_limits<std::int32_t>::max();
-  span.max_x = span.max_y = std::numeric_limits<std::int32_t>::min();
   const std::int32_t x0 = x * block_patches, y0 = y * block_patches;
   const std::int32_t x1 = x0 + (block_patches - 1), y1 = y0 + (block_patches - 1);
   for (auto it = patches_.lower_bound({x0, std::numeric_limits<std::int32_t>::min()});

@@ -5,6 +5,7 @@
 // one of another resolution or patch size than the grid held is refused.
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -83,7 +84,8 @@ class GridMosaic {
   GridImage bounding_image(bool cells) const;
   // Block (x, y)'s patches: their bounding box, version sum and count.
   struct BlockSpan {
-    std::int32_t min_x = 0, min_y = 0, max_x = -1, max_y = -1;
+    std::int32_t min_x = std::numeric_limits<std::int32_t>::max(), min_y = std::numeric_limits<std::int32_t>::max();
+    std::int32_t max_x = std::numeric_limits<std::int32_t>::min(), max_y = std::numeric_limits<std::int32_t>::min();
     GridBlock block;
   };
   BlockSpan span_of_block(std::int32_t block_patches, std::int32_t x, std::int32_t y) const;
