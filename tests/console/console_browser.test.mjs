@@ -191,6 +191,9 @@ try {
   // first loop comes after the stop, so the page is given one as the
   // console's graph_path event would: ConsoleGraphPath.* tests that side):
   // drawn with the tiles, and the poses' path kept from its newest keyframe on.
+  // A slow run may have closed a real loop already, whose graph path cut the
+  // poses' path to its newest keyframe: the path grows again as poses come.
+  await waitFor('a path of more than 10 points', async () => page.evaluate(() => window.adit.view.pathCount > 10), 20000);
   const graphPath = await page.evaluate(() => {
     const v = window.adit.view;
     const n = v.pathCount;
