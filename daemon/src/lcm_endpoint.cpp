@@ -338,7 +338,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
         if (hint && machine.state() != protocol::SessionState::mapping) problem = "no session is mapping";
         if (hint && problem.empty()) problem = hooks.hint ? hooks.hint(*hint) : "this daemon has no prior map";
         ack.accepted = problem.empty();
-        ack.reason = ack.accepted ? "hint taken" : "hint refused: " + problem;
+        ack.reason = ack.accepted ? "hint taken" : problem;  // the client says "HINT rejected: …"
         return;
       }
       case Verb::export_map: {

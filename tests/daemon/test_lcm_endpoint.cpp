@@ -351,7 +351,7 @@ TEST(LcmEndpoint, HintReachesTheSessionWhileMappingWithItsReasonWhenRefused) {
   Harness h;
   auto r = h.adit({"hint", "--x", "12.5", "--y", "-3"});
   EXPECT_EQ(r.exit_status, 1);
-  EXPECT_NE(r.err.find("hint refused: no session is mapping"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("HINT rejected: no session is mapping"), std::string::npos) << r.err;
   ASSERT_EQ(h.adit({"start"}).exit_status, 0);
   r = h.adit({"hint", "--x", "12.5", "--y", "-3", "--radius", "3", "--heading", "90"});
   ASSERT_EQ(r.exit_status, 0) << r.out << r.err;
@@ -367,7 +367,7 @@ TEST(LcmEndpoint, HintReachesTheSessionWhileMappingWithItsReasonWhenRefused) {
   }
   r = h.adit({"hint", "--x", "1", "--y", "2"});
   EXPECT_EQ(r.exit_status, 1);
-  EXPECT_NE(r.err.find("hint refused: already localised"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("HINT rejected: already localised"), std::string::npos) << r.err;
   // A bad argument from another client is refused before the daemon sees it.
   lcm::LCM lcm(h.url);
   Sniffer sniffer(h.url);
