@@ -77,6 +77,7 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   const PoseGraphSolution solution = optimize(graph_, config_.solver);
   ++stats_.optimizations;
   stats_.last_optimization_s = solution.time_s;
+  stats_.optimization_s_total += solution.time_s;
   return true;
 }
 
@@ -159,6 +160,7 @@ void LoopCloser::refine() {
   const PoseGraphSolution solution = optimize(graph_, batch);
   ++stats_.optimizations;
   stats_.last_optimization_s = solution.time_s;
+  stats_.optimization_s_total += solution.time_s;
 }
 
 }  // namespace adit::slam

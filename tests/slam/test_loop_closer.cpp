@@ -82,6 +82,8 @@ TEST(LoopCloser, ClosesARingDrivenTwice) {
   EXPECT_LT(o.end_after, 0.3 * o.end_before);
   EXPECT_LT(o.error_after, o.error_before);
   EXPECT_GE(o.stats.optimizations, 1U);
+  EXPECT_GT(o.stats.optimization_s_total, 0.0);
+  EXPECT_GE(o.stats.optimization_s_total, o.stats.last_optimization_s) << "the sum of every optimisation's time";
 }
 
 // The same drive with all but the newest 5 keyframe scans on disk closes the

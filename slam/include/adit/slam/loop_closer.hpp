@@ -87,6 +87,7 @@ struct LoopClosureStats {
   std::size_t rejected_inconsistent = 0;  // failed the guard
   std::size_t optimizations = 0;
   double last_optimization_s = 0.0;
+  double optimization_s_total = 0.0;      // the solver's time, all optimisations
   // Cost (CPU of the calling thread's wall clock): descriptor and candidate
   // search per keyframe, and verification per candidate.
   double search_s_total = 0.0;
