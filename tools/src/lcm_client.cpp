@@ -125,16 +125,6 @@ std::optional<command_ack_t> LcmClient::command(const std::string& verb, const s
   return answer;
 }
 
-std::optional<status_t> LcmClient::wait_status() {
-  std::optional<status_t> status;
-  const Listen statuses(impl_->lcm, impl_->channel(Channel::status), [&](const lcm::ReceiveBuffer* rbuf) {
-    if (auto s = decode<status_t>(rbuf)) status = std::move(s);
-  });
-  const auto start = Clock::now();
-  while (!status && seconds_since(start) < impl_->options.timeout_s) impl_->handle_for(0.05);
-  return status;
-}
-
 namespace {
 
 Eigen::Isometry3d isometry_of(const double* position, const double* orientation) {

@@ -59,7 +59,6 @@ class LcmClient {
   // Milliseconds from the last send of the last command() to its ack (the
   // daemon's answer time plus the network's; a retry restarts the clock).
   double last_round_trip_ms() const;
-  std::optional<status_t> wait_status();
 
   // Everything a live view follows; an empty handler is not subscribed.
   struct FollowHandlers {
