@@ -35,6 +35,7 @@ slam::LoopClosureConfig loop_closure_config(const config::Config& config, slam::
   if (config.imu.enabled && loops.gravity_sigma_rad <= 0.0) loops.gravity_sigma_rad = 0.002;
   if (config.imu.enabled && loops.tilt_walk_rad_per_sqrt_s <= 0.0 && config.map.loops_tilt_walk)
     loops.tilt_walk_rad_per_sqrt_s = config.imu.accel_bias_walk / slam::kStandardGravity;
+  loops.optimize_every_s = config.map.loops_optimize_every_s;
   return loops;
 }
 

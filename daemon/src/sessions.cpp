@@ -168,6 +168,7 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
           {"optimizations", s.optimizations},
           {"last_optimization_s", s.last_optimization_s},
           {"optimization_s_total", s.optimization_s_total},
+          {"optimization_iterations", s.optimization_iterations_total},
           {"refine_s", loops->refine_time_s()},
           {"search_ms_mean", s.keyframes > 0 ? 1e3 * s.search_s_total / static_cast<double>(s.keyframes) : 0.0},
           {"search_ms_max", 1e3 * s.search_s_max},

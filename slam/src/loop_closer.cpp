@@ -65,23 +65,22 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   const double search_s = 1e-9 * static_cast<double>(monotonic_ns() - search_start_ns);
   stats_.search_s_total += search_s;
   stats_.search_s_max = std::max(stats_.search_s_max, search_s);
-  bool added = false;
   for (const LoopCandidate& c : candidates) {
     const std::int64_t t0 = monotonic_ns();
-    added = try_candidate(c) || added;
+    try_candidate(c);
     const double verification_s = 1e-9 * static_cast<double>(monotonic_ns() - t0);
     stats_.verification_s_total += verification_s;
     stats_.verification_s_max = std::max(stats_.verification_s_max, verification_s);
   }
-  if (!added) return false;
-  const PoseGraphSolution solution = optimize(graph_, config_.solver);
-  ++stats_.optimizations;
-  stats_.last_optimization_s = solution.time_s;
-  stats_.optimization_s_total += solution.time_s;
+  if (unsolved_ == 0) return false;
+  const double since_s = 1e-9 * static_cast<double>(stamp_ns - last_optimization_stamp_ns_);
+  if (stats_.optimizations > 0 && since_s < config_.optimize_every_s) return false;
+  count(optimize(graph_, config_.solver));
+  last_optimization_stamp_ns_ = stamp_ns;
   return true;
 }
 
-bool LoopCloser::try_candidate(const LoopCandidate& c) {
+void LoopCloser::try_candidate(const LoopCandidate& c) {
   LoopEvent event{c.query, c.candidate, c.descriptor_distance, "", 0.0, 0.0, 0.0};
   // The candidate's surroundings in its own frame, by the graph.
   // Its storage becomes resident only as the submap's voxels are used (11
@@ -99,7 +98,7 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
       ++stats_.rejected_unreadable;    // the candidate's own: no loop here
       event.outcome = "keyframe_unreadable";
       events_.push_back(event);
-      return false;
+      return;
     }
     add_to_submap(submap, neighbour_, candidate_inverse * graph_.nodes[m]);
   }
@@ -121,7 +120,7 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
     ++stats_.rejected_verification;
     event.outcome = std::string(to_string(v.verdict));
     events_.push_back(event);
-    return false;
+    return;
   }
   ++stats_.verified;
   if (v.verdict == LoopVerdict::partial) ++stats_.partial;
@@ -143,8 +142,17 @@ bool LoopCloser::try_candidate(const LoopCandidate& c) {
       if (p.query == l.to && p.candidate == l.from) information = p.information;
     graph_.edges.push_back({l.from, l.to, l.measurement, information, EdgeKind::loop});
     ++stats_.accepted;
+    ++unsolved_;
   }
-  return !newly.empty();
+}
+
+void LoopCloser::count(const PoseGraphSolution& solution) {
+  unsolved_ = 0;
+  ++stats_.optimizations;
+  stats_.last_optimization_s = solution.time_s;
+  stats_.optimization_s_total += solution.time_s;
+  stats_.last_optimization_iterations = solution.iterations;
+  stats_.optimization_iterations_total += static_cast<std::size_t>(solution.iterations);
 }
 
 Eigen::Isometry3d LoopCloser::correction() const {
@@ -158,9 +166,7 @@ void LoopCloser::refine() {
   batch.max_iterations = std::max(batch.max_iterations, 200);
   batch.max_time_s = std::max(batch.max_time_s, 10.0);
   const PoseGraphSolution solution = optimize(graph_, batch);
-  ++stats_.optimizations;
-  stats_.last_optimization_s = solution.time_s;
-  stats_.optimization_s_total += solution.time_s;
+  count(solution);
 }
 
 }  // namespace adit::slam

@@ -51,6 +51,12 @@ TEST(LoopClosureStage, ClosesLoopsInTheBackgroundAndPublishesTheCorrection) {
   EXPECT_EQ(stats.loop_keyframes.load(), closer.poses().size());
   EXPECT_GE(stats.loops_accepted.load(), 3U);
   EXPECT_EQ(stats.loops_accepted.load(), closer.stats().accepted);
+  // Loops found within map.loops_optimize_every_s of a solve wait for the next
+  // (decision 062); finish() refines the graph with those still waiting.
+  EXPECT_EQ(loop_closure_config(config).optimize_every_s, config.map.loops_optimize_every_s);
+  EXPECT_GT(config.map.loops_optimize_every_s, 0.0);
+  EXPECT_LT(closer.stats().optimizations, closer.stats().accepted);
+  EXPECT_EQ(closer.unsolved(), 0U);
   const double before = (odometry.translation() - truth_end.translation()).norm();
   const double after = (closer.poses().back().translation() - truth_end.translation()).norm();
   EXPECT_LT(after, 0.5 * before);

@@ -86,6 +86,60 @@ TEST(LoopCloser, ClosesARingDrivenTwice) {
   EXPECT_GE(o.stats.optimization_s_total, o.stats.last_optimization_s) << "the sum of every optimisation's time";
 }
 
+// Loops found within optimize_every_s of the last optimisation wait for the
+// first keyframe that long after it, and are solved together; the first loop
+// is solved at once, and refine() solves what still waits. The ring's second
+// lap closes a loop at nearly every keyframe (1 s apart): the coalesced graph
+// is solved a few times, closes nearly the same loops and ends where the
+// graph solved at every loop ends.
+TEST(LoopCloser, LoopsFoundSoonAfterAnOptimisationWaitForTheNextAndEndTheSame) {
+  const Drive d = drive([](double s) { return test::ring_pose(kSide, s); }, 1.3 * 4 * kSide, 2.0);
+  const auto run = [&d](double every_s, LoopCloser& closer) {
+    std::vector<std::int64_t> solved_at;  // keyframe stamps where add_keyframe optimised
+    for (std::size_t k = 0; k < d.truth.size(); ++k) {
+      const std::int64_t stamp = static_cast<std::int64_t>(k) * 1'000'000'000;
+      const std::size_t accepted_before = closer.stats().accepted;
+      const bool optimised =
+          closer.add_keyframe(stamp, d.odometry[k], test::scan_of(ring_world(), d.truth[k], 1000 + static_cast<unsigned>(k)));
+      if (optimised) {
+        EXPECT_EQ(closer.unsolved(), 0U);
+        if (!solved_at.empty()) {
+          EXPECT_GE(stamp - solved_at.back(), static_cast<std::int64_t>(every_s * 1e9));
+        }
+        solved_at.push_back(stamp);
+      } else if (closer.unsolved() > 0) {  // loops wait only within every_s of the last solve
+        EXPECT_FALSE(solved_at.empty()) << "loops wait before any solve";
+        if (!solved_at.empty()) {
+          EXPECT_LT(stamp - solved_at.back(), static_cast<std::int64_t>(every_s * 1e9));
+        }
+      }
+      if (closer.stats().accepted > 0 && accepted_before == 0) {
+        EXPECT_TRUE(optimised) << "the first loop waits for nothing";
+      }
+    }
+    return solved_at;
+  };
+  LoopClosureConfig every_loop, coalesced;
+  coalesced.optimize_every_s = 5.0;
+  LoopCloser at_once(every_loop), batched(coalesced);
+  const std::vector<std::int64_t> at_once_solves = run(0.0, at_once);
+  const std::vector<std::int64_t> batched_solves = run(5.0, batched);
+  ASSERT_GE(at_once.stats().accepted, 5U);
+  // The same candidates; those whose overlap lies at the threshold (0.59-0.60
+  // of 0.6) fall either way from a graph a few keyframes older.
+  EXPECT_EQ(batched.stats().candidates, at_once.stats().candidates);
+  EXPECT_GE(batched.stats().accepted, at_once.stats().accepted * 9 / 10) << "of " << at_once.stats().accepted;
+  EXPECT_LT(batched_solves.size(), at_once_solves.size() / 2) << at_once_solves.size() << " solves at every loop";
+  const std::size_t waiting = batched.unsolved();
+  batched.refine();
+  at_once.refine();
+  EXPECT_EQ(batched.unsolved(), 0U) << waiting << " loops waited for the session's end";
+  double worst_m = 0.0;
+  for (std::size_t k = 0; k < d.truth.size(); ++k)
+    worst_m = std::max(worst_m, (batched.poses()[k].translation() - at_once.poses()[k].translation()).norm());
+  EXPECT_LT(worst_m, 0.01) << "the two graphs end apart";
+}
+
 // The same drive with all but the newest 5 keyframe scans on disk closes the
 // same loops; the scans of the first lap damaged on disk before the second:
 // each such candidate is refused as unreadable, none reaches the graph, the

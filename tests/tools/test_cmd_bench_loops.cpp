@@ -21,7 +21,8 @@ CommandRun adit(const std::string& arguments) { return adit::test::run_adit(argu
 
 TEST(CmdBenchLoops, TimesEveryKeyframeAndTheGraph) {
   const CommandRun run =
-      adit("bench loops --session " + adit::test::mine_drive_12s().string() + " --graph-keyframes 600 --graph-runs 1 --json");
+      adit("bench loops --session " + adit::test::mine_drive_12s().string() +
+           " --graph-keyframes 600 --graph-runs 1 --optimize-every-s 2.5 --json");
   ASSERT_EQ(run.status, 0) << run.output;
   const auto j = nlohmann::json::parse(run.output.substr(run.output.find('{')));
   const int keyframes = j["keyframes"].get<int>();
@@ -34,6 +35,8 @@ TEST(CmdBenchLoops, TimesEveryKeyframeAndTheGraph) {
   EXPECT_EQ(j["graph"]["loops"].get<int>(), 10);  // every 10 keyframes from 500 on
   EXPECT_TRUE(j["graph"]["converged"].get<bool>()) << run.output;
   EXPECT_EQ(j["graph"]["wall"]["count"].get<int>(), 1);
+  EXPECT_EQ(j["optimize_every_s"].get<double>(), 2.5);
+  EXPECT_GE(j["optimisation_in_session_iterations"]["total"].get<int>(), j["optimisation_in_session"]["count"].get<int>());
 }
 
 TEST(CmdBenchLoops, AFolderWithoutASessionExitsWithStatus2) {

@@ -52,6 +52,7 @@ struct Options {
   int graph_keyframes = 2000;
   int graph_runs = 3;
   bool json = false;
+  double optimize_every_s = -1.0;  // < 0: the session's configuration
 };
 
 Eigen::Isometry3d planar(double x, double y, double yaw) {
@@ -132,6 +133,7 @@ int bench_loops(const Options& o) {
   config.threads.lock_memory = false;
   config.map.loop_closure = false;  // the loop closer runs below, alone on this thread
   config.session.products = false;
+  if (o.optimize_every_s >= 0.0) config.map.loops_optimize_every_s = o.optimize_every_s;
 
   // 1. aditd's pipeline: keyframes and the odometry's time per scan.
   daemon::Pipeline pipeline(config, {});
@@ -144,6 +146,7 @@ int bench_loops(const Options& o) {
   const slam::LoopClosureConfig loops = daemon::loop_closure_config(config);
   slam::LoopCloser closer(loops);
   Series search, verification, optimisation, per_keyframe_cpu;
+  std::vector<double> iterations;  // of each optimisation in the session
   const std::size_t count = o.max_keyframes > 0 ? std::min(o.max_keyframes, keyframes.size()) : keyframes.size();
   for (std::size_t i = 0; i < count; ++i) {
     const slam::Keyframe& k = keyframes[i];
@@ -157,7 +160,10 @@ int bench_loops(const Options& o) {
     for (std::size_t c = 0; c < candidates; ++c)
       verification.ms.push_back(1e3 * (after.verification_s_total - before.verification_s_total) /
                                 static_cast<double>(candidates));
-    if (after.optimizations > before.optimizations) optimisation.ms.push_back(1e3 * after.last_optimization_s);
+    if (after.optimizations > before.optimizations) {
+      optimisation.ms.push_back(1e3 * after.last_optimization_s);
+      iterations.push_back(after.last_optimization_iterations);
+    }
   }
   const slam::LoopClosureStats& s = closer.stats();
 
@@ -187,7 +193,13 @@ int bench_loops(const Options& o) {
         {"search", search.json(kSearchBudgetMs, odometry_ms)},
         {"verification", verification.json(kVerificationBudgetMs, odometry_ms)},
         {"add_keyframe_cpu", per_keyframe_cpu.json(0.0, odometry_ms)},
+        {"optimize_every_s", loops.optimize_every_s},
         {"optimisation_in_session", optimisation.json(0.0, odometry_ms)},
+        {"optimisation_in_session_total_s", s.optimization_s_total},
+        {"optimisation_in_session_iterations",
+         {{"median", iterations.empty() ? 0.0 : quantile(iterations, 0.5)},
+          {"max", iterations.empty() ? 0.0 : quantile(iterations, 1.0)},
+          {"total", s.optimization_iterations_total}}},
         {"graph", {{"keyframes", o.graph_keyframes},
                    {"loops", start.loop_count()},
                    {"converged", solution.converged},
@@ -206,6 +218,10 @@ int bench_loops(const Options& o) {
   fmt::print("{}", verification.text("verification, per candidate", kVerificationBudgetMs, odometry_ms));
   fmt::print("{}", per_keyframe_cpu.text("add_keyframe, thread CPU", 0.0, odometry_ms));
   fmt::print("{}", optimisation.text("graph optimisation in the session", 0.0, odometry_ms));
+  if (!iterations.empty())
+    fmt::print("  the session's {} optimisations: {:.1f} s in all, {} iterations (median {:.0f}, max {:.0f})\n",
+               iterations.size(), s.optimization_s_total, s.optimization_iterations_total, quantile(iterations, 0.5),
+               quantile(iterations, 1.0));
   fmt::print("{}", graph_wall.text(fmt::format("{}-keyframe graph, wall", o.graph_keyframes).c_str(), 1e3 * kGraphBudgetS,
                                    odometry_ms));
   fmt::print("{}", graph_cpu.text(fmt::format("{}-keyframe graph, thread CPU", o.graph_keyframes).c_str(),
@@ -229,6 +245,9 @@ void add_bench_loops_command(CLI::App& bench, int& status) {
   cmd->add_option("--graph-keyframes", o->graph_keyframes, "Keyframes of the synthetic graph (default 2000)")
       ->check(CLI::Range(2, 100000));
   cmd->add_option("--graph-runs", o->graph_runs, "Times the graph is solved (default 3)")->check(CLI::Range(1, 100));
+  cmd->add_option("--optimize-every-s", o->optimize_every_s,
+                  "Loops wait this long for the graph's next optimisation (default: map.loops_optimize_every_s)")
+      ->check(CLI::Range(0.0, 600.0));
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
   cmd->callback([o, &status] { status = bench_loops(*o); });
 }

@@ -204,6 +204,10 @@ struct MapSection {
   // accelerometer's bias walks (imu.accel_bias_walk): a loop that closes in
   // height then levels the route (docs/LOOPS.md). false = the ups as measured.
   bool loops_tilt_walk = true;
+  // Loops found within this many seconds of the last graph optimisation wait
+  // and are solved together (slam::LoopClosureConfig::optimize_every_s,
+  // decision 062): the graph's CPU on a route driven again. 0 = at once.
+  double loops_optimize_every_s = 5.0;
 };
 
 // The live 2D occupancy grid (slam::LiveGrid, docs/PRODUCTS.md "The live

@@ -60,6 +60,14 @@ struct LoopClosureConfig {
   // gravity, decision 008).
   double gravity_sigma_rad = 0.0;
   double tilt_walk_rad_per_sqrt_s = 0.0;  // the ups' tilt walk (PoseGraph::tilt_walk_rad_per_sqrt_s)
+  // Loops accepted less than this (keyframe stamps) after the last
+  // optimisation wait for the first keyframe this long after it, and are
+  // solved together; refine() solves what still waits. A solve of the whole
+  // graph costs what it costs whether it holds one new loop or ten, and a
+  // route driven again closes a loop at nearly every keyframe (Cartographer
+  // optimises every n nodes, hdl_graph_slam every few seconds, for the same
+  // reason). 0 = after every keyframe that adds a loop. Decision 062.
+  double optimize_every_s = 0.0;
 };
 
 // One candidate's fate, for the log and summary.json.
@@ -88,6 +96,8 @@ struct LoopClosureStats {
   std::size_t optimizations = 0;
   double last_optimization_s = 0.0;
   double optimization_s_total = 0.0;      // the solver's time, all optimisations
+  int last_optimization_iterations = 0;
+  std::size_t optimization_iterations_total = 0;
   // Cost (CPU of the calling thread's wall clock): descriptor and candidate
   // search per keyframe, and verification per candidate.
   double search_s_total = 0.0;
@@ -101,7 +111,8 @@ class LoopCloser {
   explicit LoopCloser(const LoopClosureConfig& config = {});
 
   // Adds a keyframe (`points` in its body frame) and closes what loops it
-  // can. Returns true when the graph was optimised (the poses moved).
+  // can. Returns true when the graph was optimised (the poses moved): when
+  // loops wait and config.optimize_every_s has passed since the last time.
   bool add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
                     std::span<const Eigen::Vector3f> points);
 
@@ -116,6 +127,8 @@ class LoopCloser {
   const LoopClosureStats& stats() const { return stats_; }
   // Verified loops still waiting for a witness (never in the graph unless one comes).
   std::size_t unconfirmed() const { return guard_.waiting().size(); }
+  // Loops in the graph not yet optimised (config.optimize_every_s).
+  std::size_t unsolved() const { return unsolved_; }
   const std::vector<LoopEvent>& events() const { return events_; }
   const PoseGraph& graph() const { return graph_; }
   // A last optimisation of the whole graph (session end).
@@ -126,7 +139,8 @@ class LoopCloser {
   const KeyframeScanStore& scans() const { return scans_; }
 
  private:
-  bool try_candidate(const LoopCandidate& candidate);
+  void try_candidate(const LoopCandidate& candidate);
+  void count(const PoseGraphSolution& solution);
 
   LoopClosureConfig config_;
   PoseGraph graph_;
@@ -146,6 +160,8 @@ class LoopCloser {
     Matrix6d information;
   };
   std::vector<PendingInformation> information_;  // of the loops that passed verification
+  std::size_t unsolved_ = 0;                     // loops added since the last optimisation
+  std::int64_t last_optimization_stamp_ns_ = 0;  // keyframe stamp of the last one (0: none yet)
 };
 
 }  // namespace adit::slam
