@@ -75,7 +75,7 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   if (unsolved_ == 0) return false;
   const double since_s = 1e-9 * static_cast<double>(stamp_ns - last_optimization_stamp_ns_);
   if (stats_.optimizations > 0 && since_s < config_.optimize_every_s) return false;
-  count(optimize(graph_, config_.solver));
+  record(optimize(graph_, config_.solver));
   last_optimization_stamp_ns_ = stamp_ns;
   return true;
 }
@@ -146,7 +146,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
   }
 }
 
-void LoopCloser::count(const PoseGraphSolution& solution) {
+void LoopCloser::record(const PoseGraphSolution& solution) {
   unsolved_ = 0;
   ++stats_.optimizations;
   stats_.last_optimization_s = solution.time_s;
@@ -166,7 +166,7 @@ void LoopCloser::refine() {
   batch.max_iterations = std::max(batch.max_iterations, 200);
   batch.max_time_s = std::max(batch.max_time_s, 10.0);
   const PoseGraphSolution solution = optimize(graph_, batch);
-  count(solution);
+  record(solution);
 }
 
 }  // namespace adit::slam

@@ -140,7 +140,7 @@ class LoopCloser {
 
  private:
   void try_candidate(const LoopCandidate& candidate);
-  void count(const PoseGraphSolution& solution);
+  void record(const PoseGraphSolution& solution);  // its figures; nothing waits any more
 
   LoopClosureConfig config_;
   PoseGraph graph_;
@@ -161,7 +161,7 @@ class LoopCloser {
   };
   std::vector<PendingInformation> information_;  // of the loops that passed verification
   std::size_t unsolved_ = 0;                     // loops added since the last optimisation
-  std::int64_t last_optimization_stamp_ns_ = 0;  // keyframe stamp of the last one (0: none yet)
+  std::int64_t last_optimization_stamp_ns_ = 0;  // the keyframe stamp it ran at
 };
 
 }  // namespace adit::slam
