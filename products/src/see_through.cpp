@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "adit/common/error.hpp"
+#include "adit/slam/voxel_key.hpp"
 
 namespace adit::products {
 namespace {
@@ -110,13 +111,36 @@ void RangeImage::finish() {
   std::copy_n(scratch_.begin(), ring_of_row_.size(), elevation.begin());
   for (std::size_t row = 0; row < ring_of_row_.size(); ++row)
     row_tangent_[row] = std::isfinite(elevation[row]) ? std::tan(elevation[row]) : std::numeric_limits<float>::infinity();
+  // The rows' tangents in kTangentBins equal bins from the lowest to the
+  // highest finite one, each with the first row above its start: the
+  // projection of every map point into every scan looks its row up there,
+  // not by a binary search with its mispredicted branches.
+  const auto end = row_tangent_.begin() + rings_;
+  tangent_low_ = row_tangent_.front();
+  float high = tangent_low_;  // the highest finite tangent (rows without returns sort last, at +inf)
+  for (const float t : row_tangent_)
+    if (std::isfinite(t)) high = t;
+  inverse_bin_ = std::isfinite(tangent_low_) && high > tangent_low_
+                     ? static_cast<float>(kTangentBins) / (high - tangent_low_)
+                     : 0.0F;
+  for (std::size_t b = 0; b < kTangentBins; ++b) {
+    const float start = tangent_low_ + (inverse_bin_ > 0.0F ? static_cast<float>(b) / inverse_bin_ : 0.0F);
+    row_start_[b] = static_cast<std::uint32_t>(std::upper_bound(row_tangent_.begin(), end, start) - row_tangent_.begin());
+  }
 }
 
 int RangeImage::row_below_tangent(float tan_e) const {
-  const auto end = row_tangent_.begin() + rings_;
-  const auto above = std::upper_bound(row_tangent_.begin(), end, tan_e);
-  if (above == row_tangent_.begin() || above == end || !std::isfinite(*above)) return -1;
-  return static_cast<int>(above - row_tangent_.begin()) - 1;
+  // std::upper_bound over the rows' tangents, started from the table's guess
+  // for this tangent's bin and walked the row or two to the exact answer.
+  if (!(tan_e >= tangent_low_)) return -1;  // below the lowest row (or no rows, or NaN)
+  const float bin = (tan_e - tangent_low_) * inverse_bin_;
+  auto above = static_cast<std::size_t>(
+      row_start_[bin < static_cast<float>(kTangentBins - 1) ? static_cast<std::size_t>(bin) : kTangentBins - 1]);
+  const auto rings = static_cast<std::size_t>(rings_);
+  while (above > 0 && row_tangent_[above - 1] > tan_e) --above;
+  while (above < rings && !(row_tangent_[above] > tan_e)) ++above;
+  if (above == 0 || above == rings || !std::isfinite(row_tangent_[above])) return -1;
+  return static_cast<int>(above) - 1;
 }
 
 int RangeImage::row_below(float e) const {
@@ -189,20 +213,12 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
            it != cell_keys_.end() && *it <= last; ++it)
         in_range_.push_back(static_cast<std::uint32_t>(it - cell_keys_.begin()));
     }
-  for (const std::uint32_t c : in_range_) {
-    const Cell& cell = cells_[c];
-    // The nearest and farthest distances of the cell's box from the sensor.
-    const Eigen::Vector3f near = centre.cwiseMax(cell.low).cwiseMin(cell.high) - centre;
-    const Eigen::Vector3f far = (centre - cell.low).cwiseAbs().cwiseMax((cell.high - centre).cwiseAbs());
-    if (near.squaredNorm() > max2 || far.squaredNorm() < min2) continue;
-    for (std::uint32_t s = cell.begin; s < cell.end; ++s) {
+  // One candidate (at s in sorted_) against this scan.
+  const auto test = [&](std::uint32_t s) {
     const Eigen::Vector3f& p = sorted_[s];
     const std::size_t i = index_[s];
-    if (retire_after_seen_ > 0 && through_[i] == 0 && seen_[i] >= retire_after_seen_ &&
-        scans_ - first_seen_[i] >= retire_after_scans_)
-      continue;
     const float d2 = (p - centre).squaredNorm();
-    if (d2 < min2 || d2 > max2) continue;
+    if (d2 < min2 || d2 > max2) return;
     // The sensor's pose when this azimuth was fired.
     Eigen::Vector3f q = middle * p;
     float azimuth = fast_atan2(q.y(), q.x());
@@ -219,13 +235,13 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
     const float rho2 = q.x() * q.x() + q.y() * q.y();
     const float rho = std::sqrt(rho2);
     const float range = std::sqrt(rho2 + q.z() * q.z());
-    if (!(rho > 0.0F)) continue;
+    if (!(rho > 0.0F)) return;
     const int row = image.row_below_tangent(q.z() / rho);
-    if (row < 0) continue;
+    if (row < 0) return;
     // The columns whose centres bracket the azimuth.
     float a = azimuth;
     if (a < 0.0F) a += kTwoPi;
-    const int c0 = static_cast<int>(std::floor(a / w - 0.5F));
+    const int c0 = slam::floor_to_int(a / w - 0.5F);  // ≥ -0.5: in int range
     const int left = c0 < 0 ? c0 + cols : c0 >= cols ? c0 - cols : c0;
     const int right = left + 1 == cols ? 0 : left + 1;
     float r[4] = {image.range(row, left), image.range(row, right), image.range(row + 1, left),
@@ -243,13 +259,36 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
       nearest = std::min(nearest, x);
       seen = seen || std::abs(x - range) <= tolerance;
     }
-    if (!known) continue;  // a bin without a return says nothing
+    if (!known) return;  // a bin without a return says nothing
     if (seen) {
       if (seen_[i] < std::numeric_limits<std::uint16_t>::max()) ++seen_[i];
       if (!first_seen_.empty() && first_seen_[i] == 0) first_seen_[i] = static_cast<std::uint32_t>(scans_);
     } else if (nearest > range + std::max(margin, fraction * range)) {
       if (through_[i] < std::numeric_limits<std::uint16_t>::max()) ++through_[i];
     }
+  };
+  const auto retired = [&](std::size_t i) {
+    return retire_after_seen_ > 0 && through_[i] == 0 && seen_[i] >= retire_after_seen_ &&
+           scans_ - first_seen_[i] >= retire_after_scans_;
+  };
+  for (const std::uint32_t c : in_range_) {
+    Cell& cell = cells_[c];
+    // The nearest and farthest distances of the cell's box from the sensor.
+    const Eigen::Vector3f near = centre.cwiseMax(cell.low).cwiseMin(cell.high) - centre;
+    const Eigen::Vector3f far = (centre - cell.low).cwiseAbs().cwiseMax((cell.high - centre).cwiseAbs());
+    if (near.squaredNorm() > max2 || far.squaredNorm() < min2) continue;
+    for (std::uint32_t s = cell.begin; s < cell.end;) {
+      if (retired(index_[s])) {
+        // Retired for good (nothing tests it again, so its counts stay): it
+        // leaves the cell's tested span, swapped past its end; the point
+        // swapped in is looked at next.
+        --cell.end;
+        std::swap(sorted_[s], sorted_[cell.end]);
+        std::swap(index_[s], index_[cell.end]);
+        continue;
+      }
+      test(s);
+      ++s;
     }
   }
 }

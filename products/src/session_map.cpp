@@ -117,6 +117,7 @@ SessionInputs read_session_inputs(const std::filesystem::path& session_dir) {
                                   Eigen::AngleAxisd(e.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
                                      .toRotationMatrix();
     in.body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
+    in.map_voxel_m = c.map.voxel_m;
   }
   return in;
 }

@@ -12,6 +12,7 @@
 #include "adit/common/error.hpp"
 #include "adit/products/grid_io.hpp"
 #include "adit/products/grid_projection.hpp"
+#include "adit/products/map_thinning.hpp"
 #include "adit/products/session_map.hpp"
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/map_import.hpp"
@@ -30,7 +31,9 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
   if (o.write_ot) files.push_back("occupancy.ot");
   files.insert(files.end(), {"grid.pgm", "grid.yaml", "top_view.png", "sections/"});
   if (r.targets_note.empty()) files.push_back("targets.csv");
-  return {{"points", r.points},
+  return {{"read_points", r.read_points},
+          {"thinning", {{"voxel_m", r.thin_voxel_m}, {"dropped", r.thinned}}},
+          {"points", r.points},
           {"moving_objects", {{"enabled", o.moving.enabled}, {"removed", r.moving_removed},
                               {"candidates", r.moving_candidates}, {"suspects", r.moving_suspects}, {"scans_used", r.moving_scans},
                               {"skipped_because", r.moving_skipped}, {"cpu_s", r.moving_cpu_s}, {"map_static_bytes", r.map_static_bytes}}},
@@ -85,6 +88,8 @@ void check_options(const ProductsOptions& o) {
           fmt::format("{} m is outside 0.01 .. 1 m", o.grid_resolution_m));
   require(o.occupancy.resolution_m >= 0.01 - 1e-12 && o.occupancy.resolution_m <= 1.0, "octree-resolution",
           fmt::format("{} m is outside 0.01 .. 1 m", o.occupancy.resolution_m));
+  require(!std::isnan(o.thin_voxel_m) && o.thin_voxel_m <= 1.0, "thin-voxel",
+          fmt::format("{} m is above 1 m (0: every point kept)", o.thin_voxel_m));
   require(o.band_low_m < o.band_high_m, "band", "the band's low height must be below its high one");
   require(o.outliers.k >= 1 && o.outliers.stddev_mult > 0.0, "sor", "k >= 1 and a positive stddev multiple");
   require(o.ground.patch_m > 0.0 && o.ground.distance_m > 0.0, "ground", "patch and distance must be positive");
@@ -120,6 +125,10 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   r.points_bytes = std::filesystem::file_size(map_file);
   std::filesystem::create_directories(r.out_dir);
   lap("read_map");
+  r.read_points = inputs.points.size();
+  r.thin_voxel_m = options.thin_voxel_m < 0.0 ? inputs.map_voxel_m : options.thin_voxel_m;
+  r.thinned = thin_to_voxels(inputs.points, r.thin_voxel_m);
+  lap("one_point_per_voxel");
   check_cancel();
   {
     const double moving0 = thread_cpu_s();

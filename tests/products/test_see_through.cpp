@@ -4,7 +4,9 @@
 // seen at grazing angles far ahead, must stay; a person who stood in the
 // corridor and left must go.
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <unordered_set>
 
@@ -147,6 +149,47 @@ TEST(RangeImage, RowsByElevationAndColumnsByAzimuth) {
   EXPECT_EQ(image.row_below(static_cast<float>(5 * M_PI / 180)), 1);
   EXPECT_EQ(image.row_below(static_cast<float>(20 * M_PI / 180)), -1);
   EXPECT_EQ(image.row_below(static_cast<float>(-20 * M_PI / 180)), -1);
+}
+
+TEST(RangeImage, RowByTangentIsTheBinarySearchsAnswer) {
+  // 16 rings 2° apart from -15° (a VLP-16), ring 5 without returns (a dead
+  // beam: its row sorts last, at +inf), and 3 rings: the looked-up row below
+  // each tangent, for tangents over and past the rings and on their own
+  // values, is std::upper_bound's over the rows' tangents.
+  for (const int rings : {16, 3}) {
+    RangeImage image(rings, 64);
+    for (int ring = 0; ring < rings; ++ring) {
+      if (rings == 16 && ring == 5) continue;
+      const double el = (-15.0 + 2.0 * ring) * M_PI / 180;
+      for (int k = 0; k < 64; ++k) {
+        const double az = 2 * M_PI * (k + 0.5) / 64;
+        image.add(ring, Eigen::Vector3f(static_cast<float>(10 * std::cos(el) * std::cos(az)),
+                                        static_cast<float>(10 * std::cos(el) * std::sin(az)),
+                                        static_cast<float>(10 * std::sin(el))),
+                  0.0F);
+      }
+    }
+    image.finish();
+    std::vector<float> tangents;
+    for (int row = 0; row < rings; ++row) tangents.push_back(image.row_tangent(row));
+    const auto expected = [&](float t) {
+      const auto above = std::upper_bound(tangents.begin(), tangents.end(), t);
+      if (above == tangents.begin() || above == tangents.end() || !std::isfinite(*above)) return -1;
+      return static_cast<int>(above - tangents.begin()) - 1;
+    };
+    std::vector<float> probes = {-1e9F, 1e9F, std::numeric_limits<float>::infinity(),
+                                 -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()};
+    for (const float t : tangents)
+      if (std::isfinite(t)) probes.insert(probes.end(), {t, std::nextafter(t, -1.0F), std::nextafter(t, 1.0F)});
+    for (int k = 0; k <= 4000; ++k) probes.push_back(-0.4F + 0.8F * static_cast<float>(k) / 4000.0F);
+    int inside = 0;
+    for (const float t : probes) {
+      const int want = std::isnan(t) ? -1 : expected(t);
+      EXPECT_EQ(image.row_below_tangent(t), want) << rings << " rings, tangent " << t;
+      inside += want >= 0;
+    }
+    EXPECT_GT(inside, 300);  // the 3 rings span 4° of the probes' 46°
+  }
 }
 
 TEST(SeeThrough, StaticCorridorStaysAtGrazingAngles) {

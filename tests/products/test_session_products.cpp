@@ -11,6 +11,7 @@
 #include "adit/products/grid_io.hpp"
 #include "adit/products/session_products.hpp"
 #include "adit/protocol/map_export.hpp"
+#include "adit/protocol/map_import.hpp"
 #include "adit/slam/tum.hpp"
 
 namespace adit::products {
@@ -101,10 +102,54 @@ TEST(SessionProducts, FinerGridAndOtherFolder) {
   EXPECT_GT(r.ot_bytes, 0u);
 }
 
+TEST(SessionProducts, APlaceMappedOnTwoLapsIsThinnedToOnePointPerMapVoxel) {
+  // The corridor as one lap, and as two: the second lap's points 1 cm from
+  // the first's, in the same 5 cm voxels (the loop closure moved them there).
+  const auto once = corridor_session("one_lap");
+  const auto twice = corridor_session("two_laps");
+  std::vector<protocol::MapPoint> points = protocol::read_map(twice / "map.ply");
+  const std::size_t lap = points.size();
+  for (std::size_t i = 0; i < lap; ++i) {
+    protocol::MapPoint p = points[i];
+    p.x += 0.01;
+    points.push_back(p);
+  }
+  protocol::write_map(twice / "map.ply", protocol::MapFormat::ply, points);
+  // Thinned to the session's own map voxel (config.yaml) by default.
+  std::ofstream(twice / "config.yaml") << "payload:\n  id: test\nlidar:\n  model: VLP-16\nmap:\n  voxel_m: 0.05\n";
+  const ProductsReport r = write_session_products(twice, ProductsOptions{});
+  EXPECT_EQ(r.read_points, 2 * lap);
+  EXPECT_DOUBLE_EQ(r.thin_voxel_m, 0.05);
+  // The one lap alone, thinned the same (its own few duplicates: samples 5 cm
+  // apart whose rounding put two in one voxel).
+  ProductsOptions same_voxel;
+  same_voxel.thin_voxel_m = 0.05;
+  const ProductsReport one = write_session_products(once, same_voxel);
+  // The second lap adds nothing: the first lap's points are the ones kept, and the products are the one lap's.
+  EXPECT_EQ(r.thinned, lap + one.thinned);
+  EXPECT_EQ(r.points, one.points);
+  const Grid2d a = read_grid(once / "products" / "grid.yaml");
+  const Grid2d b = read_grid(twice / "products" / "grid.yaml");
+  EXPECT_EQ(a.cells, b.cells);
+  std::ifstream in(twice / "products" / "products.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["read_points"], 2 * lap);
+  EXPECT_EQ(j["thinning"]["dropped"], r.thinned);
+  // 0 keeps every point; without a config.yaml nothing is thinned either.
+  ProductsOptions keep_all;
+  keep_all.thin_voxel_m = 0.0;
+  EXPECT_EQ(write_session_products(twice, keep_all).thinned, 0U);
+  std::filesystem::remove(twice / "config.yaml");
+  EXPECT_EQ(write_session_products(twice, ProductsOptions{}).thinned, 0U);
+}
+
 TEST(SessionProducts, BadOptionsAndMissingFilesAreInputErrors) {
   const auto dir = corridor_session("bad");
   ProductsOptions options;
   options.grid_resolution_m = 0.005;
+  EXPECT_THROW(write_session_products(dir, options), InputError);
+  options = ProductsOptions{};
+  options.thin_voxel_m = 2.0;
   EXPECT_THROW(write_session_products(dir, options), InputError);
   std::filesystem::remove(dir / "map_trajectory.tum");
   try {

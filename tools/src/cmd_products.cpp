@@ -24,6 +24,11 @@ std::string kib(std::uintmax_t bytes) { return fmt::format("{:.1f} kB", static_c
 void run_products(const ProductsCommand& c) {
   const products::ProductsReport r = products::write_session_products(c.session, c.options, c.out);
   fmt::print("products of {} in {}\n", c.session, r.out_dir.string());
+  if (r.thin_voxel_m > 0.0)
+    fmt::print("read              {} map points, {} more than one in a {} m voxel left out\n", r.read_points, r.thinned,
+               r.thin_voxel_m);
+  else
+    fmt::print("read              {} map points, all kept\n", r.read_points);
   if (r.moving_skipped.empty())
     fmt::print("moving objects    {} map points removed ({} suspects; seen through by later or earlier scans, {} "
                "scans of the recording; {:.2f} s CPU); the rest in map_static, the removed in moving_points.ply\n",
@@ -53,6 +58,8 @@ void register_products_commands(CLI::App& app, int& status) {
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--out", c->out, "Where to write (default SESSION/products)");
+  cmd->add_option("--thin-voxel", o.thin_voxel_m,
+                  "Keep one map point per voxel of this edge first (m; default: the session's map.voxel_m; 0: every point)");
   cmd->add_option("--grid-resolution", o.grid_resolution_m, "2D grid cell (m), 0.01 .. 1 (default 0.05)");
   cmd->add_option("--octree-resolution", o.occupancy.resolution_m, "3D voxel (m), 0.01 .. 1 (default 0.1)");
   cmd->add_option("--band", o.band_low_m, "Lowest height above the ground that blocks (m, default 0.15)");

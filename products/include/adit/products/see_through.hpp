@@ -17,7 +17,9 @@
 // and in at least `through_ratio` times as many scans as it was seen in (a
 // return of the quad within `seen_tolerance_m` of it). docs/decisions/029-moving-objects-seen-through-in-the-recording.md.
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -98,6 +100,11 @@ class RangeImage {
   std::vector<float> row_elevation_;
   std::vector<float> row_tangent_;
   std::vector<int> ring_of_row_;
+  // row_below_tangent's table (finish()): kTangentBins bins from tangent_low_.
+  static constexpr std::size_t kTangentBins = 256;
+  std::array<std::uint32_t, kTangentBins> row_start_{};
+  float tangent_low_ = std::numeric_limits<float>::infinity();
+  float inverse_bin_ = 0.0F;
 };
 
 // The sensor's pose over one scan: `map_to_sensor[k]` at time k·step_s after
@@ -132,7 +139,7 @@ class SeeThroughCounter {
  private:
   struct Cell {
     Eigen::Vector3f low, high;  // the bounding box of its points
-    std::uint32_t begin = 0, end = 0;  // into sorted_ / index_
+    std::uint32_t begin = 0, end = 0;  // into sorted_ / index_; retired points are swapped past `end`
   };
   std::size_t size_ = 0;
   std::vector<Eigen::Vector3f> sorted_;  // the candidates, cell by cell (scans visit the cells in range)

@@ -51,6 +51,7 @@ struct SessionInputs {
   std::vector<protocol::MapPoint> points;
   slam::Trajectory body_poses;
   Eigen::Isometry3d body_to_sensor = Eigen::Isometry3d::Identity();
+  double map_voxel_m = 0.0;  // config.yaml's map.voxel_m: aditd kept one point per such voxel (0: no config)
 };
 
 // Reads the map file, map_trajectory.tum and config.yaml. Missing or bad

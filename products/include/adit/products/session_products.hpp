@@ -27,6 +27,9 @@
 namespace adit::products {
 
 struct ProductsOptions {
+  // The map is thinned to one point per voxel of this edge first (map_thinning.hpp):
+  // < 0, the session's own map.voxel_m (config.yaml; none without one); 0, every point kept.
+  double thin_voxel_m = -1.0;
   SeeThroughOptions moving;         // moving objects out of the map (moving_objects.hpp); moving.enabled
   RayOptions rays;
   Occupancy3dOptions occupancy;
@@ -54,6 +57,9 @@ struct Cancelled : std::runtime_error {
 };
 
 struct ProductsReport {
+  std::size_t read_points = 0;      // in the session's map file
+  double thin_voxel_m = 0.0;        // the voxel the map was thinned to (0: not thinned)
+  std::size_t thinned = 0;          // of read_points, more than one in a voxel: dropped
   std::size_t points = 0;           // after the moving objects were removed
   std::size_t moving_removed = 0;   // map points of moving objects taken out
   std::size_t moving_candidates = 0, moving_suspects = 0, moving_scans = 0;

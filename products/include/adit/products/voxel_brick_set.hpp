@@ -27,10 +27,14 @@ class VoxelBrickSet {
   explicit VoxelBrickSet(std::size_t voxels)
       : slots_(std::bit_ceil(std::max<std::size_t>(voxels / 2, 16))), shift_(64 - std::countr_zero(slots_.size())) {}
 
-  void insert(const VoxelIndex& v) {
+  // Adds a voxel; true when it was not in the set before.
+  bool insert(const VoxelIndex& v) {
     if (2 * (bricks_ + 1) > slots_.size()) grow();
     Slot& s = find_or_add(brick_key(v));
-    s.mask |= bit_of(v);
+    const std::uint64_t bit = bit_of(v);
+    const bool added = (s.mask & bit) == 0;
+    s.mask |= bit;
+    return added;
   }
 
   bool contains(const VoxelIndex& v) const { return (mask_of(brick_key(v)) & bit_of(v)) != 0; }
