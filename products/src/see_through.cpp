@@ -154,11 +154,14 @@ SeeThroughCounter::SeeThroughCounter(std::span<const Eigen::Vector3f> map_points
                                      const SeeThroughOptions& options, bool retire)
     : size_(map_points.size()),
       options_(options),
-      retire_after_seen_(retire ? static_cast<std::uint16_t>(std::clamp(options.coarse_retire_after_seen, 0, 65535)) : 0),
+      retire_after_looks_(retire ? static_cast<std::uint16_t>(std::clamp(options.coarse_retire_after_looks, 0, 65535)) : 0),
       retire_after_scans_(static_cast<std::size_t>(std::max(options.coarse_retire_after_scans, 0))),
       through_(map_points.size(), 0),
       seen_(map_points.size(), 0) {
-  if (retire_after_seen_ > 0) first_seen_.assign(map_points.size(), 0);
+  if (retire_after_looks_ > 0) {
+    looked_.assign(map_points.size(), 0);
+    first_looked_.assign(map_points.size(), 0);
+  }
   if (!candidate.empty() && candidate.size() != map_points.size())
     throw InputError("see-through", "", "the candidate flags do not match the map points");
   // The candidates grouped by cell (sorted by the cell's key), so that a scan
@@ -260,16 +263,18 @@ void SeeThroughCounter::add_scan(const RangeImage& image, const ScanPoses& poses
       seen = seen || std::abs(x - range) <= tolerance;
     }
     if (!known) return;  // a bin without a return says nothing
-    if (seen) {
-      if (seen_[i] < std::numeric_limits<std::uint16_t>::max()) ++seen_[i];
-      if (!first_seen_.empty() && first_seen_[i] == 0) first_seen_[i] = static_cast<std::uint32_t>(scans_);
-    } else if (nearest > range + std::max(margin, fraction * range)) {
-      if (through_[i] < std::numeric_limits<std::uint16_t>::max()) ++through_[i];
+    constexpr std::uint16_t kMost = std::numeric_limits<std::uint16_t>::max();
+    const bool through = !seen && nearest > range + std::max(margin, fraction * range);
+    if (seen && seen_[i] < kMost) ++seen_[i];
+    if (through && through_[i] < kMost) ++through_[i];
+    if (!through && !looked_.empty()) {
+      if (looked_[i] < kMost) ++looked_[i];
+      if (first_looked_[i] == 0) first_looked_[i] = static_cast<std::uint32_t>(scans_);
     }
   };
   const auto retired = [&](std::size_t i) {
-    return retire_after_seen_ > 0 && through_[i] == 0 && seen_[i] >= retire_after_seen_ &&
-           scans_ - first_seen_[i] >= retire_after_scans_;
+    return retire_after_looks_ > 0 && through_[i] == 0 && looked_[i] >= retire_after_looks_ &&
+           scans_ - first_looked_[i] >= retire_after_scans_;
   };
   for (const std::uint32_t c : in_range_) {
     Cell& cell = cells_[c];

@@ -224,13 +224,13 @@ TEST(SeeThrough, PersonWhoStaysIsKept) {
 }
 
 TEST(SeeThrough, ARetiringCounterStopsTestingWhatItSawStillFindsWhoLeft) {
-  // The coarse pass's counter: a point seen 8 times, first 40 scans ago or
-  // more, and never seen through is tested no more. The person of
-  // PersonWhoLeftIsRemoved stood for 10 scans: seen more than 8 times, but
-  // over too short a span to retire before leaving and being seen through.
+  // The coarse pass's counter: a point looked at 8 times, first 40 scans ago
+  // or more, and never seen through is tested no more. The person of
+  // PersonWhoLeftIsRemoved stood for 10 scans: looked at more than 8 times,
+  // but over too short a span to retire before leaving and being seen through.
   const Drive d = drive(60, Person{{12.0, 0.5}, 1.0}, 0.02);
   SeeThroughOptions options;
-  options.coarse_retire_after_seen = 8;
+  options.coarse_retire_after_looks = 8;
   options.coarse_retire_after_scans = 40;
   SeeThroughCounter all(d.map, {}, options);
   SeeThroughCounter retiring(d.map, {}, options, true);
@@ -253,6 +253,47 @@ TEST(SeeThrough, ARetiringCounterStopsTestingWhatItSawStillFindsWhoLeft) {
   EXPECT_GT(retired, d.map.size() / 4);  // most of the corridor is seen often: retired
   // Whether a point was seen through at all (what makes a suspect) hardly changes.
   EXPECT_LT(static_cast<double>(through_differs), 0.01 * static_cast<double>(d.map.size())) << through_differs;
+}
+
+TEST(SeeThrough, APointOnlyEverHiddenRetiresOnItsLooks) {
+  // A map point 10 m ahead that the first 48 scans look at but never see
+  // (something 5 m ahead hides it: all four returns there, nearer), then 4
+  // scans see through it. Its looks retire it in the coarse pass's counter
+  // before the four; a sighting it never had could not have.
+  const Eigen::Vector3f point(10.0F, 0.0F, 0.0F);
+  const auto scan_at = [](float range) {
+    RangeImage image(2, 64);
+    for (int ring = 0; ring < 2; ++ring)
+      for (int c = 0; c < 64; ++c) {
+        const float az = 6.2831853F * (static_cast<float>(c) + 0.5F) / 64.0F;
+        const float el = (ring == 0 ? -1.0F : 1.0F) * 0.01745F;
+        image.add(ring, range * Eigen::Vector3f(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)),
+                  0.0F);
+      }
+    image.finish();
+    return image;
+  };
+  const RangeImage hidden = scan_at(5.0F), past = scan_at(20.0F);
+  ScanPoses poses;
+  poses.map_to_sensor.assign(16, Eigen::Isometry3f::Identity());
+  SeeThroughOptions options;
+  options.coarse_retire_after_looks = 8;
+  options.coarse_retire_after_scans = 40;
+  const std::vector<Eigen::Vector3f> map = {point};
+  SeeThroughCounter all(map, {}, options);
+  SeeThroughCounter retiring(map, {}, options, true);
+  for (int k = 0; k < 52; ++k) {
+    all.add_scan(k < 48 ? hidden : past, poses);
+    retiring.add_scan(k < 48 ? hidden : past, poses);
+  }
+  EXPECT_EQ(all.seen(0), 0U);
+  EXPECT_EQ(all.through(0), 4U);
+  EXPECT_EQ(retiring.through(0), 0U);
+  // Looked at fewer times than asked, it is not retired.
+  options.coarse_retire_after_looks = 49;
+  SeeThroughCounter patient(map, {}, options, true);
+  for (int k = 0; k < 52; ++k) patient.add_scan(k < 48 ? hidden : past, poses);
+  EXPECT_EQ(patient.through(0), 4U);
 }
 
 TEST(SeeThrough, ExcludedPointsAreNeverRemoved) {

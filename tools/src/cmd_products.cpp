@@ -81,12 +81,12 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--moving-coarse-step", o.moving.coarse_step,
                   "Moving objects: suspects from every n-th scan first, then judged on every --moving-scan-step-th "
                   "(0: one pass over all points; default 16)");
-  cmd->add_option("--moving-coarse-retire", o.moving.coarse_retire_after_seen,
-                  "Moving objects: in the coarse pass, a point seen in this many scans over --moving-coarse-retire-scans "
-                  "or more and never seen through is tested no more (0: never retired; default 8)")
+  cmd->add_option("--moving-coarse-retire", o.moving.coarse_retire_after_looks,
+                  "Moving objects: in the coarse pass, a point looked at (all four returns there) in this many scans over "
+                  "--moving-coarse-retire-scans or more and never seen through is tested no more (0: never retired; default 8)")
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--moving-coarse-retire-scans", o.moving.coarse_retire_after_scans,
-                  "Moving objects: the coarse scans from a point's first sighting before it may retire (default 40)")
+                  "Moving objects: the coarse scans from a point's first look before it may retire (default 40)")
       ->check(CLI::Range(0, 1000000));
   cmd->add_flag("--moving-nearest-return-only", o.moving.nearest_return_only,
                 "Moving objects: compare with the one nearest return, not the four around (for measurements)");

@@ -41,14 +41,17 @@ struct SeeThroughOptions {
   // candidates finds the suspects (seen through once), then every scan_step-th
   // scan judges only those. 0: one pass over all.
   int coarse_step = 16;
-  // In the coarse pass, a point seen in this many scans, the first of them at
+  // In the coarse pass, a point looked at in this many scans (all four returns
+  // there, not seen through: seen, or hidden, or grazed), the first of them at
   // least coarse_retire_after_scans coarse scans ago, and never seen through
   // is tested no more (0: every point in every coarse scan). A route that
   // comes back to the same drifts for half an hour would otherwise test each
   // static point again on every lap. The span keeps someone who stood in view
   // for less than a minute (40 coarse scans of a 10 Hz LiDAR) from being
-  // retired before they leave.
-  int coarse_retire_after_seen = 8;
+  // retired before they leave. Looks, not sightings, count: a point at a
+  // grazing angle is rarely seen and was tested on every lap
+  // (docs/decisions/063-products-one-point-per-map-voxel.md).
+  int coarse_retire_after_looks = 8;
   int coarse_retire_after_scans = 40;
   // Only the return nearest in direction is compared (a plain per-pixel range
   // image comparison, as Removert's), not the four around: for measuring what
@@ -119,9 +122,9 @@ struct ScanPoses {
 class SeeThroughCounter {
  public:
   // `candidate[i]` = 0: point i is never tested (e.g. it is ground). Empty: all are.
-  // `retire` true: a point seen in options.coarse_retire_after_seen scans
-  // over options.coarse_retire_after_scans scans of this counter or more, and
-  // never seen through, is tested no more (the coarse pass).
+  // `retire` true: a point looked at in options.coarse_retire_after_looks
+  // scans over options.coarse_retire_after_scans scans of this counter or
+  // more, and never seen through, is tested no more (the coarse pass).
   SeeThroughCounter(std::span<const Eigen::Vector3f> map_points, std::span<const std::uint8_t> candidate,
                     const SeeThroughOptions& options, bool retire = false);
 
@@ -148,9 +151,12 @@ class SeeThroughCounter {
   std::vector<std::uint64_t> cell_keys_;  // each cell's key, ascending: a scan looks up only the cells in its range
   std::vector<std::uint32_t> in_range_;   // add_scan's: the cells within its range
   SeeThroughOptions options_;
-  std::uint16_t retire_after_seen_ = 0;   // 0: never retired
+  std::uint16_t retire_after_looks_ = 0;  // 0: never retired
   std::size_t retire_after_scans_ = 0;
-  std::vector<std::uint32_t> first_seen_;  // with retiring: the scan (1, 2, ...) that first saw each point, 0: none
+  // With retiring: the scans that looked at each point without seeing through
+  // it, and the first of them (1, 2, ...; 0: none).
+  std::vector<std::uint16_t> looked_;
+  std::vector<std::uint32_t> first_looked_;
   std::vector<std::uint16_t> through_;
   std::vector<std::uint16_t> seen_;
   std::size_t scans_ = 0;
