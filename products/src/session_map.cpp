@@ -11,6 +11,7 @@
 
 #include "adit/common/error.hpp"
 #include "adit/config/load.hpp"
+#include "adit/products/map_thinning.hpp"
 #include "adit/products/voxel_brick_set.hpp"
 #include "adit/protocol/map_import.hpp"
 #include "adit/slam/tum.hpp"
@@ -101,12 +102,8 @@ SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::
   return m;
 }
 
-SessionInputs read_session_inputs(const std::filesystem::path& session_dir) {
+SessionInputs read_session_inputs(const std::filesystem::path& session_dir, double thin_voxel_m) {
   SessionInputs in;
-  const std::filesystem::path map_file = map_file_of(session_dir);
-  in.points = protocol::read_map(map_file);
-  if (in.points.empty()) throw InputError(map_file.string(), "", "the map has no points");
-  in.body_poses = slam::read_tum(session_dir / "map_trajectory.tum");
   const std::filesystem::path config_file = session_dir / "config.yaml";
   if (std::filesystem::exists(config_file)) {
     const config::Config c = config::load_config(config_file);
@@ -119,6 +116,21 @@ SessionInputs read_session_inputs(const std::filesystem::path& session_dir) {
     in.body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
     in.map_voxel_m = c.map.voxel_m;
   }
+  in.thin_voxel_m = thin_voxel_m < 0.0 ? in.map_voxel_m : thin_voxel_m;
+  const std::filesystem::path map_file = map_file_of(session_dir);
+  protocol::MapFileReader reader(map_file);
+  in.read_points = reader.count();
+  VoxelThinner thinner(in.thin_voxel_m, in.read_points);
+  // Room for every point only when none is thinned: thinned, the vector grows
+  // with what is kept (a quarter to a third of a long drive's map).
+  if (!(in.thin_voxel_m > 0.0)) in.points.reserve(in.read_points);
+  for (std::span<const protocol::MapPoint> block = reader.next(); !block.empty(); block = reader.next())
+    for (const protocol::MapPoint& p : block)
+      if (thinner.keep(p)) in.points.push_back(p);
+  in.points.shrink_to_fit();
+  in.thinned = in.read_points - in.points.size();
+  if (in.points.empty()) throw InputError(map_file.string(), "", "the map has no points");
+  in.body_poses = slam::read_tum(session_dir / "map_trajectory.tum");
   return in;
 }
 

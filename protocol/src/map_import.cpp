@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -19,6 +19,12 @@
 namespace adit::protocol {
 namespace {
 
+// The first bytes of a file that hold its header: PLY's and PCD's headers end
+// within them (ply_header.hpp), LAS's public header block is 375 bytes.
+constexpr std::size_t kHeadBytes = 64 * 1024;
+// Points decoded per block when reading a file (2.5 MB of MapPoint).
+constexpr std::size_t kBlockPoints = 64 * 1024;
+
 template <typename T>
 T load(std::string_view bytes, std::size_t offset) {
   T v;
@@ -26,58 +32,118 @@ T load(std::string_view bytes, std::size_t offset) {
   return v;
 }
 
-// `count` records of `record` bytes from `offset` must fit in the file.
-void check_size(std::string_view bytes, std::size_t offset, std::uint64_t count, std::size_t record,
+// One number of a point record: its binary type, where it lies in the record,
+// and value = raw * scale + add (LAS scales integer coordinates).
+enum class Scalar : std::uint8_t { i8, u8, i16, u16, i32, u32, i64, u64, f32, f64 };
+
+struct Field {
+  Scalar type = Scalar::f32;
+  std::size_t offset = 0;
+  double scale = 1.0;
+  double add = 0.0;
+};
+
+template <typename T>
+double raw(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return static_cast<double>(v);
+}
+
+double value(const Field& f, const char* record) {
+  const char* p = record + f.offset;
+  double v = 0.0;
+  switch (f.type) {
+    case Scalar::i8: v = raw<std::int8_t>(p); break;
+    case Scalar::u8: v = raw<std::uint8_t>(p); break;
+    case Scalar::i16: v = raw<std::int16_t>(p); break;
+    case Scalar::u16: v = raw<std::uint16_t>(p); break;
+    case Scalar::i32: v = raw<std::int32_t>(p); break;
+    case Scalar::u32: v = raw<std::uint32_t>(p); break;
+    case Scalar::i64: v = raw<std::int64_t>(p); break;
+    case Scalar::u64: v = raw<std::uint64_t>(p); break;
+    case Scalar::f32: v = raw<float>(p); break;
+    case Scalar::f64: v = raw<double>(p); break;
+  }
+  return v * f.scale + f.add;
+}
+
+// Where a file's points lie and how each record is laid out.
+struct Layout {
+  std::uint64_t count = 0;
+  std::size_t data_offset = 0;
+  std::size_t record = 0;
+  Field x, y, z;
+  std::optional<Field> intensity, time;
+};
+
+// `count` records of `record` bytes from `offset` must fit in `size` bytes.
+void check_size(std::uint64_t size, std::size_t offset, std::uint64_t count, std::size_t record,
                 const std::string& name) {
-  const std::size_t room = bytes.size() >= offset ? bytes.size() - offset : 0;
+  const std::uint64_t room = size >= offset ? size - offset : 0;
   if (record == 0 || count > room / record)
     throw InputError(name, "",
                      fmt::format("truncated: {} points of {} bytes need {} bytes after the header, file has {}", count,
                                  record, static_cast<double>(count) * record, room));
 }
 
-void check_finite(const MapPoint& p, std::size_t index, const std::string& name) {
-  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-    throw InputError(name, fmt::format("point {}", index), "non-finite coordinate");
+// The points of records [first, first + out.size()) from their bytes at `records`.
+void decode(const Layout& l, const char* records, std::uint64_t first, std::span<MapPoint> out,
+            const std::string& name) {
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const char* r = records + i * l.record;
+    MapPoint& p = out[i];
+    p.x = value(l.x, r);
+    p.y = value(l.y, r);
+    p.z = value(l.z, r);
+    if (l.intensity) p.intensity = static_cast<float>(value(*l.intensity, r));
+    if (l.time) p.time = value(*l.time, r);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError(name, fmt::format("point {}", first + i), "non-finite coordinate");
+  }
 }
 
-std::vector<MapPoint> read_ply_map(std::string_view bytes, const std::string& name) {
-  const PlyHeader header = parse_ply_header(bytes, name);
+std::optional<Scalar> ply_scalar(std::string_view t) {
+  if (t == "char" || t == "int8") return Scalar::i8;
+  if (t == "uchar" || t == "uint8") return Scalar::u8;
+  if (t == "short" || t == "int16") return Scalar::i16;
+  if (t == "ushort" || t == "uint16") return Scalar::u16;
+  if (t == "int" || t == "int32") return Scalar::i32;
+  if (t == "uint" || t == "uint32") return Scalar::u32;
+  if (t == "float" || t == "float32") return Scalar::f32;
+  if (t == "double" || t == "float64") return Scalar::f64;
+  return std::nullopt;
+}
+
+Layout ply_layout(std::string_view head, const std::string& name) {
+  const PlyHeader header = parse_ply_header(head, name);
   if (header.elements.empty() || header.elements.front().name != "vertex")
     throw InputError(name, "element vertex", "the first element must be 'vertex'");
   const PlyElement& vertex = header.elements.front();
-  struct Field {
-    std::string type;
-    std::size_t offset = 0;
-  };
-  std::optional<Field> x, y, z, intensity;
-  std::size_t record = 0;
+  Layout l;
+  l.count = vertex.count;
+  l.data_offset = header.data_offset;
+  std::optional<Field> x, y, z;
   for (const PlyProperty& p : vertex.properties) {
     if (!p.count_type.empty()) throw InputError(name, "property " + p.name, "list properties in 'vertex' are not read");
-    const Field f{p.type, record};
+    const std::optional<Scalar> type = ply_scalar(p.type);
+    if (!type) throw InputError(name, "property " + p.name, fmt::format("unknown type '{}'", p.type));
+    const Field f{*type, l.record};
     if (p.name == "x") x = f;
     if (p.name == "y") y = f;
     if (p.name == "z") z = f;
-    if (p.name == "intensity") intensity = f;
-    record += ply_type_size(p.type);
+    if (p.name == "intensity") l.intensity = f;
+    l.record += ply_type_size(p.type);
   }
   if (!x || !y || !z) throw InputError(name, "element vertex", "needs properties x, y and z");
-  check_size(bytes, header.data_offset, vertex.count, record, name);
-  std::vector<MapPoint> points(vertex.count);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const char* r = bytes.data() + header.data_offset + i * record;
-    MapPoint& p = points[i];
-    p.x = read_ply_scalar(x->type, r + x->offset);
-    p.y = read_ply_scalar(y->type, r + y->offset);
-    p.z = read_ply_scalar(z->type, r + z->offset);
-    if (intensity) p.intensity = static_cast<float>(read_ply_scalar(intensity->type, r + intensity->offset));
-    check_finite(p, i, name);
-  }
-  return points;
+  l.x = *x;
+  l.y = *y;
+  l.z = *z;
+  return l;
 }
 
 // PCD v0.7 (pointclouds.org, "The PCD (Point Cloud Data) file format").
-std::vector<MapPoint> read_pcd_map(std::string_view bytes, const std::string& name) {
+Layout pcd_layout(std::string_view bytes, const std::string& name) {
   std::vector<std::string> fields, types;
   std::vector<std::size_t> sizes, counts;
   std::optional<std::uint64_t> points_count;
@@ -142,69 +208,48 @@ std::vector<MapPoint> read_pcd_map(std::string_view bytes, const std::string& na
       counts.size() != fields.size())
     throw InputError(name, "FIELDS", "FIELDS, SIZE, TYPE and COUNT must list the same number of fields");
   if (!points_count) throw InputError(name, "POINTS", "the header has no POINTS line");
-  struct Field {
-    char type = 'F';
-    std::size_t size = 4;
-    std::size_t offset = 0;
-  };
-  std::optional<Field> x, y, z, intensity;
-  std::size_t record = 0;
+  Layout l;
+  l.count = *points_count;
+  l.data_offset = offset;
+  std::optional<Field> x, y, z;
   for (std::size_t i = 0; i < fields.size(); ++i) {
-    const Field f{types[i][0], sizes[i], record};
-    const bool number = f.size == 4 || f.size == 8 || (f.type != 'F' && (f.size == 1 || f.size == 2));
-    if (!number)
-      throw InputError(name, "SIZE",
-                       fmt::format("field {}: {} {} is not a binary number type", fields[i], types[i], sizes[i]));
+    const char t = types[i][0];
+    const std::size_t s = sizes[i];
+    std::optional<Scalar> type;
+    if (t == 'F' && s == 4) type = Scalar::f32;
+    if (t == 'F' && s == 8) type = Scalar::f64;
+    if (t == 'I') type = s == 1 ? Scalar::i8 : s == 2 ? Scalar::i16 : s == 4 ? Scalar::i32 : Scalar::i64;
+    if (t == 'U') type = s == 1 ? Scalar::u8 : s == 2 ? Scalar::u16 : s == 4 ? Scalar::u32 : Scalar::u64;
+    if (!type || (t != 'F' && s != 1 && s != 2 && s != 4 && s != 8))
+      throw InputError(name, "SIZE", fmt::format("field {}: {} {} is not a binary number type", fields[i], types[i], s));
+    const Field f{*type, l.record};
     if (fields[i] == "x") x = f;
     if (fields[i] == "y") y = f;
     if (fields[i] == "z") z = f;
-    if (fields[i] == "intensity") intensity = f;
-    record += sizes[i] * counts[i];
+    if (fields[i] == "intensity") l.intensity = f;
+    l.record += s * counts[i];
   }
   if (!x || !y || !z) throw InputError(name, "FIELDS", "needs fields x, y and z");
-  check_size(bytes, offset, *points_count, record, name);
-  const auto value = [&](const Field& f, std::size_t at) -> double {
-    switch (f.type) {
-      case 'F':
-        return f.size == 4 ? load<float>(bytes, at) : load<double>(bytes, at);
-      case 'I':
-        return f.size == 1   ? load<std::int8_t>(bytes, at)
-               : f.size == 2 ? load<std::int16_t>(bytes, at)
-               : f.size == 4 ? load<std::int32_t>(bytes, at)
-                             : static_cast<double>(load<std::int64_t>(bytes, at));
-      default:
-        return f.size == 1   ? load<std::uint8_t>(bytes, at)
-               : f.size == 2 ? load<std::uint16_t>(bytes, at)
-               : f.size == 4 ? load<std::uint32_t>(bytes, at)
-                             : static_cast<double>(load<std::uint64_t>(bytes, at));
-    }
-  };
-  std::vector<MapPoint> points(*points_count);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::size_t r = offset + i * record;
-    MapPoint& p = points[i];
-    p.x = value(*x, r + x->offset);
-    p.y = value(*y, r + y->offset);
-    p.z = value(*z, r + z->offset);
-    if (intensity) p.intensity = static_cast<float>(value(*intensity, r + intensity->offset));
-    check_finite(p, i, name);
-  }
-  return points;
+  l.x = *x;
+  l.y = *y;
+  l.z = *z;
+  return l;
 }
 
 // LAS 1.0-1.4 (ASPRS LAS 1.4 R15, Table 3 header; §2.6 point data records).
-std::vector<MapPoint> read_las_map(std::string_view bytes, const std::string& name) {
+// `size`: the whole file's, of which `head` is the start.
+Layout las_layout(std::string_view head, std::uint64_t size, const std::string& name) {
   constexpr std::size_t kMinHeader = 227;  // LAS 1.0-1.2 public header block
-  if (bytes.size() < kMinHeader || bytes.substr(0, 4) != "LASF")
+  if (head.size() < kMinHeader || head.substr(0, 4) != "LASF")
     throw InputError(name, "", "not a LAS file (no 'LASF' signature or shorter than a header)");
-  const auto major = load<std::uint8_t>(bytes, 24);
-  const auto minor = load<std::uint8_t>(bytes, 25);
+  const auto major = load<std::uint8_t>(head, 24);
+  const auto minor = load<std::uint8_t>(head, 25);
   if (major != 1 || minor > 4)
     throw InputError(name, "version", fmt::format("LAS {}.{} is not read (1.0-1.4 are)", major, minor));
-  const auto header_size = load<std::uint16_t>(bytes, 94);
-  const auto data_offset = load<std::uint32_t>(bytes, 96);
-  const auto format_byte = load<std::uint8_t>(bytes, 104);
-  const auto record = load<std::uint16_t>(bytes, 105);
+  const auto header_size = load<std::uint16_t>(head, 94);
+  const auto data_offset = load<std::uint32_t>(head, 96);
+  const auto format_byte = load<std::uint8_t>(head, 104);
+  const auto record = load<std::uint16_t>(head, 105);
   if (format_byte & 0xC0) throw InputError(name, "point data format", "compressed (LAZ) points are not read");
   // Record lengths of point data record formats 0-10 (Tables 7-17).
   constexpr std::array<std::size_t, 11> kMinRecord{20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
@@ -212,37 +257,43 @@ std::vector<MapPoint> read_las_map(std::string_view bytes, const std::string& na
   if (record < kMinRecord[format_byte])
     throw InputError(name, "point data record length",
                      fmt::format("{} bytes is short for format {} ({})", record, format_byte, kMinRecord[format_byte]));
-  if (header_size < kMinHeader || data_offset < header_size || data_offset > bytes.size())
+  if (header_size < kMinHeader || data_offset < header_size || data_offset > size)
     throw InputError(name, "offset to point data",
-                     fmt::format("{} (header size {}, file {} bytes)", data_offset, header_size, bytes.size()));
-  std::uint64_t count = load<std::uint32_t>(bytes, 107);  // legacy count
-  if (minor >= 4 && header_size >= 375 && bytes.size() >= 255) count = std::max(count, load<std::uint64_t>(bytes, 247));
-  std::array<double, 3> scale{}, offset{};
+                     fmt::format("{} (header size {}, file {} bytes)", data_offset, header_size, size));
+  Layout l;
+  l.count = load<std::uint32_t>(head, 107);  // legacy count
+  if (minor >= 4 && header_size >= 375 && head.size() >= 255)
+    l.count = std::max(l.count, load<std::uint64_t>(head, 247));
+  l.data_offset = data_offset;
+  l.record = record;
+  Field* axes[] = {&l.x, &l.y, &l.z};
   for (int a = 0; a < 3; ++a) {
-    scale[a] = load<double>(bytes, 131 + 8 * a);
-    offset[a] = load<double>(bytes, 155 + 8 * a);
-    if (!(scale[a] > 0.0) || !std::isfinite(scale[a]) || !std::isfinite(offset[a]))
+    const double scale = load<double>(head, 131 + 8 * a);
+    const double offset = load<double>(head, 155 + 8 * a);
+    if (!(scale > 0.0) || !std::isfinite(scale) || !std::isfinite(offset))
       throw InputError(name, "scale/offset", "scale factors must be positive and offsets finite");
+    *axes[a] = Field{Scalar::i32, static_cast<std::size_t>(4 * a), scale, offset};
   }
-  check_size(bytes, data_offset, count, record, name);
-  // GPS time follows the 20-byte core in formats 1, 3-5, the 22-byte core in 6-10.
+  l.intensity = Field{Scalar::u16, 12};
+  // GPS time follows the 20-byte core in formats 1, 3-5, the 22-byte core in 6-10;
+  // Adjusted Standard GPS Time goes back to Unix seconds.
   const int time_at = format_byte >= 6 ? 22 : (format_byte == 1 || format_byte >= 3) ? 20 : -1;
-  const bool adjusted_gps = (load<std::uint16_t>(bytes, 6) & 1) != 0;
-  std::vector<MapPoint> points(count);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::size_t r = data_offset + i * record;
-    MapPoint& p = points[i];
-    p.x = load<std::int32_t>(bytes, r) * scale[0] + offset[0];
-    p.y = load<std::int32_t>(bytes, r + 4) * scale[1] + offset[1];
-    p.z = load<std::int32_t>(bytes, r + 8) * scale[2] + offset[2];
-    p.intensity = load<std::uint16_t>(bytes, r + 12);
-    if (time_at >= 0) {
-      const double t = load<double>(bytes, r + time_at);
-      // Back to Unix seconds when the time is Adjusted Standard GPS Time.
-      p.time = adjusted_gps ? t + 1e9 + kGpsEpochUnixSeconds - kGpsLeapSeconds : t;
-    }
+  const bool adjusted_gps = (load<std::uint16_t>(head, 6) & 1) != 0;
+  if (time_at >= 0)
+    l.time = Field{Scalar::f64, static_cast<std::size_t>(time_at), 1.0,
+                   adjusted_gps ? 1e9 + kGpsEpochUnixSeconds - kGpsLeapSeconds : 0.0};
+  return l;
+}
+
+Layout layout_of(std::string_view head, std::uint64_t size, MapFormat format, const std::string& name) {
+  Layout l;
+  switch (format) {
+    case MapFormat::ply: l = ply_layout(head, name); break;
+    case MapFormat::pcd: l = pcd_layout(head, name); break;
+    case MapFormat::las: l = las_layout(head, size, name); break;
   }
-  return points;
+  check_size(size, l.data_offset, l.count, l.record, name);
+  return l;
 }
 
 }  // namespace
@@ -257,23 +308,63 @@ MapFormat map_format_of(const std::filesystem::path& file) {
 }
 
 std::vector<MapPoint> read_map(std::string_view bytes, MapFormat format, const std::string& name) {
-  switch (format) {
-    case MapFormat::ply:
-      return read_ply_map(bytes, name);
-    case MapFormat::pcd:
-      return read_pcd_map(bytes, name);
-    case MapFormat::las:
-      return read_las_map(bytes, name);
-  }
-  return {};
+  const Layout l = layout_of(bytes, bytes.size(), format, name);
+  std::vector<MapPoint> points(l.count);
+  decode(l, bytes.data() + l.data_offset, 0, points, name);
+  return points;
+}
+
+struct MapFileReader::Impl {
+  std::string name;
+  std::ifstream in;
+  Layout layout;
+  std::uint64_t next_point = 0;
+  std::string bytes;
+  std::vector<MapPoint> block;
+};
+
+MapFileReader::MapFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  const MapFormat format = map_format_of(file);
+  m.name = file.string();
+  m.in.open(file, std::ios::binary);
+  if (!m.in) throw InputError(m.name, "", "cannot open the map file");
+  std::error_code error;
+  const std::uint64_t size = std::filesystem::file_size(file, error);
+  if (error) throw InputError(m.name, "", "cannot read the map file's size: " + error.message());
+  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, kHeadBytes)), '\0');
+  if (!m.in.read(head.data(), static_cast<std::streamsize>(head.size())))
+    throw InputError(m.name, "", "cannot read the map file's header");
+  m.layout = layout_of(head, size, format, m.name);
+  m.in.seekg(static_cast<std::streamoff>(m.layout.data_offset));
+  const auto block = static_cast<std::size_t>(std::min<std::uint64_t>(kBlockPoints, m.layout.count));
+  m.bytes.resize(block * m.layout.record);
+  m.block.resize(block);
+}
+
+MapFileReader::~MapFileReader() = default;
+
+std::uint64_t MapFileReader::count() const { return impl_->layout.count; }
+
+std::span<const MapPoint> MapFileReader::next() {
+  Impl& m = *impl_;
+  const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(m.block.size(), m.layout.count - m.next_point));
+  if (n == 0) return {};
+  if (!m.in.read(m.bytes.data(), static_cast<std::streamsize>(n * m.layout.record)))
+    throw InputError(m.name, fmt::format("point {}", m.next_point), "the file ended early (changed while read?)");
+  const std::span<MapPoint> out(m.block.data(), n);
+  decode(m.layout, m.bytes.data(), m.next_point, out, m.name);
+  m.next_point += n;
+  return out;
 }
 
 std::vector<MapPoint> read_map(const std::filesystem::path& file) {
-  const MapFormat format = map_format_of(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "", "cannot open the map file");
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  return read_map(bytes, format, file.string());
+  MapFileReader reader(file);
+  std::vector<MapPoint> points;
+  points.reserve(static_cast<std::size_t>(reader.count()));
+  for (std::span<const MapPoint> block = reader.next(); !block.empty(); block = reader.next())
+    points.insert(points.end(), block.begin(), block.end());
+  return points;
 }
 
 }  // namespace adit::protocol

@@ -9,6 +9,8 @@
 
 #include "adit/common/error.hpp"
 #include "adit/products/grid_io.hpp"
+#include "adit/products/map_thinning.hpp"
+#include "adit/products/session_map.hpp"
 #include "adit/products/session_products.hpp"
 #include "adit/protocol/map_export.hpp"
 #include "adit/protocol/map_import.hpp"
@@ -120,6 +122,21 @@ TEST(SessionProducts, APlaceMappedOnTwoLapsIsThinnedToOnePointPerMapVoxel) {
   const ProductsReport r = write_session_products(twice, ProductsOptions{});
   EXPECT_EQ(r.read_points, 2 * lap);
   EXPECT_DOUBLE_EQ(r.thin_voxel_m, 0.05);
+  // Thinned as the file is read: the points thin_to_voxels keeps of the whole file, in order.
+  {
+    std::vector<protocol::MapPoint> whole = protocol::read_map(twice / "map.ply");
+    const std::size_t dropped = thin_to_voxels(whole, 0.05);
+    const SessionInputs in = read_session_inputs(twice, -1.0);
+    EXPECT_EQ(in.read_points, 2 * lap);
+    EXPECT_EQ(in.thinned, dropped);
+    ASSERT_EQ(in.points.size(), whole.size());
+    for (std::size_t i = 0; i < whole.size(); ++i) {
+      ASSERT_EQ(in.points[i].x, whole[i].x) << i;
+      ASSERT_EQ(in.points[i].y, whole[i].y) << i;
+      ASSERT_EQ(in.points[i].z, whole[i].z) << i;
+    }
+    EXPECT_EQ(read_session_inputs(twice).points.size(), 2 * lap) << "0, the default: every point";
+  }
   // The one lap alone, thinned the same (its own few duplicates: samples 5 cm
   // apart whose rounding put two in one voxel).
   ProductsOptions same_voxel;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <span>
 #include <string>
 
 #include "adit/common/error.hpp"
@@ -132,6 +134,58 @@ TEST_F(MapImport, NonFiniteCoordinatesAreRefused) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), f.string());
     EXPECT_EQ(e.key(), "point 1");
+  }
+}
+
+// A file read a block at a time (MapFileReader) gives the points read_map
+// gives from the file's bytes, in order, across block boundaries (64 Ki).
+TEST_F(MapImport, AFileReadInBlocksGivesThePointsOfTheWholeFile) {
+  std::vector<MapPoint> points;
+  for (int i = 0; i < 150'000; ++i)
+    points.push_back({0.001 * i, -0.002 * i, 0.5 * (i % 11), static_cast<float>(i % 60'000), 1'763'700'000.0 + i});
+  for (const char* name : {"blocks.ply", "blocks.pcd", "blocks.las"}) {
+    SCOPED_TRACE(name);
+    const auto f = file(name);
+    write_map(f, map_format_of(f), points);
+    std::ifstream in(f, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::vector<MapPoint> whole = read_map(bytes, map_format_of(f), f.string());
+    MapFileReader reader(f);
+    EXPECT_EQ(reader.count(), points.size());
+    std::vector<MapPoint> blocks;
+    int block_count = 0;
+    for (std::span<const MapPoint> b = reader.next(); !b.empty(); b = reader.next()) {
+      EXPECT_LE(b.size(), 65'536U);
+      blocks.insert(blocks.end(), b.begin(), b.end());
+      ++block_count;
+    }
+    EXPECT_EQ(block_count, 3);
+    ASSERT_EQ(blocks.size(), whole.size());
+    for (std::size_t i = 0; i < whole.size(); ++i) {
+      ASSERT_EQ(blocks[i].x, whole[i].x) << i;
+      ASSERT_EQ(blocks[i].y, whole[i].y) << i;
+      ASSERT_EQ(blocks[i].z, whole[i].z) << i;
+      ASSERT_EQ(blocks[i].intensity, whole[i].intensity) << i;
+      ASSERT_EQ(blocks[i].time, whole[i].time) << i;
+    }
+    expect_same(read_map(f), points, 5e-4);
+  }
+}
+
+// A bad point in a later block is named by its index in the file.
+TEST_F(MapImport, ABadPointInALaterBlockIsNamedByItsIndexInTheFile) {
+  std::vector<MapPoint> points(70'000);
+  points[69'999].y = std::nan("");
+  const auto f = file("late-nan.pcd");
+  write_map(f, MapFormat::pcd, points);
+  MapFileReader reader(f);
+  EXPECT_EQ(reader.next().size(), 65'536U);
+  try {
+    reader.next();
+    FAIL() << "read a NaN coordinate";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), f.string());
+    EXPECT_EQ(e.key(), "point 69999");
   }
 }
 

@@ -13,9 +13,23 @@
 #include <cstddef>
 #include <vector>
 
+#include "adit/products/voxel_brick_set.hpp"
 #include "adit/protocol/map_point.hpp"
 
 namespace adit::products {
+
+// Points offered one by one (as a map file is read, protocol::MapFileReader):
+// keep() says whether each is the first in its voxel.
+class VoxelThinner {
+ public:
+  // voxel_m ≤ 0: every point is kept. `expected_points` sizes the table.
+  VoxelThinner(double voxel_m, std::size_t expected_points);
+  bool keep(const protocol::MapPoint& p);
+
+ private:
+  double inverse_ = 0.0;  // 1 / voxel_m; 0: keep all
+  VoxelBrickSet seen_;
+};
 
 // Keeps the first point (in order) of each voxel of edge `voxel_m`, in their
 // order; returns how many were dropped. voxel_m ≤ 0: every point is kept.

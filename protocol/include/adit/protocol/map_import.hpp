@@ -6,7 +6,10 @@
 // record formats 0-10, uncompressed). Anything else, or a truncated file,
 // throws adit::InputError naming the file and what is wrong.
 
+#include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,6 +23,26 @@ namespace adit::protocol {
 MapFormat map_format_of(const std::filesystem::path& file);
 
 std::vector<MapPoint> read_map(const std::filesystem::path& file);
+
+// A map file read a block of points at a time, so that a caller that keeps
+// only some of them (products::thin_to_voxels on a 14.7 M-point map) does not
+// hold the whole file nor every point: memory for one block (64 Ki points).
+// The header is read and checked against the file's size on construction.
+class MapFileReader {
+ public:
+  explicit MapFileReader(const std::filesystem::path& file);
+  ~MapFileReader();
+  MapFileReader(const MapFileReader&) = delete;
+  MapFileReader& operator=(const MapFileReader&) = delete;
+
+  std::uint64_t count() const;  // the points the header announces
+  // The next points in file order; empty at the end. Valid until the next call.
+  std::span<const MapPoint> next();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The same from the file's bytes; `name` is the file named in errors.
 std::vector<MapPoint> read_map(std::string_view bytes, MapFormat format, const std::string& name);
