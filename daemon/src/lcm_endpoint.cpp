@@ -106,6 +106,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
   Handoff<PoseSample> poses;
   Handoff<StatusSample> statuses;
   Handoff<TileUpdate> tiles;
+  std::atomic<std::uint64_t> tile_points_waiting{0};  // in `tiles`, not yet taken
   Handoff<GridPatchUpdate> grids;
   std::mutex events_mutex;  // control events are rare (button, end of flush)
   std::vector<protocol::SessionEvent> events;
@@ -245,6 +246,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       TileUpdate t;
       while (take_from(tiles, t)) {
         publisher.update(t.key, t.points, t.utime);
+        tile_points_waiting.fetch_sub(t.points.size(), std::memory_order_relaxed);
         // take_from gives the slot what `t` held: it must be nothing, or each
         // of the queue's slots would keep a whole tile's points (up to ~19 MB)
         // until the producer comes round to it again.
@@ -574,7 +576,10 @@ bool LcmEndpoint::publish_grid(GridPatchUpdate&& patch) {
 }
 
 bool LcmEndpoint::publish_tile(TileUpdate&& tile) {
+  const std::size_t points = tile.points.size();
+  impl_->tile_points_waiting.fetch_add(points, std::memory_order_relaxed);
   if (hand_over(impl_->tiles, tile)) return true;
+  impl_->tile_points_waiting.fetch_sub(points, std::memory_order_relaxed);
   ++impl_->counters.tiles_dropped;
   return false;
 }
@@ -601,6 +606,10 @@ void LcmEndpoint::stop_session() {
 }
 
 protocol::SessionState LcmEndpoint::state() const { return impl_->published_state.load(); }
+
+std::uint64_t LcmEndpoint::tile_points_waiting() const {
+  return impl_->tile_points_waiting.load(std::memory_order_relaxed);
+}
 
 const EndpointCounters& LcmEndpoint::counters() const { return impl_->counters; }
 

@@ -6,7 +6,9 @@
 #include "adit/daemon/mapping_stage.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 #include <malloc.h>
 
@@ -418,13 +420,21 @@ void MappingStage::flush_tiles(bool final) {
 
 // Tiles sent placed by an earlier correction go again when the latest moves
 // any of their points by more than kTileMoveM; at most kReplaceBudgetMs of
-// the mapping thread per flush (all at the session's end), so a closure on a
-// long session's map does not hold the scans back.
+// the mapping thread per flush and while the tile sink's backlog is short
+// (all at the session's end), so a closure on a long session's map neither
+// holds the scans back nor queues the whole map for the LCM thread.
 void MappingStage::replace_moved_tiles(bool all) {
   const std::int64_t deadline = monotonic_ns() + kReplaceBudgetMs * 1'000'000;
+  const std::int64_t wait_until = monotonic_ns() + kFinalBacklogWaitMs * 1'000'000;
   std::vector<slam::MapSample> tile_buffer;
   std::span<const slam::MapSample> samples;
-  while (!recheck_.empty() && (all || monotonic_ns() < deadline)) {
+  while (!recheck_.empty()) {
+    if (!all && (monotonic_ns() >= deadline || tile_backlog_full())) break;
+    // The final flush sends every moved tile, each once the backlog has drained.
+    while (all && tile_backlog_full() && monotonic_ns() < wait_until) {
+      thread_.beat.beat();
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
     const slam::TileCoord coord = recheck_.front();
     recheck_.pop_front();
     const auto sent = sent_with_.find(coord);

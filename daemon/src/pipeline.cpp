@@ -96,6 +96,7 @@ struct Pipeline::Impl {
     if (o.mapping) {
       mapping.emplace(c, odometry_config, *odometry.map_scans(), source.max_points_per_scan(), o.sinks.tile, stats, stop);
       mapping->publish_grid_to(o.sinks.grid);
+      mapping->limit_tile_backlog(o.sinks.tile_backlog);
       mapping->time_grid_into(&timings.grid_ms);
     }
     if (mapping && c.map.loop_closure) {

@@ -139,6 +139,10 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
   outputs.tile = [&endpoint_ptr](TileUpdate&& t) {
     if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_tile(std::move(t));
   };
+  outputs.tile_backlog = [&endpoint_ptr]() -> std::uint64_t {
+    const LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed);
+    return e != nullptr ? e->tile_points_waiting() : 0;
+  };
   outputs.grid = [&endpoint_ptr](GridPatchUpdate&& g) {
     if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_grid(std::move(g));
   };

@@ -278,6 +278,7 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
     options.sinks.pose = [pose = outputs_.pose](const slam::OdometryResult& r) { pose(pose_sample_of(r)); };
   }
   options.sinks.imu_pose = outputs_.imu_pose;
+  options.sinks.tile_backlog = outputs_.tile_backlog;
   if (outputs_.tile) {
     options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
       tile(TileUpdate{realtime_us(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -43,6 +45,7 @@ void fill_wall(MapSlot& slot, std::int64_t stamp_ns) {
 struct Sent {
   std::mutex mutex;
   std::map<slam::TileCoord, std::vector<std::vector<slam::MapSample>>> tiles;  // every send of each tile
+  std::map<slam::TileCoord, std::vector<std::chrono::steady_clock::time_point>> when;  // and when it went
   std::size_t count() {
     const std::lock_guard lock(mutex);
     std::size_t n = 0;
@@ -54,6 +57,7 @@ struct Sent {
 struct StageRun {
   Sent sent;
   PipelineStats stats;
+  std::function<std::uint64_t()> backlog;  // the tile sink's backlog (MappingStage::limit_tile_backlog)
   bool grid = false;  // with the live grid, its patches as last sent:
   std::mutex grid_mutex;
   std::map<slam::GridPatchCoord, std::vector<std::int8_t>> patches;
@@ -98,9 +102,11 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
       [&run](const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
         const std::lock_guard lock(run.sent.mutex);
         run.sent.tiles[coord].emplace_back(samples.begin(), samples.end());
+        run.sent.when[coord].push_back(std::chrono::steady_clock::now());
       },
       run.stats, stop);
   stage.follow_graph(&board);
+  stage.limit_tile_backlog(run.backlog);
   run.patch_cells = config.grid.patch_cells;
   run.resolution_m = static_cast<float>(config.grid.resolution_m);
   stage.publish_grid_to([&run](slam::GridPatchCoord c, std::int32_t, std::span<const std::int8_t> cells, std::size_t) {
@@ -149,6 +155,33 @@ TEST(MappingFollowsGraph, TilesSentBeforeACorrectionGoAgainMovedByIt) {
   }
   EXPECT_EQ(run.stats.tiles_moved_by_loops.load(), resent);
   EXPECT_GE(run.stats.tiles_checked_for_loops.load(), resent);
+}
+
+// While more than kTileBacklogPoints wait for the tile sink's consumer (the
+// LCM thread), tiles a correction moved are not sent again; new content still
+// goes. The final flush waits for the backlog to drain, then sends them all.
+TEST(MappingFollowsGraph, MovedTilesWaitWhileTheTileSinksBacklogIsLong) {
+  const std::vector<std::int64_t> stamps{1'000'000'000, 3'000'000'000};
+  const std::vector<Eigen::Isometry3d> odometry{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  const slam::CorrectionTrack track(stamps, std::vector{shifted(0, 0.5), shifted(0, 0.7)}, odometry);
+  const auto drained_at = std::chrono::steady_clock::now() + 1500ms;
+  std::atomic<int> asked{0};
+  StageRun run;
+  run.backlog = [&]() -> std::uint64_t {
+    ++asked;
+    return std::chrono::steady_clock::now() < drained_at ? MappingStage::kTileBacklogPoints + 1 : 0;
+  };
+  run_stage(run, track);
+  EXPECT_GT(asked.load(), 0);
+  ASSERT_FALSE(run.sent.tiles.empty());
+  for (const auto& [coord, sends] : run.sent.tiles) {
+    ASSERT_GE(sends.size(), 2U) << "a moved tile was never sent again";
+    const auto& when = run.sent.when[coord];
+    EXPECT_LT(when.front(), drained_at) << "the first content went while the backlog was long";
+    EXPECT_GE(when.back(), drained_at) << "a moved tile went again before the backlog drained";
+    EXPECT_NEAR(sends.back().front().position.y() - sends.front().front().position.y(), 0.5, 1e-5);
+  }
+  EXPECT_EQ(run.stats.tiles_moved_by_loops.load(), run.sent.tiles.size());
 }
 
 TEST(MappingFollowsGraph, ACorrectionBelowTheThresholdSendsNothingAgain) {

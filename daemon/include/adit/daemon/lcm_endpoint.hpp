@@ -178,6 +178,9 @@ class LcmEndpoint {
   bool publish_pose(const PoseSample& pose);
   bool publish_status(StatusSample&& status);
   bool publish_tile(TileUpdate&& tile);
+  // Any thread: points of tiles handed to publish_tile that the endpoint's
+  // thread has not taken yet.
+  std::uint64_t tile_points_waiting() const;
   bool publish_grid(GridPatchUpdate&& patch);
 
   // The daemon finished flushing the stopping session (STOPPING -> IDLE).

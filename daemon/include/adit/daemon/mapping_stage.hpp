@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -80,6 +81,15 @@ class MappingStage {
   void follow_graph(const CorrectionBoard* graph) { graph_ = graph; }
   static constexpr double kTileMoveM = 0.02;
   static constexpr std::int64_t kReplaceBudgetMs = 20;
+  // Before start(): how many points sent as tiles still wait for the tile
+  // sink's consumer. Tiles moved by a correction are sent again only while
+  // at most kTileBacklogPoints wait (the rest at a later flush), and the final
+  // flush waits for them to drain before each (kFinalBacklogWaitMs in all,
+  // then sends the rest): a correction that moved the whole 30-minute map
+  // queued 38 whole tiles, 229 MB, for the LCM thread (decision 065).
+  void limit_tile_backlog(std::function<std::uint64_t()> backlog) { tile_backlog_ = std::move(backlog); }
+  static constexpr std::uint64_t kTileBacklogPoints = 1'000'000;  // 40 MB as protocol::MapPoint
+  static constexpr std::int64_t kFinalBacklogWaitMs = 10'000;
   // Before start(): each mapped scan's pose, the points each tile confirms and
   // each keyframe also go to the session journal.
   void journal_to(JournalWriter* journal) { journal_ = journal; }
@@ -122,6 +132,7 @@ class MappingStage {
                          std::span<const slam::MapSample>& samples) const;
   void send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples);
   void replace_moved_tiles(bool all);
+  bool tile_backlog_full() const { return tile_backlog_ && tile_backlog_() > kTileBacklogPoints; }
   void flush_grid();
   void insert_into_grid(std::int64_t stamp_ns, const Eigen::Vector3f& origin);
   void journal_new_points();
@@ -167,6 +178,7 @@ class MappingStage {
   std::optional<slam::MapRefiner> refiner_;  // with map.refine
   std::optional<slam::LiveGrid> grid_;       // with grid.enabled
   PipelineSinks::GridSink grid_sink_;
+  std::function<std::uint64_t()> tile_backlog_;
   std::vector<double>* grid_ms_ = nullptr;
   std::vector<std::int8_t> grid_cells_;      // one patch, for the sink
   std::vector<Eigen::Vector3f> grid_points_; // a scan placed by the graph's correction, for the grid

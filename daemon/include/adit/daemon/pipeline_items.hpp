@@ -73,6 +73,10 @@ struct PipelineSinks {
   // The IMU source's thread, per IMU reading while LiDAR-inertial (imu_pose_feed.hpp): quick, never throws.
   ImuPoseSink imu_pose;
   TileSink tile;  // mapping thread: the whole current content of a tile that changed
+  // Any thread: points handed to `tile` that its consumer has not taken yet
+  // (the LCM thread's queue); the mapping thread holds back re-sends while
+  // they are many (MappingStage::kTileBacklogPoints). Empty: not measured.
+  std::function<std::uint64_t()> tile_backlog;
   GridSink grid;  // mapping thread, at most once per grid.publish_period_s per patch
 };
 

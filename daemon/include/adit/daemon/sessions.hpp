@@ -62,6 +62,7 @@ class Sessions {
     std::function<void(const PoseSample&)> pose;
     PipelineSinks::ImuPoseSink imu_pose;  // the IMU source's thread
     std::function<void(TileUpdate&&)> tile;
+    std::function<std::uint64_t()> tile_backlog;  // points handed to `tile` not yet taken (PipelineSinks)
     std::function<void(GridPatchUpdate&&)> grid;  // the mapping thread
     std::function<void(const std::string& session)> ended;
   };

@@ -62,7 +62,7 @@ struct SessionInputs {
 // read to its first point per voxel of `thin_voxel_m` (map_thinning.hpp):
 // < 0 the session's own map.voxel_m (none without config.yaml), 0 every point.
 // Only the kept points are held: the 30-minute drive's map file of 14.7 M
-// points was 1.1 GB of memory read whole, 0.15 GB thinned as read.
+// points was 1.1 GB of memory read whole, 0.17-0.25 GB thinned as read.
 SessionInputs read_session_inputs(const std::filesystem::path& session_dir, double thin_voxel_m = 0.0);
 
 // The session's map file: SESSION_DIR/map.las, .ply or .pcd (the first there).
