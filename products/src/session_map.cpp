@@ -104,6 +104,7 @@ SessionMap rays_from(const std::vector<protocol::MapPoint>& points, const slam::
 
 SessionInputs read_session_inputs(const std::filesystem::path& session_dir, double thin_voxel_m) {
   SessionInputs in;
+  double map_voxel_m = 0.0;  // config.yaml's map.voxel_m: aditd kept one point per such voxel (0: no config)
   const std::filesystem::path config_file = session_dir / "config.yaml";
   if (std::filesystem::exists(config_file)) {
     const config::Config c = config::load_config(config_file);
@@ -114,9 +115,9 @@ SessionInputs read_session_inputs(const std::filesystem::path& session_dir, doub
                                   Eigen::AngleAxisd(e.rpy_deg[0] * k, Eigen::Vector3d::UnitX()))
                                      .toRotationMatrix();
     in.body_to_sensor.translation() << e.xyz_m[0], e.xyz_m[1], e.xyz_m[2];
-    in.map_voxel_m = c.map.voxel_m;
+    map_voxel_m = c.map.voxel_m;
   }
-  in.thin_voxel_m = thin_voxel_m < 0.0 ? in.map_voxel_m : thin_voxel_m;
+  in.thin_voxel_m = thin_voxel_m < 0.0 ? map_voxel_m : thin_voxel_m;
   const std::filesystem::path map_file = map_file_of(session_dir);
   protocol::MapFileReader reader(map_file);
   in.read_points = reader.count();

@@ -34,8 +34,6 @@ T load(std::string_view bytes, std::size_t offset) {
 
 // One number of a point record: its binary type, where it lies in the record,
 // and value = raw * scale + add (LAS scales integer coordinates).
-enum class Scalar : std::uint8_t { i8, u8, i16, u16, i32, u32, i64, u64, f32, f64 };
-
 struct Field {
   Scalar type = Scalar::f32;
   std::size_t offset = 0;
@@ -43,30 +41,7 @@ struct Field {
   double add = 0.0;
 };
 
-template <typename T>
-double raw(const char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return static_cast<double>(v);
-}
-
-double value(const Field& f, const char* record) {
-  const char* p = record + f.offset;
-  double v = 0.0;
-  switch (f.type) {
-    case Scalar::i8: v = raw<std::int8_t>(p); break;
-    case Scalar::u8: v = raw<std::uint8_t>(p); break;
-    case Scalar::i16: v = raw<std::int16_t>(p); break;
-    case Scalar::u16: v = raw<std::uint16_t>(p); break;
-    case Scalar::i32: v = raw<std::int32_t>(p); break;
-    case Scalar::u32: v = raw<std::uint32_t>(p); break;
-    case Scalar::i64: v = raw<std::int64_t>(p); break;
-    case Scalar::u64: v = raw<std::uint64_t>(p); break;
-    case Scalar::f32: v = raw<float>(p); break;
-    case Scalar::f64: v = raw<double>(p); break;
-  }
-  return v * f.scale + f.add;
-}
+double value(const Field& f, const char* record) { return read_scalar(f.type, record + f.offset) * f.scale + f.add; }
 
 // Where a file's points lie and how each record is laid out.
 struct Layout {
@@ -103,18 +78,6 @@ void decode(const Layout& l, const char* records, std::uint64_t first, std::span
   }
 }
 
-std::optional<Scalar> ply_scalar(std::string_view t) {
-  if (t == "char" || t == "int8") return Scalar::i8;
-  if (t == "uchar" || t == "uint8") return Scalar::u8;
-  if (t == "short" || t == "int16") return Scalar::i16;
-  if (t == "ushort" || t == "uint16") return Scalar::u16;
-  if (t == "int" || t == "int32") return Scalar::i32;
-  if (t == "uint" || t == "uint32") return Scalar::u32;
-  if (t == "float" || t == "float32") return Scalar::f32;
-  if (t == "double" || t == "float64") return Scalar::f64;
-  return std::nullopt;
-}
-
 Layout ply_layout(std::string_view head, const std::string& name) {
   const PlyHeader header = parse_ply_header(head, name);
   if (header.elements.empty() || header.elements.front().name != "vertex")
@@ -133,7 +96,7 @@ Layout ply_layout(std::string_view head, const std::string& name) {
     if (p.name == "y") y = f;
     if (p.name == "z") z = f;
     if (p.name == "intensity") l.intensity = f;
-    l.record += ply_type_size(p.type);
+    l.record += scalar_size(*type);
   }
   if (!x || !y || !z) throw InputError(name, "element vertex", "needs properties x, y and z");
   l.x = *x;

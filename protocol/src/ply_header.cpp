@@ -1,6 +1,5 @@
 #include "adit/protocol/ply_header.hpp"
 
-#include <cstring>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -13,33 +12,26 @@ namespace {
 // A header longer than this is not one of ours nor a sane mesh.
 constexpr std::size_t kMaxHeader = 64 * 1024;
 
-template <typename T>
-double load(const char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);  // the host is little-endian, as the files
-  return static_cast<double>(v);
-}
-
 }  // namespace
 
-std::size_t ply_type_size(std::string_view t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
+std::optional<Scalar> ply_scalar(std::string_view t) {
+  if (t == "char" || t == "int8") return Scalar::i8;
+  if (t == "uchar" || t == "uint8") return Scalar::u8;
+  if (t == "short" || t == "int16") return Scalar::i16;
+  if (t == "ushort" || t == "uint16") return Scalar::u16;
+  if (t == "int" || t == "int32") return Scalar::i32;
+  if (t == "uint" || t == "uint32") return Scalar::u32;
+  if (t == "float" || t == "float32") return Scalar::f32;
+  if (t == "double" || t == "float64") return Scalar::f64;
+  return std::nullopt;
 }
 
-double read_ply_scalar(std::string_view t, const char* p) {
-  if (t == "char" || t == "int8") return load<std::int8_t>(p);
-  if (t == "uchar" || t == "uint8") return load<std::uint8_t>(p);
-  if (t == "short" || t == "int16") return load<std::int16_t>(p);
-  if (t == "ushort" || t == "uint16") return load<std::uint16_t>(p);
-  if (t == "int" || t == "int32") return load<std::int32_t>(p);
-  if (t == "uint" || t == "uint32") return load<std::uint32_t>(p);
-  if (t == "float" || t == "float32") return load<float>(p);
-  return load<double>(p);
+std::size_t ply_type_size(std::string_view t) {
+  const std::optional<Scalar> s = ply_scalar(t);
+  return s ? scalar_size(*s) : 0;
 }
+
+double read_ply_scalar(std::string_view t, const char* p) { return read_scalar(ply_scalar(t).value_or(Scalar::f64), p); }
 
 PlyHeader parse_ply_header(std::string_view bytes, const std::string& file) {
   const std::size_t end = bytes.substr(0, kMaxHeader).find("end_header\n");

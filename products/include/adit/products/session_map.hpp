@@ -51,7 +51,6 @@ struct SessionInputs {
   std::vector<protocol::MapPoint> points;
   slam::Trajectory body_poses;
   Eigen::Isometry3d body_to_sensor = Eigen::Isometry3d::Identity();
-  double map_voxel_m = 0.0;     // config.yaml's map.voxel_m: aditd kept one point per such voxel (0: no config)
   std::size_t read_points = 0;  // in the map file
   double thin_voxel_m = 0.0;    // the voxel `points` were thinned to (0: not thinned)
   std::size_t thinned = 0;      // points of the file left out by the thinning

@@ -6,9 +6,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "adit/protocol/binary_scalar.hpp"
 
 namespace adit::protocol {
 
@@ -31,7 +34,10 @@ struct PlyHeader {
 
 PlyHeader parse_ply_header(std::string_view bytes, const std::string& file);
 
-// Bytes of a PLY scalar type (char/int8 ... double/float64); 0 when unknown.
+// The binary type of a PLY scalar type name (char/int8 ... double/float64); nullopt when unknown.
+std::optional<Scalar> ply_scalar(std::string_view type);
+
+// Bytes of a PLY scalar type; 0 when unknown.
 std::size_t ply_type_size(std::string_view type);
 
 // The little-endian scalar of PLY type `type` at p, as a double.
