@@ -35,7 +35,8 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   VoxelDownsampler downsampler(points.size());
   downsampler.downsample(points, config_.points_voxel_m, kept);
   downsampler.downsample(points, config_.query_voxel_m, query);
-  descriptors_.push_back(make_scan_context(points, config_.descriptor));
+  ScanContext descriptor = make_scan_context(points, config_.descriptor);
+  ring_keys_.push_back(descriptor.ring_key);
   if (k == 0) {
     graph_.nodes.push_back(odometry_pose);
     path_m_.push_back(0.0);
@@ -55,12 +56,21 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   }
   odometry_.push_back(odometry_pose);
   stamps_.push_back(stamp_ns);
-  scans_.add(std::move(kept));
+  scans_.add(std::move(kept), descriptor.bins);
   query_points_ = std::move(query);
+  query_descriptor_ = std::move(descriptor);
   ++stats_.keyframes;
 
-  const KeyframeIndexView view{descriptors_, graph_.nodes, path_m_, variance_};
-  const std::vector<LoopCandidate> candidates = find_loop_candidates(k, view, config_.search);
+  const KeyframeIndexView view{ring_keys_, graph_.nodes, path_m_, variance_};
+  // An old keyframe whose file cannot be read is passed over, as its scan would be.
+  const auto read_descriptor = [this, k](std::size_t j, Eigen::MatrixXf& bins) {
+    if (scans_.read_descriptor(j, bins)) return true;
+    ++stats_.rejected_unreadable;
+    events_.push_back({k, j, 1.0, "keyframe_unreadable", 0.0, 0.0, 0.0});
+    return false;
+  };
+  const std::vector<LoopCandidate> candidates =
+      find_loop_candidates(k, query_descriptor_, view, read_descriptor, config_.search);
   stats_.candidates += candidates.size();
   const double search_s = 1e-9 * static_cast<double>(monotonic_ns() - search_start_ns);
   stats_.search_s_total += search_s;
@@ -108,8 +118,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
   std::vector<Eigen::Isometry3d> guesses{graph_guess};
   if (std::abs(std::remainder(c.yaw_rad - yaw_of(graph_guess), 2.0 * M_PI)) > 0.05)
     guesses.push_back(yawed(graph_guess, c.yaw_rad));
-  const ScanContextMatch m = compare(descriptors_[c.query], descriptors_[c.candidate]);
-  if (m.alternative_distance <= config_.search.max_descriptor_distance)
+  if (c.alternative_distance <= config_.search.max_descriptor_distance)
     guesses.push_back(yawed(graph_guess, c.alternative_yaw_rad));
   const LoopVerification v = verify_loop(query_points_, submap, guesses, config_.verification);
   stats_.set_aside_readings += static_cast<std::size_t>(v.set_aside);
@@ -134,12 +143,17 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
                   kind;
   if (decision == GuardDecision::rejected) ++stats_.rejected_inconsistent;
   events_.push_back(event);
-  // The information of each loop the guard let in (waiting ones kept theirs).
-  if (decision != GuardDecision::rejected) information_.push_back({c.query, c.candidate, v.information});
+  // A waiting loop keeps its information until a witness lets it in.
+  if (decision == GuardDecision::waiting) information_.push_back({c.query, c.candidate, v.information});
   for (const LoopConstraint& l : newly) {
-    Matrix6d information = v.information;
-    for (const PendingInformation& p : information_)
-      if (p.query == l.to && p.candidate == l.from) information = p.information;
+    Matrix6d information = v.information;  // this candidate's loop
+    const auto waited = std::find_if(information_.begin(), information_.end(), [&](const PendingInformation& p) {
+      return p.query == l.to && p.candidate == l.from;
+    });
+    if (waited != information_.end()) {  // a waiting one it confirmed
+      information = waited->information;
+      information_.erase(waited);
+    }
     graph_.edges.push_back({l.from, l.to, l.measurement, information, EdgeKind::loop});
     ++stats_.accepted;
     ++unsolved_;

@@ -6,10 +6,11 @@
 
 namespace adit::slam {
 
-std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const KeyframeIndexView& k,
+std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const ScanContext& query_descriptor,
+                                                const KeyframeIndexView& k, const DescriptorReader& read_descriptor,
                                                 const PlaceRecognitionConfig& config) {
   std::vector<LoopCandidate> out;
-  if (query >= k.descriptors.size() || query >= k.poses.size() || query >= k.path_m.size() ||
+  if (query >= k.ring_keys.size() || query >= k.poses.size() || query >= k.path_m.size() ||
       query >= k.position_variance.size())
     return out;
   const Eigen::Vector3d here = k.poses[query].translation();
@@ -25,15 +26,18 @@ std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const Keyfram
     const double radius = config.base_radius_m + config.gate_sigmas * std::sqrt(variance);
     const double gap = (k.poses[j].translation() - here).norm();
     if (gap > radius) continue;
-    gated.push_back({j, ring_key_distance(k.descriptors[query], k.descriptors[j]), gap});
+    gated.push_back({j, (query_descriptor.ring_key - k.ring_keys[j]).norm(), gap});
   }
   const std::size_t keep = std::min(gated.size(), static_cast<std::size_t>(std::max(0, config.ring_key_candidates)));
   std::partial_sort(gated.begin(), gated.begin() + static_cast<std::ptrdiff_t>(keep), gated.end(),
                     [](const Gated& a, const Gated& b) { return a.ring_distance < b.ring_distance; });
+  ScanContext old;  // compare() reads the bins only
   for (std::size_t i = 0; i < keep; ++i) {
-    const ScanContextMatch m = compare(k.descriptors[query], k.descriptors[gated[i].index]);
+    if (!read_descriptor(gated[i].index, old.bins)) continue;
+    const ScanContextMatch m = compare(query_descriptor, old);
     if (m.distance > config.max_descriptor_distance) continue;
-    out.push_back({query, gated[i].index, m.distance, m.yaw_rad, m.alternative_yaw_rad, gated[i].gap});
+    out.push_back({query, gated[i].index, m.distance, m.yaw_rad, m.alternative_yaw_rad, m.alternative_distance,
+                   gated[i].gap});
   }
   std::sort(out.begin(), out.end(),
             [](const LoopCandidate& a, const LoopCandidate& b) { return a.descriptor_distance < b.descriptor_distance; });

@@ -52,6 +52,38 @@ TEST(KeyframeScanStore, OlderScansGoToDiskAndComeBackTheSame) {
   EXPECT_EQ(store.read_errors(), 0U);
 }
 
+// A keyframe's descriptor goes to disk with its scan and comes back the same;
+// a descriptor read from a damaged file is refused like its scan.
+TEST(KeyframeScanStore, DescriptorsGoToDiskWithTheirScans) {
+  const Folder folder("adit_test_kfs_descriptor");
+  KeyframeScanStore store(2);
+  store.spill_to(folder.path);
+  const auto bins = [](int k) { return Eigen::MatrixXf::Constant(20, 60, static_cast<float>(k) + 0.5F); };
+  for (int k = 0; k < 6; ++k) store.add(scan(k), bins(k));
+  EXPECT_EQ(store.spilled(), 4U);
+  EXPECT_LE(store.bytes_in_ram(), 2 * (512 * sizeof(Eigen::Vector3f) + 20 * 60 * sizeof(float)));
+  Eigen::MatrixXf out;
+  std::vector<Eigen::Vector3f> points;
+  for (int k = 0; k < 6; ++k) {
+    ASSERT_TRUE(store.read_descriptor(static_cast<std::size_t>(k), out)) << store.last_error();
+    EXPECT_EQ(out, bins(k)) << k;
+    ASSERT_TRUE(store.read(static_cast<std::size_t>(k), points)) << store.last_error();
+    EXPECT_EQ(points, scan(k)) << k;
+  }
+  {  // a flipped byte amid the bins
+    std::fstream f(store.file_of(1), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(40);
+    f.put('\x5a');
+  }
+  EXPECT_FALSE(store.read_descriptor(1, out));
+  EXPECT_NE(store.last_error().find(store.file_of(1).string()), std::string::npos);
+  EXPECT_NE(store.last_error().find("hash"), std::string::npos);
+  EXPECT_EQ(out.size(), 0);
+  EXPECT_FALSE(store.read(1, points));
+  EXPECT_EQ(store.read_errors(), 2U);
+  EXPECT_FALSE(store.read_descriptor(6, out));  // not stored
+}
+
 TEST(KeyframeScanStore, ADamagedOrMissingFileIsRefusedNamingIt) {
   const Folder folder("adit_test_kfs_damaged");
   KeyframeScanStore store(1);
@@ -88,17 +120,25 @@ TEST(KeyframeScanStore, ACountTheFileCannotHoldIsRefusedBeforeItsRamIsTaken) {
   store.spill_to(folder.path);
   store.add(scan(0));
   ASSERT_EQ(store.spilled(), 1U);
-  {
+  const auto write = [&](std::uint64_t n, std::uint32_t rows, std::uint32_t cols) {
     std::ofstream f(store.file_of(0), std::ios::binary | std::ios::trunc);
-    const std::uint64_t n = std::uint64_t{1} << 25, hash = 0;
-    f.write("ADITKFS1", 8);
+    const std::uint64_t hash = 0;
+    f.write("ADITKFS2", 8);
     f.write(reinterpret_cast<const char*>(&n), sizeof n);
+    f.write(reinterpret_cast<const char*>(&rows), sizeof rows);
+    f.write(reinterpret_cast<const char*>(&cols), sizeof cols);
     f.write(reinterpret_cast<const char*>(&hash), sizeof hash);
-  }
+  };
+  write(std::uint64_t{1} << 25, 0, 0);
   std::vector<Eigen::Vector3f> out;
   EXPECT_FALSE(store.read(0, out));
   EXPECT_NE(store.last_error().find("short"), std::string::npos) << store.last_error();
   EXPECT_LT(out.capacity(), 1000U);
+  write(0, 1U << 12, 1U << 12);  // a descriptor of 2^24 bins (64 MB)
+  Eigen::MatrixXf bins;
+  EXPECT_FALSE(store.read_descriptor(0, bins));
+  EXPECT_NE(store.last_error().find("short"), std::string::npos) << store.last_error();
+  EXPECT_EQ(bins.size(), 0);
 }
 
 TEST(KeyframeScanStore, AFolderThatCannotBeWrittenKeepsTheScansInRam) {

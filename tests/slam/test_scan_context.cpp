@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 
 #include "adit/slam/place_recognition.hpp"
 #include "adit/slam/scan_context.hpp"
@@ -65,6 +66,22 @@ TEST(ScanContext, AnotherStretchIsFarther) {
   EXPECT_LT(compare(same, a).distance + 0.05, compare(other, a).distance);
 }
 
+// The search over keyframes with these descriptors, all readable unless `unreadable`.
+std::vector<LoopCandidate> search(std::size_t query, const std::vector<ScanContext>& descriptors,
+                                  const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& path,
+                                  const std::vector<double>& variance, std::size_t unreadable = SIZE_MAX,
+                                  std::size_t* reads = nullptr) {
+  std::vector<Eigen::VectorXf> ring_keys;
+  for (const ScanContext& d : descriptors) ring_keys.push_back(d.ring_key);
+  const DescriptorReader read = [&](std::size_t k, Eigen::MatrixXf& bins) {
+    if (reads != nullptr) ++*reads;
+    if (k == unreadable) return false;
+    bins = descriptors[k].bins;
+    return true;
+  };
+  return find_loop_candidates(query, descriptors[query], {ring_keys, poses, path, variance}, read);
+}
+
 // Candidates are sought only where the graph's uncertainty lets the query
 // be: the same scan, far from the query by the graph, is not a candidate
 // until the accumulated variance says the graph could be that wrong.
@@ -76,10 +93,29 @@ TEST(PlaceRecognition, TheGateFollowsTheGraphsUncertainty) {
   std::vector<double> path{0.0, 40.0, 100.0};
   std::vector<double> tight{0.0, 0.1, 0.2};
   std::vector<double> loose{0.0, 5.0, 16.0};  // σ 4 m per axis between 0 and 2
-  EXPECT_TRUE(find_loop_candidates(2, {descriptors, poses, path, tight}).empty());
-  const std::vector<LoopCandidate> found = find_loop_candidates(2, {descriptors, poses, path, loose});
+  EXPECT_TRUE(search(2, descriptors, poses, path, tight).empty());
+  const std::vector<LoopCandidate> found = search(2, descriptors, poses, path, loose);
   ASSERT_FALSE(found.empty());
   EXPECT_EQ(found.front().candidate, 0U);  // by appearance: the other place is within the gate too
+}
+
+// Old keyframes' full descriptors are read only for those their ring keys
+// keep, and one that cannot be read is passed over.
+TEST(PlaceRecognition, OnlyTheKeptFewAreReadAndAnUnreadableOneIsPassedOver) {
+  const ScanContext place = make_scan_context(test::scan_of(ring_world(), pose_at(6.0, 0.0, 0.0), 8));
+  std::vector<ScanContext> descriptors(30, place);
+  std::vector<Eigen::Isometry3d> poses(30, pose_at(6.0, 0.0, 0.0));
+  std::vector<double> path, variance(30, 0.0);
+  for (int k = 0; k < 30; ++k) path.push_back(40.0 * k);
+  std::size_t reads = 0;
+  const std::vector<LoopCandidate> all = search(29, descriptors, poses, path, variance, SIZE_MAX, &reads);
+  EXPECT_EQ(reads, 10U);  // PlaceRecognitionConfig::ring_key_candidates of the 29 gated
+  ASSERT_EQ(all.size(), 3U);
+  EXPECT_LT(all.front().descriptor_distance, 1e-6);  // the same place
+  const std::size_t best = all.front().candidate;
+  const std::vector<LoopCandidate> without = search(29, descriptors, poses, path, variance, best);
+  ASSERT_EQ(without.size(), 3U);
+  for (const LoopCandidate& c : without) EXPECT_NE(c.candidate, best);
 }
 
 TEST(PlaceRecognition, NeighboursAlongThePathAreNotRevisits) {
@@ -88,7 +124,7 @@ TEST(PlaceRecognition, NeighboursAlongThePathAreNotRevisits) {
   std::vector<Eigen::Isometry3d> poses{pose_at(6, 0, 0), pose_at(6.5, 0, 0)};
   std::vector<double> path{0.0, 10.0};
   std::vector<double> variance{0.0, 0.01};
-  EXPECT_TRUE(find_loop_candidates(1, {descriptors, poses, path, variance}).empty());
+  EXPECT_TRUE(search(1, descriptors, poses, path, variance).empty());
 }
 
 }  // namespace

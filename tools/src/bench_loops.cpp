@@ -7,7 +7,8 @@
 //    pose, 0.2 m scan: what the loops thread receives) are kept, and the
 //    odometry's time per scan is the baseline.
 // 2. The keyframes go through slam::LoopCloser on this thread, as aditd's loops
-//    thread feeds it (gravity prior with an accelerometer). Per keyframe: the
+//    thread feeds it (gravity prior with an accelerometer; keyframes beyond the
+//    closer's window go to files in a temporary folder). Per keyframe: the
 //    descriptor and candidate search; per candidate: the verification (the
 //    closer's own clocks, LoopClosureStats; a keyframe with several candidates
 //    gives each their mean); per accepted batch: the graph's optimisation.
@@ -38,6 +39,7 @@
 #include "adit/slam/pose_graph.hpp"
 #include "adit/slam/pose_graph_solver.hpp"
 #include "pipeline_run.hpp"
+#include "temporary_folder.hpp"
 
 namespace adit::tools {
 namespace {
@@ -145,6 +147,8 @@ int bench_loops(const Options& o) {
   // 2. The loop closer, keyframe by keyframe, as aditd's loops thread feeds it.
   const slam::LoopClosureConfig loops = daemon::loop_closure_config(config);
   slam::LoopCloser closer(loops);
+  const TemporaryFolder spill("adit-bench-loops-");  // older keyframes go to disk, as aditd's do
+  closer.spill_scans_to(spill.path());
   Series search, verification, optimisation, per_keyframe_cpu;
   std::vector<double> iterations;  // of each optimisation in the session
   const std::size_t count = o.max_keyframes > 0 ? std::min(o.max_keyframes, keyframes.size()) : keyframes.size();

@@ -2,8 +2,6 @@
 // scans, as fast as possible or at a chosen pace; writes the trajectory and
 // prints the pipeline's figures (counters, odometry time, latency, memory).
 
-#include <stdlib.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +15,7 @@
 #include "commands.hpp"
 #include "pipeline_run.hpp"
 #include "replay_session.hpp"
+#include "temporary_folder.hpp"
 
 namespace adit::tools {
 namespace {
@@ -32,26 +31,6 @@ struct ReplayOptions {
   std::string memory_csv;   // empty: none
   std::string session;      // a stored session to map again (replay_session.hpp)
   std::string out_dir;      // where its new session goes
-};
-
-// A fresh folder under the system's temporary directory, removed when done.
-class TemporaryFolder {
- public:
-  TemporaryFolder() {
-    std::string name = (std::filesystem::temp_directory_path() / "adit-replay-tiles-XXXXXX").string();
-    if (::mkdtemp(name.data()) == nullptr) throw InputError(name, "--session-dir", "cannot create a temporary folder");
-    path_ = name;
-  }
-  ~TemporaryFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TemporaryFolder(const TemporaryFolder&) = delete;
-  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
 };
 
 const std::string& source_of(const config::Config& c) {
@@ -72,7 +51,7 @@ int replay(const ReplayOptions& o) {
   options.replay_speed = o.realtime ? 1.0 : o.speed;
   daemon::Pipeline pipeline(config, options);
   std::optional<TemporaryFolder> temporary;
-  if (o.session_dir.empty()) temporary.emplace();
+  if (o.session_dir.empty()) temporary.emplace("adit-replay-tiles-");
   const std::filesystem::path dir = temporary ? temporary->path() : std::filesystem::absolute(o.session_dir);
   daemon::SessionFiles files;
   files.tiles_dir = dir / "tiles";

@@ -50,8 +50,8 @@ struct LoopClosureConfig {
   PoseGraphSolverConfig solver;
   OdometryNoise odometry;
   int submap_keyframes = 5;          // each side of the candidate go into its submap
-  // Keyframe scans kept in RAM (the newest); older ones go to the folder
-  // given to spill_scans_to() (none: all stay in RAM).
+  // Keyframe scans and descriptors kept in RAM (the newest); older ones go to
+  // the folder given to spill_scans_to() (none: all stay in RAM).
   std::size_t scans_in_ram = 200;
   float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
@@ -90,7 +90,7 @@ struct LoopClosureStats {
   std::size_t partial = 0;                // of which partial (one direction unobserved)
   std::size_t accepted = 0;               // in the graph
   std::size_t rejected_verification = 0;  // failed registration (overlap, fit, conditioning, ambiguity)
-  std::size_t rejected_unreadable = 0;    // the candidate's scan could not be read back (KeyframeScanStore)
+  std::size_t rejected_unreadable = 0;    // a candidate's scan or descriptor could not be read back (KeyframeScanStore)
   std::size_t set_aside_readings = 0;     // passing readings outside the heading gate, set aside
   std::size_t rejected_inconsistent = 0;  // failed the guard
   std::size_t optimizations = 0;
@@ -133,8 +133,8 @@ class LoopCloser {
   const PoseGraph& graph() const { return graph_; }
   // A last optimisation of the whole graph (session end).
   void refine();
-  // Before the first keyframe: keyframe scans beyond config.scans_in_ram go
-  // to `folder` (slam/keyframe_scan_store.hpp).
+  // Before the first keyframe: keyframe scans and descriptors beyond
+  // config.scans_in_ram go to `folder` (slam/keyframe_scan_store.hpp).
   void spill_scans_to(const std::filesystem::path& folder) { scans_.spill_to(folder); }
   const KeyframeScanStore& scans() const { return scans_; }
 
@@ -147,10 +147,11 @@ class LoopCloser {
   LoopGuard guard_;
   std::vector<Eigen::Isometry3d> odometry_;
   std::vector<std::int64_t> stamps_;
-  KeyframeScanStore scans_;                  // each keyframe's scan at points_voxel_m (submaps)
+  KeyframeScanStore scans_;  // each keyframe's scan at points_voxel_m (submaps) and its descriptor's bins
   std::vector<Eigen::Vector3f> query_points_;  // the newest keyframe's at query_voxel_m: only it is ever a query
+  ScanContext query_descriptor_;               // the newest keyframe's
   std::vector<Eigen::Vector3f> neighbour_;     // a submap keyframe's scan, read back
-  std::vector<ScanContext> descriptors_;
+  std::vector<Eigen::VectorXf> ring_keys_;     // every keyframe's: the search's first stage
   std::vector<double> path_m_;
   std::vector<double> variance_;
   LoopClosureStats stats_;
@@ -159,7 +160,7 @@ class LoopCloser {
     std::size_t query, candidate;
     Matrix6d information;
   };
-  std::vector<PendingInformation> information_;  // of the loops that passed verification
+  std::vector<PendingInformation> information_;  // of the verified loops waiting in the guard
   std::size_t unsolved_ = 0;                     // loops added since the last optimisation
   std::int64_t last_optimization_stamp_ns_ = 0;  // the keyframe stamp it ran at
 };

@@ -16,6 +16,7 @@
 // so the keyframes just behind are not "revisits".
 
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -40,18 +41,27 @@ struct LoopCandidate {
   double descriptor_distance = 1.0;
   double yaw_rad = 0.0;                // R_candidate⁻¹·R_query about z, from the best column shift
   double alternative_yaw_rad = 0.0;    // the best shift ≥ 90° away (a symmetric tunnel's other reading)
+  double alternative_distance = 1.0;   // its descriptor distance
   double gap_m = 0.0;                  // between the two estimated positions
 };
 
 // What the search sees of each keyframe up to the query (index = keyframe).
+// The full descriptors of old keyframes are read only for the few their ring
+// keys keep (they may lie on disk: slam/keyframe_scan_store.hpp).
 struct KeyframeIndexView {
-  std::span<const ScanContext> descriptors;
+  std::span<const Eigen::VectorXf> ring_keys;   // ScanContext::ring_key
   std::span<const Eigen::Isometry3d> poses;     // the graph's current estimate
   std::span<const double> path_m;               // path length from the first keyframe
   std::span<const double> position_variance;    // accumulated odometry σ² per axis from the first keyframe
 };
 
-std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const KeyframeIndexView& keyframes,
+// Fills `bins` with keyframe k's ScanContext::bins; false when they cannot be
+// had (that keyframe is passed over; the reader says why).
+using DescriptorReader = std::function<bool(std::size_t k, Eigen::MatrixXf& bins)>;
+
+std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const ScanContext& query_descriptor,
+                                                const KeyframeIndexView& keyframes,
+                                                const DescriptorReader& read_descriptor,
                                                 const PlaceRecognitionConfig& config = {});
 
 }  // namespace adit::slam
