@@ -40,8 +40,9 @@ slam::LoopClosureConfig loop_closure_config(const config::Config& config, slam::
 }
 
 LoopClosureStage::LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
-                                   const slam::LoopClosureConfig& loops)
+                                   const slam::LoopClosureConfig& loops, bool live)
     : stats_(stats),
+      live_source_(live),
       thread_("loops", config::ThreadSettings{}, stop),  // SCHED_OTHER whatever the other stages use, never FIFO
       closer_(loop_closure_config(config, loops)) {}
 
@@ -58,6 +59,7 @@ void LoopClosureStage::loop() {
   // Linux: a thread's nice value is per thread (setpriority on its tid).
   if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kNice) != 0)
     log::warn("loops: could not lower the thread's priority");
+  bool catching_up = false;
   while (!thread_.stopping()) {
     thread_.beat.beat();
     std::optional<KeyframeItem> k = keyframes_.pop(std::chrono::milliseconds(200));
@@ -67,7 +69,16 @@ void LoopClosureStage::loop() {
     }
     const std::size_t accepted_before = closer_.stats().accepted;
     const std::size_t file_errors_before = closer_.scans().read_errors() + closer_.scans().write_errors();
-    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points)) {
+    const std::size_t waiting = keyframes_.depth();
+    const bool search = !live_source_ || waiting <= kMaxKeyframesBehind;
+    if (!search && !catching_up)
+      log::warn("loops: {} keyframes waiting: adding them without a loop search until {} or fewer wait", waiting,
+                kMaxKeyframesBehind);
+    if (search && catching_up)
+      log::info("loops: caught up at keyframe {} ({} keyframes so far added without a search)", closer_.stats().keyframes,
+                closer_.stats().keyframes_not_searched);
+    catching_up = !search;
+    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points, search)) {
       const Eigen::Isometry3d c = closer_.correction();
       log::info("loops: keyframe {}: {} loop(s) accepted, graph optimised in {:.3f} s; correction {:.3f} m",
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,

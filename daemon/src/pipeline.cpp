@@ -100,7 +100,7 @@ struct Pipeline::Impl {
       mapping->time_grid_into(&timings.grid_ms);
     }
     if (mapping && c.map.loop_closure) {
-      loops.emplace(c, stats, stop);
+      loops.emplace(c, stats, stop, slam::LoopClosureConfig{}, source.overflow() == Overflow::drop_oldest);
       mapping->feed_loops(&loops->input());
       // The live tiles follow the graph as the exported map does (docs/LOOPS.md, "Live tiles").
       if (c.map.loops_move_map) mapping->follow_graph(&loops->live());

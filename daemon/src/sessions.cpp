@@ -150,6 +150,7 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
   return {{"enabled", true},
           {"map_moved", moved},
           {"keyframes", s.keyframes},
+          {"keyframes_not_searched", s.keyframes_not_searched},
           {"candidates", s.candidates},
           {"verified", s.verified},
           {"accepted", s.accepted},

@@ -26,7 +26,7 @@ LoopCloser::LoopCloser(const LoopClosureConfig& config)
 }
 
 bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                              std::span<const Eigen::Vector3f> points) {
+                              std::span<const Eigen::Vector3f> points, bool search) {
   const std::size_t k = graph_.nodes.size();
   const std::int64_t search_start_ns = monotonic_ns();
   std::vector<Eigen::Vector3f> kept, query;
@@ -60,6 +60,10 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   query_points_ = std::move(query);
   query_descriptor_ = std::move(descriptor);
   ++stats_.keyframes;
+  if (!search) {
+    ++stats_.keyframes_not_searched;
+    return false;
+  }
 
   const KeyframeIndexView view{ring_keys_, graph_.nodes, path_m_, variance_};
   // An old keyframe whose file cannot be read is passed over, as its scan would be.

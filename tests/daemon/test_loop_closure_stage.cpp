@@ -67,6 +67,32 @@ TEST(LoopClosureStage, ClosesLoopsInTheBackgroundAndPublishesTheCorrection) {
   for (double ms : push_ms) EXPECT_LT(ms, 50.0);  // a push never waits for the graph
 }
 
+// 40 keyframes already waiting when the thread starts (a core too slow for the
+// graph): behind a live source the stage adds them without a loop search until
+// no more than kMaxKeyframesBehind wait, then searches again; a replay
+// searches every one. Every keyframe is in the graph either way.
+TEST(LoopClosureStage, BehindALiveSourceKeyframesJoinUnsearchedUntilTheQueueIsShort) {
+  const std::vector<Eigen::Vector3f> world = slam::test::ring_corridor(kSide, 30, 23, 20.0F);
+  const auto run = [&](bool live) {
+    config::Config config;
+    PipelineStats stats;
+    std::atomic<bool> stop{false};
+    LoopClosureStage stage(config, stats, stop, slam::LoopClosureConfig{}, live);
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Isometry3d pose = slam::test::ring_pose(kSide, 2.0 * k);
+      stage.input().push({static_cast<std::int64_t>(k) * 1'000'000'000, pose,
+                          slam::test::scan_of(world, pose, 700 + static_cast<unsigned>(k))});
+    }
+    stage.start();
+    stage.finish();
+    EXPECT_EQ(stage.closer().poses().size(), 40U);
+    return stage.closer().stats();
+  };
+  const slam::LoopClosureStats live = run(true);
+  EXPECT_EQ(live.keyframes_not_searched, 40 - 1 - kMaxKeyframesBehind);  // until 10 wait behind the one in hand
+  EXPECT_EQ(run(false).keyframes_not_searched, 0U);
+}
+
 // Stopped at once (request_stop): the thread ends without draining or refining.
 TEST(LoopClosureStage, StopsAtOnce) {
   config::Config config;

@@ -1,8 +1,10 @@
 #pragma once
-// Keyframes from the mapping thread to the loop-closure thread. Unbounded
+// Keyframes from the mapping thread to the loop-closure thread. No capacity
 // and under a mutex: a keyframe comes about once a metre, the graph needs
 // every one (a dropped keyframe would cut the odometry chain), and neither
-// side is the odometry thread. push() never waits for the consumer.
+// side is the odometry thread. push() never waits for the consumer. Behind a
+// live source the consumer keeps it short by skipping loop searches while
+// it is long (loop_closure_stage.hpp).
 
 #include <condition_variable>
 #include <cstdint>

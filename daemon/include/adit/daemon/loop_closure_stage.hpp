@@ -11,6 +11,11 @@
 // thread only pushes into the queue; the odometry never sees it. At the end
 // it drains the queue and, with `refine_at_end`, optimises the whole graph
 // once more before the exports.
+// Behind a live source, with more than kMaxKeyframesBehind keyframes waiting,
+// keyframes join the graph without a loop search (LoopCloser::add_keyframe's
+// `search`) until the queue is short again: the queue and the loops' delay
+// stay bounded on a core too slow for the graph. A replay searches every
+// keyframe, so that it gives the same graph on any machine.
 
 #include <atomic>
 #include <filesystem>
@@ -27,14 +32,17 @@
 
 namespace adit::daemon {
 
+inline constexpr std::size_t kMaxKeyframesBehind = 10;  // about 10 s of a walk, 2 s of a fast drone
+
 // The loop closer's settings for `config`: `loops` with, given an IMU, the
 // gravity priors and the tilt walk (the stage's; `adit bench loops` uses it too).
 slam::LoopClosureConfig loop_closure_config(const config::Config& config, slam::LoopClosureConfig loops = {});
 
 class LoopClosureStage {
  public:
+  // `live`: the keyframes come from a live source (see above).
   LoopClosureStage(const config::Config& config, PipelineStats& stats, const std::atomic<bool>& stop,
-                   const slam::LoopClosureConfig& loops = {});
+                   const slam::LoopClosureConfig& loops = {}, bool live = false);
 
   KeyframeQueue& input() { return keyframes_; }
   // Before start(): keyframe scans beyond the closer's window go to `folder`.
@@ -57,6 +65,7 @@ class LoopClosureStage {
   void update_stats();
 
   PipelineStats& stats_;
+  const bool live_source_;
   StageThread thread_;
   KeyframeQueue keyframes_;
   slam::LoopCloser closer_;

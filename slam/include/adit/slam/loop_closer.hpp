@@ -85,6 +85,7 @@ struct LoopEvent {
 
 struct LoopClosureStats {
   std::size_t keyframes = 0;
+  std::size_t keyframes_not_searched = 0;  // added with search = false (the caller was behind)
   std::size_t candidates = 0;             // found by place recognition
   std::size_t verified = 0;               // passed registration
   std::size_t partial = 0;                // of which partial (one direction unobserved)
@@ -113,8 +114,11 @@ class LoopCloser {
   // Adds a keyframe (`points` in its body frame) and closes what loops it
   // can. Returns true when the graph was optimised (the poses moved): when
   // loops wait and config.optimize_every_s has passed since the last time.
+  // With `search` false the keyframe joins the graph and the store (a later
+  // one may find it) but seeks no loop and no optimisation runs: a caller
+  // that has fallen behind catches up at a few milliseconds a keyframe.
   bool add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                    std::span<const Eigen::Vector3f> points);
+                    std::span<const Eigen::Vector3f> points, bool search = true);
 
   // The graph's estimate of every keyframe, in order.
   const std::vector<Eigen::Isometry3d>& poses() const { return graph_.nodes; }
