@@ -386,7 +386,8 @@ std::string MappingStage::whole_tile(const slam::TileCoord& coord, std::vector<s
 // A tile's whole content to the sink, placed by the graph's correction when
 // following it (each sample by the correction at its scan's time).
 void MappingStage::send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
-  if (graph_ != nullptr) sent_with_[coord] = placement_;
+  if (graph_ != nullptr)
+    sent_with_[coord] = {placement_version_, placement_ ? placement_->slice_for(samples) : slam::CorrectionTrack{}};
   if (placement_ == nullptr) {
     sink_(coord, samples);
     return;
@@ -403,8 +404,9 @@ void MappingStage::flush_tiles(bool final) {
     std::shared_ptr<const slam::CorrectionTrack> latest = graph_->latest();
     if (latest != placement_) {  // a new optimisation: every tile sent is checked against it
       placement_ = std::move(latest);
+      ++placement_version_;
       recheck_.clear();
-      for (const auto& [coord, track] : sent_with_) recheck_.push_back(coord);
+      for (const auto& [coord, sent] : sent_with_) recheck_.push_back(coord);
     }
   }
   std::vector<slam::MapSample> tile_buffer;
@@ -438,13 +440,13 @@ void MappingStage::replace_moved_tiles(bool all) {
     const slam::TileCoord coord = recheck_.front();
     recheck_.pop_front();
     const auto sent = sent_with_.find(coord);
-    if (sent == sent_with_.end() || sent->second == placement_) continue;  // sent since, placed by the latest
+    if (sent == sent_with_.end() || sent->second.version == placement_version_) continue;  // sent since, by the latest
     if (const std::string problem = whole_tile(coord, tile_buffer, samples); !problem.empty()) {
       tile_file_error(problem);
       continue;
     }
     stats_.tiles_checked_for_loops.fetch_add(1, std::memory_order_relaxed);
-    if (!slam::correction_moves(samples, sent->second.get(), placement_.get(), kTileMoveM)) continue;
+    if (!slam::correction_moves(samples, &sent->second.track, placement_.get(), kTileMoveM)) continue;
     send_tile(coord, samples);
     stats_.tiles_moved_by_loops.fetch_add(1, std::memory_order_relaxed);
     stats_.points_moved_by_loops.fetch_add(samples.size(), std::memory_order_relaxed);

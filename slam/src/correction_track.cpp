@@ -77,6 +77,42 @@ bool correction_moves(std::span<const MapSample> samples, const CorrectionTrack*
   return false;
 }
 
+CorrectionTrack CorrectionTrack::slice_for(std::span<const MapSample> samples) const {
+  CorrectionTrack slice;
+  if (stamps_.empty()) return slice;
+  // at(t) reads the keyframes a = b − 1 and b, b the first stamp after t, or
+  // the first or last alone beyond the ends: those are kept.
+  std::vector<std::size_t> kept;
+  double time = std::numeric_limits<double>::quiet_NaN();
+  for (const MapSample& s : samples) {
+    if (s.time_s == time) continue;
+    time = s.time_s;
+    const auto it = std::upper_bound(stamps_.begin(), stamps_.end(), stamp_of(s));
+    const auto b = static_cast<std::size_t>(it - stamps_.begin());
+    if (b == 0) {
+      kept.push_back(0);
+    } else if (b == stamps_.size()) {
+      kept.push_back(b - 1);
+    } else {
+      kept.push_back(b - 1);
+      kept.push_back(b);
+    }
+  }
+  std::sort(kept.begin(), kept.end());
+  kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const std::size_t k = kept[i];
+    slice.stamps_.push_back(stamps_[k]);
+    slice.positions_.push_back(positions_[k]);
+    slice.corrections_.push_back(corrections_[k]);
+    if (i + 1 == kept.size()) break;
+    // A kept pair's own step (the same bits); across a gap no sample's time falls.
+    const std::size_t next = kept[i + 1];
+    slice.steps_.push_back(next == k + 1 ? steps_[k] : log_se3(corrections_[k].inverse() * corrections_[next]));
+  }
+  return slice;
+}
+
 double CorrectionTrack::max_translation_m() const {
   double m = 0.0;
   for (const Eigen::Isometry3d& c : corrections_) m = std::max(m, c.translation().norm());

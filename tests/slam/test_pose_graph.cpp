@@ -220,5 +220,32 @@ TEST(CorrectionTrack, MovesEachSampleByItsScansCorrectionAndSaysWhenATileMoved) 
   EXPECT_FALSE(correction_moves(late, &first, &first, 0.0));
 }
 
+// A live tile remembers the correction it was sent with only at its samples'
+// times: the slice gives the same bits there and holds the keyframes that
+// bracket them, not the session's.
+TEST(CorrectionTrack, ASliceGivesTheSameCorrectionAtItsSamplesTimes) {
+  std::vector<std::int64_t> stamps;
+  std::vector<Eigen::Isometry3d> odometry, graph;
+  for (int k = 0; k < 1000; ++k) {
+    stamps.push_back(std::int64_t{k} * 1'000'000'000 + 500'000'000);  // 0.5 s, 1.5 s, ...
+    odometry.push_back(pose(k, 0, 0));
+    graph.push_back(pose(k, 0.001 * k * k, 1e-4 * k));
+  }
+  const CorrectionTrack track(stamps, graph, odometry);
+  // Samples at 0.1 s (before the first keyframe), amid 300-302 s and 700 s, at
+  // a keyframe's own stamp (800.5 s) and at 2000 s (after the last).
+  std::vector<MapSample> samples;
+  for (double t : {0.1, 300.2, 300.2, 301.7, 302.0, 700.9, 800.5, 2000.0})
+    samples.push_back({Eigen::Vector3f(1, 2, 3), 1.0F, t});
+  const CorrectionTrack slice = track.slice_for(samples);
+  EXPECT_LE(slice.stamps_ns().size(), 12U);
+  for (const MapSample& s : samples) {
+    const auto t = static_cast<std::int64_t>(std::llround(s.time_s * 1e9));
+    EXPECT_TRUE(slice.at(t).matrix() == track.at(t).matrix()) << s.time_s;
+  }
+  EXPECT_FALSE(correction_moves(samples, &slice, &track, 0.0));
+  EXPECT_TRUE(CorrectionTrack().slice_for(samples).empty());
+}
+
 }  // namespace
 }  // namespace adit::slam

@@ -166,8 +166,15 @@ class MappingStage {
   KeyframeQueue* loops_ = nullptr;
   const CorrectionBoard* graph_ = nullptr;
   std::shared_ptr<const slam::CorrectionTrack> placement_;  // the tiles sent now are placed by it (null: identity)
-  // With graph_: each tile sent and the correction it was placed by.
-  std::map<slam::TileCoord, std::shared_ptr<const slam::CorrectionTrack>> sent_with_;
+  std::uint64_t placement_version_ = 0;                     // counts placement_'s changes
+  // With graph_: each tile sent and the correction it was placed by, kept at
+  // its samples' times only (CorrectionTrack::slice_for): a tile unmoved by
+  // later corrections does not hold a whole track of its time.
+  struct SentPlacement {
+    std::uint64_t version = 0;  // placement_version_ when sent
+    slam::CorrectionTrack track;
+  };
+  std::map<slam::TileCoord, SentPlacement> sent_with_;
   std::deque<slam::TileCoord> recheck_;  // tiles to check against placement_
   JournalWriter* journal_ = nullptr;
   std::map<slam::TileCoord, std::size_t> journaled_;  // per resident tile: points of tile() already journaled

@@ -35,6 +35,12 @@ class CorrectionTrack {
   const std::vector<std::int64_t>& stamps_ns() const { return stamps_; }
   const std::vector<Eigen::Vector3d>& graph_positions() const { return positions_; }
 
+  // The same track at every scan time of `samples` (at() gives the same
+  // bits), holding only the keyframes that bracket those times: what a live
+  // tile sent placed by it must remember, a few of the session's keyframes.
+  // Elsewhere it is an interpolation between the keyframes kept.
+  CorrectionTrack slice_for(std::span<const MapSample> samples) const;
+
  private:
   std::vector<std::int64_t> stamps_;
   std::vector<Eigen::Vector3d> positions_;
