@@ -126,9 +126,9 @@ nlohmann::json loops_summary(const LoopClosureStage* loops, const slam::Correcti
   if (loops == nullptr) return {{"enabled", false}};
   const slam::LoopClosureStats& s = loops->closer().stats();
   nlohmann::json by_outcome = nlohmann::json::object();
+  for (const auto& [outcome, count] : loops->closer().outcomes()) by_outcome[outcome] = count;
   nlohmann::json events = nlohmann::json::array();
   for (const slam::LoopEvent& e : loops->closer().events()) {
-    by_outcome[e.outcome] = by_outcome.value(e.outcome, 0) + 1;
     if (events.size() < 200)  // the first ones; the counts cover all
       events.push_back({{"query", e.query}, {"candidate", e.candidate}, {"descriptor_distance", e.descriptor_distance},
                         {"outcome", e.outcome}, {"inlier_ratio", e.inlier_ratio}, {"rmse_m", e.rmse_m},

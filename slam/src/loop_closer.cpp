@@ -70,7 +70,7 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   const auto read_descriptor = [this, k](std::size_t j, Eigen::MatrixXf& bins) {
     if (scans_.read_descriptor(j, bins)) return true;
     ++stats_.rejected_unreadable;
-    events_.push_back({k, j, 1.0, "keyframe_unreadable", 0.0, 0.0, 0.0});
+    record({k, j, 1.0, "keyframe_unreadable", 0.0, 0.0, 0.0});
     return false;
   };
   const std::vector<LoopCandidate> candidates =
@@ -111,7 +111,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
       if (m != c.candidate) continue;  // a neighbour's damaged scan: a smaller submap
       ++stats_.rejected_unreadable;    // the candidate's own: no loop here
       event.outcome = "keyframe_unreadable";
-      events_.push_back(event);
+      record(std::move(event));
       return;
     }
     add_to_submap(submap, neighbour_, candidate_inverse * graph_.nodes[m]);
@@ -132,7 +132,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
   if (v.verdict != LoopVerdict::accepted && v.verdict != LoopVerdict::partial) {
     ++stats_.rejected_verification;
     event.outcome = std::string(to_string(v.verdict));
-    events_.push_back(event);
+    record(std::move(event));
     return;
   }
   ++stats_.verified;
@@ -146,7 +146,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
                                                         : "inconsistent") +
                   kind;
   if (decision == GuardDecision::rejected) ++stats_.rejected_inconsistent;
-  events_.push_back(event);
+  record(std::move(event));
   // A waiting loop keeps its information until a witness lets it in.
   if (decision == GuardDecision::waiting) information_.push_back({c.query, c.candidate, v.information});
   for (const LoopConstraint& l : newly) {
@@ -162,6 +162,11 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
     ++stats_.accepted;
     ++unsolved_;
   }
+}
+
+void LoopCloser::record(LoopEvent event) {
+  ++outcomes_[event.outcome];
+  if (events_.size() < config_.events_kept) events_.push_back(std::move(event));
 }
 
 void LoopCloser::record(const PoseGraphSolution& solution) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <tuple>
 
 #include "adit/slam/loop_closer.hpp"
 #include "loop_scenes.hpp"
@@ -176,6 +177,34 @@ TEST(LoopCloser, ScansOnDiskCloseTheSameLoopsAndDamagedOnesAreRefused) {
   EXPECT_LT(damaged.accepted, in_ram.stats.accepted);
   EXPECT_TRUE(std::any_of(damaged_events.begin(), damaged_events.end(),
                           [](const LoopEvent& e) { return e.outcome == "keyframe_unreadable"; }));
+}
+
+// A long session keeps the first config.events_kept events whole and counts
+// every candidate's outcome.
+TEST(LoopCloser, KeepsTheFirstEventsAndCountsEveryOutcome) {
+  const Drive d = drive([](double s) { return test::ring_pose(kSide, s); }, 1.3 * 4 * kSide, 2.0);
+  const auto run = [&d](std::size_t kept) {
+    LoopClosureConfig config;
+    config.events_kept = kept;
+    LoopCloser closer(config);
+    for (std::size_t k = 0; k < d.truth.size(); ++k)
+      closer.add_keyframe(static_cast<std::int64_t>(k) * 1'000'000'000, d.odometry[k],
+                          test::scan_of(ring_world(), d.truth[k], 1000 + static_cast<unsigned>(k)));
+    return std::tuple{closer.stats(), closer.events(), closer.outcomes()};
+  };
+  const auto [all_stats, all_events, all_outcomes] = run(1000);
+  const auto [stats, events, outcomes] = run(3);
+  ASSERT_GT(all_events.size(), 3U);
+  EXPECT_EQ(all_events.size(), all_stats.candidates);  // one event a candidate
+  ASSERT_EQ(events.size(), 3U);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(events[i].candidate, all_events[i].candidate);
+  EXPECT_EQ(outcomes, all_outcomes);
+  std::size_t counted = 0;
+  for (const auto& [outcome, count] : outcomes) counted += count;
+  EXPECT_EQ(counted, stats.candidates);
+  EXPECT_EQ(outcomes.at("accepted"), static_cast<std::size_t>(std::count_if(
+                                         all_events.begin(), all_events.end(),
+                                         [](const LoopEvent& e) { return e.outcome == "accepted"; })));
 }
 
 // Out 40 m along the ring and back the other way: revisits in reverse,

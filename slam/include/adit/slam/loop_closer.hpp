@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <string>
 #include <vector>
@@ -53,6 +54,9 @@ struct LoopClosureConfig {
   // Keyframe scans and descriptors kept in RAM (the newest); older ones go to
   // the folder given to spill_scans_to() (none: all stay in RAM).
   std::size_t scans_in_ram = 200;
+  // Candidates' events kept whole (LoopCloser::events()); beyond, only counted
+  // by outcome: ~100 B each, an hour's drive tries ~9,000 candidates.
+  std::size_t events_kept = 1000;
   float points_voxel_m = 0.3F;       // the keyframe's scan is kept downsampled at this (submaps)
   float query_voxel_m = 0.6F;        // and registered downsampled at this (about the odometry's registration points)
   // > 0: a roll/pitch prior per keyframe holding the up its pose holds
@@ -109,6 +113,7 @@ struct LoopClosureStats {
 
 class LoopCloser {
  public:
+
   explicit LoopCloser(const LoopClosureConfig& config = {});
 
   // Adds a keyframe (`points` in its body frame) and closes what loops it
@@ -133,7 +138,9 @@ class LoopCloser {
   std::size_t unconfirmed() const { return guard_.waiting().size(); }
   // Loops in the graph not yet optimised (config.optimize_every_s).
   std::size_t unsolved() const { return unsolved_; }
+  // The first config.events_kept candidates' events; outcomes() counts every one's.
   const std::vector<LoopEvent>& events() const { return events_; }
+  const std::map<std::string, std::size_t>& outcomes() const { return outcomes_; }
   const PoseGraph& graph() const { return graph_; }
   // A last optimisation of the whole graph (session end).
   void refine();
@@ -145,6 +152,7 @@ class LoopCloser {
  private:
   void try_candidate(const LoopCandidate& candidate);
   void record(const PoseGraphSolution& solution);  // its figures; nothing waits any more
+  void record(LoopEvent event);
 
   LoopClosureConfig config_;
   PoseGraph graph_;
@@ -160,6 +168,7 @@ class LoopCloser {
   std::vector<double> variance_;
   LoopClosureStats stats_;
   std::vector<LoopEvent> events_;
+  std::map<std::string, std::size_t> outcomes_;
   struct PendingInformation {
     std::size_t query, candidate;
     Matrix6d information;
