@@ -29,12 +29,14 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
                               std::span<const Eigen::Vector3f> points, bool search) {
   const std::size_t k = graph_.nodes.size();
   const std::int64_t search_start_ns = monotonic_ns();
-  std::vector<Eigen::Vector3f> kept, query;
+  std::vector<Eigen::Vector3f> kept, query;  // query: only when it will be one
   kept.reserve(points.size());
-  query.reserve(points.size());
   VoxelDownsampler downsampler(points.size());
   downsampler.downsample(points, config_.points_voxel_m, kept);
-  downsampler.downsample(points, config_.query_voxel_m, query);
+  if (search) {
+    query.reserve(points.size());
+    downsampler.downsample(points, config_.query_voxel_m, query);
+  }
   ScanContext descriptor = make_scan_context(points, config_.descriptor);
   ring_keys_.push_back(descriptor.ring_key);
   if (k == 0) {
@@ -70,7 +72,7 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
   const auto read_descriptor = [this, k](std::size_t j, Eigen::MatrixXf& bins) {
     if (scans_.read_descriptor(j, bins)) return true;
     ++stats_.rejected_unreadable;
-    record({k, j, 1.0, "keyframe_unreadable", 0.0, 0.0, 0.0});
+    record_event({k, j, 1.0, "keyframe_unreadable", 0.0, 0.0, 0.0});
     return false;
   };
   const std::vector<LoopCandidate> candidates =
@@ -111,7 +113,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
       if (m != c.candidate) continue;  // a neighbour's damaged scan: a smaller submap
       ++stats_.rejected_unreadable;    // the candidate's own: no loop here
       event.outcome = "keyframe_unreadable";
-      record(std::move(event));
+      record_event(std::move(event));
       return;
     }
     add_to_submap(submap, neighbour_, candidate_inverse * graph_.nodes[m]);
@@ -132,7 +134,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
   if (v.verdict != LoopVerdict::accepted && v.verdict != LoopVerdict::partial) {
     ++stats_.rejected_verification;
     event.outcome = std::string(to_string(v.verdict));
-    record(std::move(event));
+    record_event(std::move(event));
     return;
   }
   ++stats_.verified;
@@ -146,7 +148,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
                                                         : "inconsistent") +
                   kind;
   if (decision == GuardDecision::rejected) ++stats_.rejected_inconsistent;
-  record(std::move(event));
+  record_event(std::move(event));
   // A waiting loop keeps its information until a witness lets it in.
   if (decision == GuardDecision::waiting) information_.push_back({c.query, c.candidate, v.information});
   for (const LoopConstraint& l : newly) {
@@ -164,7 +166,7 @@ void LoopCloser::try_candidate(const LoopCandidate& c) {
   }
 }
 
-void LoopCloser::record(LoopEvent event) {
+void LoopCloser::record_event(LoopEvent event) {
   ++outcomes_[event.outcome];
   if (events_.size() < config_.events_kept) events_.push_back(std::move(event));
 }

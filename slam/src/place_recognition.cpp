@@ -26,7 +26,7 @@ std::vector<LoopCandidate> find_loop_candidates(std::size_t query, const ScanCon
     const double radius = config.base_radius_m + config.gate_sigmas * std::sqrt(variance);
     const double gap = (k.poses[j].translation() - here).norm();
     if (gap > radius) continue;
-    gated.push_back({j, (query_descriptor.ring_key - k.ring_keys[j]).norm(), gap});
+    gated.push_back({j, ring_key_distance(query_descriptor.ring_key, k.ring_keys[j]), gap});
   }
   const std::size_t keep = std::min(gated.size(), static_cast<std::size_t>(std::max(0, config.ring_key_candidates)));
   std::partial_sort(gated.begin(), gated.begin() + static_cast<std::ptrdiff_t>(keep), gated.end(),

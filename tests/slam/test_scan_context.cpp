@@ -44,7 +44,7 @@ TEST(ScanContext, ATurnOnTheSpotIsAColumnShift) {
   const ScanContextMatch m = compare(b, a);
   EXPECT_LT(m.distance, 0.1);
   EXPECT_LT(angle_diff(m.yaw_rad, 72.0 * M_PI / 180.0), 7.0 * M_PI / 180.0);
-  EXPECT_LT(ring_key_distance(a, b), 0.1F);
+  EXPECT_LT(ring_key_distance(a.ring_key, b.ring_key), 0.1F);
 }
 
 // A corridor driven back the other way, half a metre aside: the best shift

@@ -113,7 +113,6 @@ struct LoopClosureStats {
 
 class LoopCloser {
  public:
-
   explicit LoopCloser(const LoopClosureConfig& config = {});
 
   // Adds a keyframe (`points` in its body frame) and closes what loops it
@@ -152,7 +151,7 @@ class LoopCloser {
  private:
   void try_candidate(const LoopCandidate& candidate);
   void record(const PoseGraphSolution& solution);  // its figures; nothing waits any more
-  void record(LoopEvent event);
+  void record_event(LoopEvent event);  // counted by outcome; kept while fewer than config.events_kept
 
   LoopClosureConfig config_;
   PoseGraph graph_;

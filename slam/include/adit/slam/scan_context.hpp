@@ -54,8 +54,6 @@ inline constexpr double kAlternativeSeparationRad = 1.5707963267948966;  // 90°
 ScanContextMatch compare(const ScanContext& query, const ScanContext& candidate);
 
 // Euclidean distance between ring keys: the cheap first stage of the search.
-inline float ring_key_distance(const ScanContext& a, const ScanContext& b) {
-  return (a.ring_key - b.ring_key).norm();
-}
+inline float ring_key_distance(const Eigen::VectorXf& a, const Eigen::VectorXf& b) { return (a - b).norm(); }
 
 }  // namespace adit::slam
