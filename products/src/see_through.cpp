@@ -56,7 +56,8 @@ RangeImage::RangeImage(int rings, int columns)
 }
 
 void RangeImage::clear() {
-  std::fill(range_.begin(), range_.end(), 0.0F);
+  // +inf while adding (the nearest return is then one min), 0 again in finish().
+  std::fill(range_.begin(), range_.end(), std::numeric_limits<float>::infinity());
   std::fill(column_time_.begin(), column_time_.end(), 0.0F);
   std::fill(column_count_.begin(), column_count_.end(), 0U);
   std::fill(ring_elevation_sum_.begin(), ring_elevation_sum_.end(), 0.0);
@@ -78,7 +79,7 @@ void RangeImage::add(int ring, const Eigen::Vector3f& p, float time_s) {
   if (!(range > 0.0F) || !std::isfinite(range)) return;
   const int c = column_of(fast_atan2(p.y(), p.x()));
   float& cell = range_[static_cast<std::size_t>(ring * columns_ + c)];
-  if (cell == 0.0F || range < cell) cell = range;
+  cell = std::min(cell, range);
   column_time_[static_cast<std::size_t>(c)] += time_s;
   ++column_count_[static_cast<std::size_t>(c)];
   ring_elevation_sum_[static_cast<std::size_t>(ring)] += std::asin(std::clamp(p.z() / range, -1.0F, 1.0F));
@@ -101,8 +102,10 @@ void RangeImage::finish() {
   const auto cols = static_cast<std::size_t>(columns_);
   for (std::size_t row = 0; row < ring_of_row_.size(); ++row) {
     const auto ring = static_cast<std::size_t>(ring_of_row_[row]);
-    std::copy_n(range_.begin() + static_cast<std::ptrdiff_t>(ring * cols), cols,
-                scratch_.begin() + static_cast<std::ptrdiff_t>(row * cols));
+    std::transform(range_.begin() + static_cast<std::ptrdiff_t>(ring * cols),
+                   range_.begin() + static_cast<std::ptrdiff_t>((ring + 1) * cols),
+                   scratch_.begin() + static_cast<std::ptrdiff_t>(row * cols),
+                   [](float r) { return std::isinf(r) ? 0.0F : r; });  // a bin without a return: 0
   }
   range_.swap(scratch_);
   // Elevations by row: rebuilt into scratch order through the ring indices.

@@ -94,7 +94,7 @@ class RangeImage {
   int rings_;
   int columns_;
   float column_width_;
-  std::vector<float> range_;         // rings × columns, by ring while adding, by row after finish()
+  std::vector<float> range_;         // rings × columns: by ring and +inf where none while adding, by row and 0 after finish()
   std::vector<float> scratch_;       // the same for the reordering
   std::vector<float> column_time_;   // sum while adding, mean after finish()
   std::vector<std::uint32_t> column_count_;
