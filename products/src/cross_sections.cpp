@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -31,6 +32,71 @@ Eigen::Vector3d at_chainage(const slam::Trajectory& path, const std::vector<doub
   return (1 - a) * path.poses[j - 1].translation() + a * path.poses[j].translation();
 }
 
+// The section at chainage `s` from `points`: its slab's profile, floor,
+// roof, walls and their width and height.
+CrossSection measure_section(std::span<const Eigen::Vector3f> points, const slam::Trajectory& path,
+                             const std::vector<double>& chainage, double s, const SectionOptions& o) {
+  CrossSection c;
+  c.chainage_m = s;
+  c.centre = at_chainage(path, chainage, s);
+  const Eigen::Vector2d d = (at_chainage(path, chainage, s + 1.0) - at_chainage(path, chainage, s - 1.0)).head<2>();
+  c.width_m = c.height_m = kNaN;
+  if (d.norm() < 1e-6) {  // the path stands still here: no direction to cut across
+    c.across.setZero();
+    return c;
+  }
+  const Eigen::Vector2d along = d.normalized();
+  c.across = Eigen::Vector2d(-along.y(), along.x());
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector2d r = p.head<2>().cast<double>() - c.centre.head<2>();
+    if (std::abs(r.dot(along)) > o.slab_m) continue;
+    const double u = r.dot(c.across);
+    if (std::abs(u) > o.max_half_width_m) continue;
+    c.profile.emplace_back(static_cast<float>(u), p.z());
+  }
+  std::vector<double> below, above;
+  for (const Eigen::Vector2f& q : c.profile) {
+    if (std::abs(q.x()) > 0.75) continue;
+    (q.y() < c.centre.z() - 0.3 ? below : above).push_back(q.y());
+  }
+  above.erase(std::remove_if(above.begin(), above.end(), [&](double z) { return z < c.centre.z() + 0.3; }), above.end());
+  c.floor_z = median(below);
+  c.roof_z = median(above);
+  c.height_m = c.roof_z - c.floor_z;
+  // Width: the innermost wall points each side at the height, their median within 0.3 m of the innermost.
+  const double zw = c.floor_z + o.width_at_m;
+  std::vector<double> left, right;
+  double inner_left = std::numeric_limits<double>::max(), inner_right = -std::numeric_limits<double>::max();
+  for (const Eigen::Vector2f& q : c.profile) {
+    if (!std::isfinite(zw) || std::abs(q.y() - zw) > o.band_m) continue;
+    if (q.x() > 0) inner_left = std::min(inner_left, double{q.x()});
+    else inner_right = std::max(inner_right, double{q.x()});
+  }
+  for (const Eigen::Vector2f& q : c.profile) {
+    if (!std::isfinite(zw) || std::abs(q.y() - zw) > o.band_m) continue;
+    if (q.x() > 0 && q.x() < inner_left + 0.3) left.push_back(q.x());
+    if (q.x() <= 0 && q.x() > inner_right - 0.3) right.push_back(q.x());
+  }
+  c.left_u = median(left);
+  c.right_u = median(right);
+  c.width_m = c.left_u - c.right_u;
+  return c;
+}
+
+// Whether both walls of `c` run on: the sections regular_span_m before and
+// after it put them within wall_tolerance_m of its own (measured in each
+// section's own frame: on a bend the path's centre line keeps its offset).
+bool walls_run_on(std::span<const Eigen::Vector3f> points, const slam::Trajectory& path,
+                  const std::vector<double>& chainage, const CrossSection& c, const SectionOptions& o) {
+  if (!std::isfinite(c.width_m)) return false;
+  for (const double side : {-o.regular_span_m, o.regular_span_m}) {
+    const CrossSection n = measure_section(points, path, chainage, c.chainage_m + side, o);
+    if (!(std::abs(n.left_u - c.left_u) <= o.wall_tolerance_m && std::abs(n.right_u - c.right_u) <= o.wall_tolerance_m))
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<CrossSection> cut_sections(std::span<const Eigen::Vector3f> points, const slam::Trajectory& path,
@@ -40,52 +106,41 @@ std::vector<CrossSection> cut_sections(std::span<const Eigen::Vector3f> points, 
   std::vector<double> chainage(path.size(), 0.0);
   for (std::size_t i = 1; i < path.size(); ++i)
     chainage[i] = chainage[i - 1] + (path.poses[i].translation() - path.poses[i - 1].translation()).head<2>().norm();
-  std::vector<double> left, right, below, above;
+  const bool shifting = o.max_shift_m > 0.0 && o.shift_step_m > 0.0;
+  // The offsets tried, nearest first: 0, +step, -step, +2 step, ...
+  std::vector<double> offsets{0.0};
+  for (double k = o.shift_step_m; shifting && k <= o.max_shift_m + 1e-9; k += o.shift_step_m) {
+    offsets.push_back(k);
+    offsets.push_back(-k);
+  }
+  // A station's section, and those around it, see only the points within
+  // this horizontal reach of its nominal place.
+  const double reach = o.max_half_width_m + o.max_shift_m + o.regular_span_m + 1.0;
+  std::vector<Eigen::Vector3f> near;
   for (double s = o.interval_m; s < chainage.back() - 1.0; s += o.interval_m) {
-    CrossSection c;
-    c.id = static_cast<int>(out.size()) + 1;
-    c.chainage_m = s;
-    c.centre = at_chainage(path, chainage, s);
-    const Eigen::Vector2d d = (at_chainage(path, chainage, s + 1.0) - at_chainage(path, chainage, s - 1.0)).head<2>();
-    if (d.norm() < 1e-6) continue;
-    const Eigen::Vector2d along = d.normalized();
-    c.across = Eigen::Vector2d(-along.y(), along.x());
-    for (const Eigen::Vector3f& p : points) {
-      const Eigen::Vector2d r = p.head<2>().cast<double>() - c.centre.head<2>();
-      if (std::abs(r.dot(along)) > o.slab_m) continue;
-      const double u = r.dot(c.across);
-      if (std::abs(u) > o.max_half_width_m) continue;
-      c.profile.emplace_back(static_cast<float>(u), p.z());
+    const Eigen::Vector3d nominal = at_chainage(path, chainage, s);
+    near.clear();
+    for (const Eigen::Vector3f& p : points)
+      if ((p.head<2>().cast<double>() - nominal.head<2>()).squaredNorm() <= reach * reach) near.push_back(p);
+    std::optional<CrossSection> chosen;
+    for (const double offset : offsets) {
+      const double at = s + offset;
+      if (at <= 0.0 || at >= chainage.back()) continue;
+      CrossSection c = measure_section(near, path, chainage, at, o);
+      if (!shifting || walls_run_on(near, path, chainage, c, o)) {
+        c.shift_m = offset;
+        chosen = std::move(c);
+        break;
+      }
     }
-    below.clear();
-    above.clear();
-    for (const Eigen::Vector2f& q : c.profile) {
-      if (std::abs(q.x()) > 0.75) continue;
-      (q.y() < c.centre.z() - 0.3 ? below : above).push_back(q.y());
+    if (!chosen) {  // the walls break everywhere within reach: the section, without its width
+      chosen = measure_section(near, path, chainage, s, o);
+      chosen->walls_regular = false;
+      chosen->width_m = kNaN;
     }
-    above.erase(std::remove_if(above.begin(), above.end(), [&](double z) { return z < c.centre.z() + 0.3; }), above.end());
-    c.floor_z = median(below);
-    c.roof_z = median(above);
-    c.height_m = c.roof_z - c.floor_z;
-    // Width: the innermost wall points each side at the height, their median within 0.3 m of the innermost.
-    const double zw = c.floor_z + o.width_at_m;
-    left.clear();
-    right.clear();
-    double inner_left = std::numeric_limits<double>::max(), inner_right = -std::numeric_limits<double>::max();
-    for (const Eigen::Vector2f& q : c.profile) {
-      if (!std::isfinite(zw) || std::abs(q.y() - zw) > o.band_m) continue;
-      if (q.x() > 0) inner_left = std::min(inner_left, double{q.x()});
-      else inner_right = std::max(inner_right, double{q.x()});
-    }
-    for (const Eigen::Vector2f& q : c.profile) {
-      if (!std::isfinite(zw) || std::abs(q.y() - zw) > o.band_m) continue;
-      if (q.x() > 0 && q.x() < inner_left + 0.3) left.push_back(q.x());
-      if (q.x() <= 0 && q.x() > inner_right - 0.3) right.push_back(q.x());
-    }
-    c.left_u = median(left);
-    c.right_u = median(right);
-    c.width_m = c.left_u - c.right_u;
-    out.push_back(std::move(c));
+    if (chosen->across.squaredNorm() == 0.0) continue;
+    chosen->id = static_cast<int>(out.size()) + 1;
+    out.push_back(std::move(*chosen));
   }
   return out;
 }
@@ -93,6 +148,8 @@ std::vector<CrossSection> cut_sections(std::span<const Eigen::Vector3f> points, 
 std::uintmax_t write_section_svg(const std::filesystem::path& file, const CrossSection& s, const SectionOptions& o) {
   Plot plot;
   plot.title = fmt::format("Section {} at {:.1f} m along the path", s.id, s.chainage_m);
+  if (s.shift_m != 0.0) plot.title += fmt::format(" (moved {:+.1f} m to where the walls run on)", s.shift_m);
+  if (!s.walls_regular) plot.title += fmt::format(" (width not given: the walls break within {:g} m)", o.max_shift_m);
   plot.x_label = "across the path, left + (m)";
   plot.y_label = "height (m, map frame)";
   plot.equal_axes = true;

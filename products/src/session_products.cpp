@@ -48,7 +48,8 @@ nlohmann::json report_json(const ProductsReport& r, const ProductsOptions& o) {
           {"bytes", {{"points", r.points_bytes}, {"octree_bt", r.bt_bytes}, {"octree_ot", r.ot_bytes}, {"grid", r.grid_bytes}}},
           {"top_view_bytes", r.top_view_bytes},
           {"sections", {{"count", r.sections}, {"measured", r.sections_measured}, {"interval_m", o.sections.interval_m},
-                        {"width_at_m", o.sections.width_at_m}}},
+                        {"width_at_m", o.sections.width_at_m}, {"moved", r.sections_moved},
+                        {"walls_broken", r.sections_walls_broken}, {"max_shift_m", o.sections.max_shift_m}}},
           {"targets", {{"found", r.targets}, {"note", r.targets_note}}},
           {"files", files},
           {"cpu_s", r.cpu_s},
@@ -93,6 +94,8 @@ void check_options(const ProductsOptions& o) {
   require(o.outliers.k >= 1 && o.outliers.stddev_mult > 0.0, "sor", "k >= 1 and a positive stddev multiple");
   require(o.ground.patch_m > 0.0 && o.ground.distance_m > 0.0, "ground", "patch and distance must be positive");
   require(o.sections.interval_m > 0.0, "section-interval", "must be positive");
+  require(o.sections.max_shift_m >= 0.0 && o.sections.max_shift_m < o.sections.interval_m / 2, "section-max-shift",
+          "from 0 to less than half the section interval");
   require(o.moving.margin_m > 0.0 && o.moving.margin_fraction >= 0.0 && o.moving.seen_tolerance_m > 0.0 &&
               o.moving.min_range_m >= 0.0 && o.moving.max_range_m > o.moving.min_range_m,
           "moving", "margins and tolerance positive, max range above min range");
@@ -224,6 +227,8 @@ ProductsReport write_session_products(const std::filesystem::path& session_dir, 
   for (const CrossSection& c : sections) {
     write_section_svg(r.out_dir / "sections" / fmt::format("section_{:03d}.svg", c.id), c, options.sections);
     r.sections_measured += std::isfinite(c.width_m) && std::isfinite(c.height_m);
+    r.sections_moved += c.shift_m != 0.0;
+    r.sections_walls_broken += !c.walls_regular;
   }
   r.sections = sections.size();
   write_sections_csv(r.out_dir / "sections" / "sections.csv", sections);

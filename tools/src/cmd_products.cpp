@@ -42,8 +42,10 @@ void run_products(const ProductsCommand& c) {
              r.grid_occupied, r.grid_free, r.grid_filled, r.grid_unknown, c.options.grid_resolution_m);
   fmt::print("storage           points {} -> 3D {} (.bt){} -> 2D {} (PGM + YAML)\n", kib(r.points_bytes),
              kib(r.bt_bytes), r.ot_bytes > 0 ? fmt::format(", {} (.ot)", kib(r.ot_bytes)) : "", kib(r.grid_bytes));
-  fmt::print("pictures          top_view.png ({}), {} cross-sections ({} measured) every {} m in sections/\n",
-             kib(r.top_view_bytes), r.sections, r.sections_measured, c.options.sections.interval_m);
+  fmt::print("pictures          top_view.png ({}), {} cross-sections ({} measured, {} moved to where the walls run on, "
+             "{} without a width: the walls break) every {} m in sections/\n",
+             kib(r.top_view_bytes), r.sections, r.sections_measured, r.sections_moved, r.sections_walls_broken,
+             c.options.sections.interval_m);
   fmt::print("cpu               {:.2f} s\n", r.cpu_s);
   for (const auto& [step, s] : r.cpu_by_step) fmt::print("  {:<24}{:.2f} s\n", step, s);
 }
@@ -69,6 +71,9 @@ void register_products_commands(CLI::App& app, int& status) {
   cmd->add_option("--ground-distance", o.ground.distance_m, "Ground: distance to the patch plane (m, default 0.12)");
   cmd->add_option("--section-interval", o.sections.interval_m, "Cross-sections every this many m of path (default 10)");
   cmd->add_option("--section-width-at", o.sections.width_at_m, "Widths measured this high above the floor (m, default 1.5)");
+  cmd->add_option("--section-max-shift", o.sections.max_shift_m,
+                  "A station moves along the path up to this far to where both walls run on (m, default 2; 0: stations at "
+                  "their nominal chainage)");
   cmd->add_option("--ray-candidates", o.rays.candidates, "Path positions tried for each point's line of sight (default 12)");
   cmd->add_flag("!--keep-moving", o.moving.enabled,
                 "Keep the map points of moving objects (people, vehicles) that the raw recording's scans saw through");

@@ -80,6 +80,8 @@ struct ProductsReport {
   std::uintmax_t grid_bytes = 0;    // PGM + YAML
   std::uintmax_t top_view_bytes = 0;
   std::size_t sections = 0, sections_measured = 0;  // measured: width and height both found
+  std::size_t sections_moved = 0;         // stations moved to where the walls run on
+  std::size_t sections_walls_broken = 0;  // stations with no such place within reach (no width)
   std::size_t targets = 0;          // found by intensity (targets.csv)
   std::string targets_note;         // why none were looked for ("" when they were)
   double cpu_s = 0.0;               // this thread's CPU time for all of it
