@@ -83,9 +83,10 @@ SegmentOutcome TileAssembler::add_segment(const tile_segment_t& m) {
     last_error_ = fmt::format("tile {} version {} segment {}: {}", m.tile_id, m.version, m.segment, error);
     return count(SegmentOutcome::corrupt);
   }
-  tile.parts[index] = HeldSegment{std::vector<std::uint8_t>(m.data.begin(), m.data.end()),
-                                  static_cast<std::uint32_t>(scratch_.size()), m.tile_id, m.tile_size_m, m.quantum_m, centred,
-                                  m.utime};
+  HeldSegment& held = tile.parts[index];
+  held = HeldSegment{{}, spill_ ? spill_->write(m.data) : nullptr, static_cast<std::uint32_t>(scratch_.size()),
+                     m.tile_id, m.tile_size_m, m.quantum_m, centred, m.utime};
+  if (!held.spilled) held.frame.assign(m.data.begin(), m.data.end());
   tile.have[index] = true;
   return count(finish_if_complete(tile));
 }
@@ -176,8 +177,11 @@ std::size_t TileAssembler::HeldTile::points() const {
 
 void HeldSegment::decode_into(std::vector<MapPoint>& out) const {
   const std::size_t first = out.size();
+  std::vector<std::uint8_t> read;  // a spilled frame's bytes (one allocation a segment, not a point)
+  if (spilled && !spilled->read(read)) read.clear();
+  const std::span<const std::uint8_t> bytes = spilled ? std::span<const std::uint8_t>(read) : frame;
   // Decoded once already, on arrival: an error here is not expected (the frame is unchanged since).
-  if (frame.empty() || !decode_segment(frame, tile_key(tile_id), tile_size_m, quantum_m, centred, out).empty()) {
+  if (bytes.empty() || !decode_segment(bytes, tile_key(tile_id), tile_size_m, quantum_m, centred, out).empty()) {
     out.resize(first);
     return;
   }

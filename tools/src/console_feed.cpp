@@ -109,8 +109,12 @@ nlohmann::json loops_json(const loop_status_t& l) {
           {"moves_map", l.moves_map != 0}};
 }
 
-LiveFeed::LiveFeed(ClientOptions options, EventHub& hub)
-    : options_(std::move(options)), hub_(hub), client_(std::make_unique<LcmClient>(options_)) {
+LiveFeed::LiveFeed(ClientOptions options, EventHub& hub, const std::filesystem::path& spill_dir)
+    : options_(std::move(options)),
+      hub_(hub),
+      spill_(spill_dir.empty() ? nullptr : protocol::FrameSpill::open(spill_dir)),
+      tiles_(spill_),
+      client_(std::make_unique<LcmClient>(options_)) {
   last_status_ms_ = now_ms();  // silent since the console started, until a status arrives
   thread_ = std::thread([this] { run(); });
 }
@@ -138,7 +142,7 @@ void LiveFeed::run() {
 void LiveFeed::switch_session(const std::string& session) {
   if (session == session_) return;
   session_ = session;
-  tiles_ = {};
+  tiles_ = protocol::TileAssembler(spill_);  // the last session's frames freed on disk
   changes_.clear();
   pending_event_.clear();
   path_.clear();

@@ -63,7 +63,8 @@ struct TileBytes {
 
 class LiveFeed {
  public:
-  LiveFeed(ClientOptions options, EventHub& hub);
+  // The map's segments are kept in a spill file in `spill_dir` (in RAM when empty).
+  LiveFeed(ClientOptions options, EventHub& hub, const std::filesystem::path& spill_dir = {});
   ~LiveFeed();
   LiveFeed(const LiveFeed&) = delete;
   LiveFeed& operator=(const LiveFeed&) = delete;
@@ -118,6 +119,7 @@ class LiveFeed {
   std::optional<nlohmann::json> graph_path_;  // the session's latest graph_path_t
   std::int32_t graph_revision_ = 0;           // its revision
   std::int64_t graph_utime_ = 0;              // its newest keyframe's time
+  std::shared_ptr<protocol::FrameSpill> spill_;  // the map's segments on disk (null: in RAM)
   protocol::TileAssembler tiles_;
   // Per tile, the completions seen: (version before, version, first segment replaced).
   struct Change {

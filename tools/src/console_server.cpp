@@ -139,7 +139,10 @@ std::vector<std::string> lines_of(const std::string& text) {
 
 int serve_console(const ConsoleOptions& options, const std::atomic<bool>& stop) {
   EventHub hub;
-  LiveFeed feed(options.client, hub);
+  // The current session's map is kept on disk beside the downloaded ones: a
+  // long session's map would otherwise grow the console's memory with it.
+  std::filesystem::create_directories(options.data_dir);
+  LiveFeed feed(options.client, hub, options.data_dir);
   MapDownloads downloads(options.client, options.data_dir / "maps", hub);
   ScanNames names(options.data_dir / "names.json");
   ControlGate gate(options.passphrase);

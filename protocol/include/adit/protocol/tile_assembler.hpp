@@ -9,7 +9,7 @@
 // Segments are held as they came: each zstd frame, checked by decoding it
 // once on arrival and decoded again when asked for (about 5 bytes a point
 // against 40 decoded), so a follower of a long session (adit console) holds
-// the map at the stream's size.
+// the map at the stream's size; given a FrameSpill, on disk instead of in RAM.
 
 #include <cstddef>
 #include <cstdint>
@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "adit/protocol/frame_spill.hpp"
 #include "adit/protocol/map_point.hpp"
 
 namespace adit {
@@ -38,7 +39,8 @@ struct MissingSegment {
 
 // One segment held: its frame as received and what decodes it.
 struct HeldSegment {
-  std::vector<std::uint8_t> frame;  // tile_codec's segment frame (zstd)
+  std::vector<std::uint8_t> frame;  // tile_codec's segment frame (zstd), unless spilled
+  std::shared_ptr<const SpilledFrame> spilled;  // the frame on disk (shared by copies; freed with the last)
   std::uint32_t points = 0;
   std::int64_t tile_id = 0;
   double tile_size_m = 0.0;
@@ -55,6 +57,10 @@ struct AssemblerCounts {
 
 class TileAssembler {
  public:
+  TileAssembler() = default;
+  // Segments' frames written to `spill` (held in RAM when a write fails).
+  explicit TileAssembler(std::shared_ptr<FrameSpill> spill) : spill_(std::move(spill)) {}
+
   // From the tile index: tile `id` exists at `version` in `n_segments` segments.
   void note_index(std::int64_t id, std::int32_t version, std::int32_t n_segments);
 
@@ -102,6 +108,7 @@ class TileAssembler {
   SegmentOutcome finish_if_complete(Tile& tile);
   SegmentOutcome count(SegmentOutcome outcome);
 
+  std::shared_ptr<FrameSpill> spill_;
   std::map<std::int64_t, Tile> tiles_;
   std::vector<MapPoint> scratch_;  // a segment decoded on arrival, to check it
   AssemblerCounts counts_;
