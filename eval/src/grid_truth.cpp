@@ -153,6 +153,10 @@ GridTruthScore score_grid(const GridView& grid, std::span<const Triangle> scene,
   }
   std::size_t free_both = 0, free_either = 0, occ_both = 0, occ_either = 0, known_both = 0, known_either = 0;
   std::size_t est_matched = 0, truth_unmatched = 0;
+  s.lattice_width = l.w;
+  s.lattice_height = l.h;
+  s.lattice_cell_m = l.cell;
+  s.cells.assign(n, CellAgreement::unscored);
   for (int r = 0; r < l.h; ++r)
     for (int c = 0; c < l.w; ++c) {
       const std::size_t k = l.index(c, r);
@@ -169,8 +173,19 @@ GridTruthScore score_grid(const GridView& grid, std::span<const Triangle> scene,
       occ_either += to || eo;
       known_both += (tf || to) && (ef || eo);
       known_either += (tf || to) || (ef || eo);
-      if (eo && near_occupied(occ, c, r)) ++est_matched;
-      if (to && !near_occupied(est_occ, c, r)) ++truth_unmatched;
+      const bool eo_matched = eo && near_occupied(occ, c, r);
+      const bool to_unmatched = to && !near_occupied(est_occ, c, r);
+      est_matched += eo_matched;
+      truth_unmatched += to_unmatched;
+      CellAgreement& a = s.cells[k];
+      a = tf && ef                                 ? CellAgreement::free_both
+          : tf && !eo                              ? CellAgreement::free_truth_unknown
+          : tf                                     ? (eo_matched ? CellAgreement::occupied_both : CellAgreement::free_truth_occupied)
+          : to_unmatched                           ? CellAgreement::occupied_truth_only
+          : (to || eo_matched)                     ? CellAgreement::occupied_both
+          : ef                                     ? CellAgreement::free_grid_only
+          : eo                                     ? CellAgreement::free_truth_occupied
+                                                   : CellAgreement::unseen_both;
     }
   s.iou_free = iou(free_both, free_either);
   s.iou_occupied = iou(occ_both, occ_either);

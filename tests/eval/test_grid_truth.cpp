@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "adit/eval/grid_truth.hpp"
@@ -63,6 +64,28 @@ TEST(GridTruth, ShiftedWallsAndUnknownCellsScoreLow) {
   const GridTruthScore u = score_grid(unknown.view(), room(), Eigen::Isometry3d::Identity(), path, GridTruthOptions{});
   EXPECT_EQ(u.iou_free, 0.0);
   EXPECT_EQ(u.iou_known, 0.0);
+}
+
+TEST(GridTruth, EachCellSaysWhereTheGridAndTheTruthAgree) {
+  const std::vector<Eigen::Vector3d> path = {{2.0, 1.5, 0.5}};
+  TestGrid g = room_grid(0);
+  const auto at = [](double x, double y) { return static_cast<std::size_t>(std::floor((y + 1.0) / 0.05)) * 140 +
+                                                  static_cast<std::size_t>(std::floor((x + 1.0) / 0.05)); };
+  g.cells[at(1.0, 1.0)] = -1;   // a free cell the grid does not know
+  g.cells[at(3.0, 2.0)] = 100;  // an obstacle the room does not have
+  g.cells[at(5.5, 1.0)] = 0;    // free outside the room, where no ray from the path goes
+  const GridTruthScore s = score_grid(g.view(), room(), Eigen::Isometry3d::Identity(), path, GridTruthOptions{});
+  ASSERT_EQ(s.cells.size(), static_cast<std::size_t>(s.lattice_width) * s.lattice_height);
+  EXPECT_EQ(s.lattice_width, 140);
+  EXPECT_EQ(s.cells[at(2.0, 2.0)], CellAgreement::free_both);
+  EXPECT_EQ(s.cells[at(1.0, 1.0)], CellAgreement::free_truth_unknown);
+  EXPECT_EQ(s.cells[at(3.0, 2.0)], CellAgreement::free_truth_occupied);
+  EXPECT_EQ(s.cells[at(0.025, 1.5)], CellAgreement::occupied_both);
+  EXPECT_EQ(s.cells[at(5.5, 1.0)], CellAgreement::free_grid_only);
+  EXPECT_EQ(s.cells[at(5.5, 2.0)], CellAgreement::unseen_both);
+  std::size_t both = 0;
+  for (const CellAgreement a : s.cells) both += a == CellAgreement::free_both;
+  EXPECT_EQ(static_cast<double>(both) / static_cast<double>(s.truth_free + s.grid_free - both), s.iou_free);
 }
 
 TEST(GridTruth, TheSceneIsPlacedInTheGridsFrame) {

@@ -70,6 +70,7 @@ struct GridEvalOptions {
   double max_range = 20.0;  // m: cells farther from the path are not scored
   double floor_z = 0.0;     // the scene's floor height (world)
   bool json = false;
+  std::string diff_png;     // a picture of where the grid and the truth agree and differ
 };
 
 void run_eval_grid(const GridEvalOptions& options);

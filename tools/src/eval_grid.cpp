@@ -7,6 +7,7 @@
 #include "adit/common/error.hpp"
 #include "adit/eval/grid_truth.hpp"
 #include "adit/products/grid_io.hpp"
+#include "adit/products/raster_image.hpp"
 #include "eval_commands.hpp"
 
 namespace adit::tools {
@@ -28,6 +29,25 @@ void run_eval_grid(const GridEvalOptions& o) {
   const eval::GridTruthScore s = score_grid(
       {grid.resolution_m, grid.origin_x, grid.origin_y, grid.width, grid.height, grid.cells}, scene, map_from_world,
       path, options);
+  if (!o.diff_png.empty()) {
+    // Row 0 of the lattice is at the grid's origin_y: drawn at the bottom, north up.
+    products::RasterImage image(s.lattice_width, s.lattice_height, {0, 0, 0});
+    for (int r = 0; r < s.lattice_height; ++r)
+      for (int c = 0; c < s.lattice_width; ++c) {
+        using A = eval::CellAgreement;
+        const A a = s.cells[static_cast<std::size_t>(r) * s.lattice_width + c];
+        const products::Rgb colour = a == A::free_both              ? products::Rgb{40, 150, 60}
+                                     : a == A::free_truth_unknown   ? products::Rgb{220, 40, 40}
+                                     : a == A::free_truth_occupied  ? products::Rgb{255, 150, 0}
+                                     : a == A::occupied_both        ? products::Rgb{255, 255, 255}
+                                     : a == A::occupied_truth_only  ? products::Rgb{230, 0, 230}
+                                     : a == A::free_grid_only       ? products::Rgb{60, 110, 255}
+                                     : a == A::unseen_both          ? products::Rgb{60, 60, 60}
+                                                                    : products::Rgb{0, 0, 0};
+        image.set(c, s.lattice_height - 1 - r, colour);
+      }
+    image.write_png(o.diff_png);
+  }
   if (o.json) {
     const nlohmann::json j = {{"iou_free", s.iou_free},
                               {"iou_occupied", s.iou_occupied},

@@ -40,6 +40,18 @@ struct GridTruthOptions {
   int rays = 2880;            // per viewpoint
 };
 
+// What the grid and the truth say of one lattice cell (GridTruthScore::cells).
+enum class CellAgreement : std::uint8_t {
+  unscored,          // out of range of the path
+  free_both,
+  free_truth_unknown,    // free in the truth, unknown in the grid
+  free_truth_occupied,   // free in the truth, occupied in the grid (and no true wall within a cell)
+  occupied_both,         // within one cell of each other
+  occupied_truth_only,   // a seeable true wall the grid has nothing of within a cell
+  free_grid_only,        // free in the grid where the truth is not seeable free
+  unseen_both,           // in range, neither knows it
+};
+
 struct GridTruthScore {
   std::size_t truth_free = 0, truth_occupied = 0;   // visible, in range
   std::size_t grid_free = 0, grid_occupied = 0;     // in range, on the truth lattice
@@ -47,6 +59,10 @@ struct GridTruthScore {
   double iou_occupied = 0.0;
   double iou_occupied_within_1_cell = 0.0;
   double iou_known = 0.0;  // seen (free or occupied) against seeable
+  // The truth's lattice (row 0 at the grid's origin_y) and each cell's agreement, for a picture.
+  int lattice_width = 0, lattice_height = 0;
+  double lattice_cell_m = 0.0;
+  std::vector<CellAgreement> cells;
 };
 
 // `map_from_world` places the scene in the grid's frame; `path_world` is the
