@@ -74,24 +74,43 @@ std::size_t fill_line_of_sight(Grid2d& g, std::span<const Eigen::Vector3f> viewp
   std::vector<std::size_t> cells;
   std::size_t filled = 0;
   const int rays = 1440;
-  const double step = 0.5 * g.resolution_m;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double t_end = range_m / g.resolution_m;  // in cells
   Eigen::Vector3f last(std::numeric_limits<float>::max(), 0, 0);
   for (const Eigen::Vector3f& v : viewpoints) {
     if ((v - last).norm() < viewpoint_step_m) continue;
     last = v;
+    const double gx = (v.x() - g.origin_x) / g.resolution_m, gy = (v.y() - g.origin_y) / g.resolution_m;
     for (int k = 0; k < rays; ++k) {
       const double a = 2 * M_PI * k / rays, dx = std::cos(a), dy = std::sin(a);
       cells.clear();
       bool bounded = false;
-      for (double t = 0; t <= range_m; t += step) {
-        const int c = g.col_of(v.x() + t * dx), r = g.row_of(v.y() + t * dy);
+      // Every cell the ray crosses, in order (Amanatides and Woo, "A fast voxel
+      // traversal algorithm for ray tracing", Eurographics 1987): t is the
+      // distance along the ray in cells, t_c and t_r where it next crosses a
+      // column and a row boundary.
+      int c = static_cast<int>(std::floor(gx)), r = static_cast<int>(std::floor(gy));
+      const int step_c = dx > 0 ? 1 : -1, step_r = dy > 0 ? 1 : -1;
+      const double delta_c = dx != 0 ? 1.0 / std::abs(dx) : kInf, delta_r = dy != 0 ? 1.0 / std::abs(dy) : kInf;
+      double t_c = dx > 0 ? (c + 1 - gx) * delta_c : dx < 0 ? (gx - c) * delta_c : kInf;
+      double t_r = dy > 0 ? (r + 1 - gy) * delta_r : dy < 0 ? (gy - r) * delta_r : kInf;
+      for (double t = 0; t <= t_end;) {
         if (!g.contains(c, r)) break;
         const std::size_t k2 = static_cast<std::size_t>(r) * g.width + c;
         if (block[k2]) {
           bounded = true;
           break;
         }
-        if (cells.empty() || cells.back() != k2) cells.push_back(k2);
+        cells.push_back(k2);
+        if (t_c < t_r) {
+          t = t_c;
+          t_c += delta_c;
+          c += step_c;
+        } else {
+          t = t_r;
+          t_r += delta_r;
+          r += step_r;
+        }
       }
       if (!bounded) continue;
       for (const std::size_t k2 : cells)

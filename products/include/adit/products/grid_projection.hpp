@@ -26,7 +26,8 @@ struct ProjectionOptions {
 };
 
 // 2D line-of-sight fill (how a 2D laser scan's free space is made): from each
-// viewpoint, rays over the grid every 0.25° mark unknown cells free up to the
+// viewpoint, rays over the grid every 0.25° (walked cell by cell, Amanatides
+// and Woo 1987) mark unknown cells free up to the
 // first occupied cell (dilated by one cell, so a pinhole in a wall does not
 // leak), but only when they meet one within range_m: free space bounded by an
 // observed obstacle. It fills the floor between the sparse rings the 3D rays

@@ -41,7 +41,7 @@ struct ProductsOptions {
   bool write_ot = false;            // the full-probability octree beside the .bt
   bool line_of_sight_fill = true;   // fill_line_of_sight (grid_projection.hpp)
   double fill_range_m = 40.0;       // aditd's map.max_range_m
-  double fill_step_m = 1.0;         // a viewpoint every metre of path
+  double fill_step_m = 0.25;        // every viewpoint of the path (RayOptions::path_step_m); 1 m before 2026-12-01
   TopViewOptions top_view;
   SectionOptions sections;
   TargetOptions targets;            // targets.csv, drawn on the top view
