@@ -100,7 +100,7 @@ void register_products_commands(CLI::App& app, int& status) {
                   "(default 1)");
   cmd->add_option("--moving-scan-step", o.moving.scan_step, "Moving objects: use every n-th scan (default 1)");
   cmd->add_flag("!--no-fill", o.line_of_sight_fill, "No 2D line-of-sight fill of the grid's free space");
-  cmd->add_option("--fill-step", o.fill_step_m, "Line-of-sight fill: a viewpoint every this many m of path (default 1)")
+  cmd->add_option("--fill-step", o.fill_step_m, "Line-of-sight fill: a viewpoint every this many m of path (default 0.25: every one)")
       ->check(CLI::Range(0.05, 100.0));
   cmd->add_flag("--ot", o.write_ot, "Also write the full-probability octree (.ot)");
   cmd->callback([c, &status] {
