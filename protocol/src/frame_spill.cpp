@@ -12,7 +12,7 @@
 
 namespace adit::protocol {
 
-SpilledFrame::SpilledFrame(std::shared_ptr<FrameSpill> file, std::uint64_t offset, std::uint32_t size)
+SpilledFrame::SpilledFrame(FrameSpill::Key, std::shared_ptr<FrameSpill> file, std::uint64_t offset, std::uint32_t size)
     : file_(std::move(file)), offset_(offset), size_(size) {}
 
 SpilledFrame::~SpilledFrame() { file_->release(offset_, size_); }
@@ -23,7 +23,10 @@ bool SpilledFrame::read(std::vector<std::uint8_t>& out) const {
   while (done < size_) {
     const ssize_t n = ::pread(file_->fd_, out.data() + done, size_ - done, static_cast<off_t>(offset_ + done));
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
+    if (n <= 0) {
+      file_->failed_reads_.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
     done += static_cast<std::size_t>(n);
   }
   return true;
@@ -61,7 +64,7 @@ std::shared_ptr<const SpilledFrame> FrameSpill::write(std::span<const std::uint8
     done += static_cast<std::size_t>(n);
   }
   live_bytes_.fetch_add(size, std::memory_order_relaxed);
-  return std::make_shared<const SpilledFrame>(shared_from_this(), offset, size);
+  return std::make_shared<const SpilledFrame>(Key{}, shared_from_this(), offset, size);
 }
 
 std::uint64_t FrameSpill::disk_bytes() const {

@@ -45,6 +45,7 @@ TEST(FrameSpill, FramesReadBackAsWrittenAndTheirBlocksAreFreedWithTheLastHolder)
   EXPECT_LT(spill->disk_bytes(), 400'000u);  // the hole punched (a block either side may stay)
   ASSERT_TRUE(a->read(out));
   EXPECT_EQ(out, bytes(300'000, 1));
+  EXPECT_EQ(spill->failed_reads(), 0u);
 }
 
 TEST(FrameSpill, AFolderThatCannotHoldOneIsNamed) {

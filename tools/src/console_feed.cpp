@@ -346,6 +346,10 @@ nlohmann::json LiveFeed::snapshot() const {
           {"graph_path", graph_path_ ? *graph_path_ : nlohmann::json()},
           {"tiles", tiles},
           {"map_points", points},
+          {"map_spill", spill_ ? nlohmann::json{{"bytes", spill_->live_bytes()},
+                                                {"failed_writes", spill_->failed_writes()},
+                                                {"failed_reads", spill_->failed_reads()}}
+                               : nlohmann::json()},
           {"grid", grid_.patch_count() == 0
                        ? nlohmann::json()
                        : nlohmann::json{{"v", grid_.version_sum()}, {"patches", grid_.patch_count()}}}};

@@ -16,28 +16,10 @@
 
 namespace adit::protocol {
 
-class FrameSpill;
-
-// One frame in a spill file; its bytes are freed when it is destroyed.
-class SpilledFrame {
- public:
-  SpilledFrame(std::shared_ptr<FrameSpill> file, std::uint64_t offset, std::uint32_t size);
-  ~SpilledFrame();
-  SpilledFrame(const SpilledFrame&) = delete;
-  SpilledFrame& operator=(const SpilledFrame&) = delete;
-
-  // The frame's bytes into `out` (resized); false when the file cannot be read.
-  bool read(std::vector<std::uint8_t>& out) const;
-  std::uint32_t size() const { return size_; }
-
- private:
-  std::shared_ptr<FrameSpill> file_;
-  std::uint64_t offset_;
-  std::uint32_t size_;
-};
+class SpilledFrame;
 
 class FrameSpill : public std::enable_shared_from_this<FrameSpill> {
-  struct Key {  // only open() makes one
+  struct Key {  // only the spill makes one: open() and write() alone construct
     explicit Key() = default;
   };
 
@@ -58,6 +40,7 @@ class FrameSpill : public std::enable_shared_from_this<FrameSpill> {
   // The file's blocks on disk (fstat's st_blocks): about live_bytes where holes can be punched.
   std::uint64_t disk_bytes() const;
   std::uint64_t failed_writes() const { return failed_writes_.load(std::memory_order_relaxed); }
+  std::uint64_t failed_reads() const { return failed_reads_.load(std::memory_order_relaxed); }
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
@@ -69,6 +52,27 @@ class FrameSpill : public std::enable_shared_from_this<FrameSpill> {
   std::atomic<std::uint64_t> end_{0};  // where the next frame goes (writers take their range first)
   std::atomic<std::uint64_t> live_bytes_{0};
   std::atomic<std::uint64_t> failed_writes_{0};
+  mutable std::atomic<std::uint64_t> failed_reads_{0};  // counted by SpilledFrame::read
+};
+
+// One frame in a spill file; its bytes are freed when it is destroyed.
+class SpilledFrame {
+ public:
+  // Made by FrameSpill::write only (its Key).
+  SpilledFrame(FrameSpill::Key, std::shared_ptr<FrameSpill> file, std::uint64_t offset, std::uint32_t size);
+  ~SpilledFrame();
+  SpilledFrame(const SpilledFrame&) = delete;
+  SpilledFrame& operator=(const SpilledFrame&) = delete;
+
+  // The frame's bytes into `out` (resized); false, and counted in the
+  // file's failed_reads(), when the file cannot be read.
+  bool read(std::vector<std::uint8_t>& out) const;
+  std::uint32_t size() const { return size_; }
+
+ private:
+  std::shared_ptr<FrameSpill> file_;
+  std::uint64_t offset_;
+  std::uint32_t size_;
 };
 
 }  // namespace adit::protocol
