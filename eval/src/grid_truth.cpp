@@ -180,11 +180,11 @@ GridTruthScore score_grid(const GridView& grid, std::span<const Triangle> scene,
       CellAgreement& a = s.cells[k];
       a = tf && ef                                 ? CellAgreement::free_both
           : tf && !eo                              ? CellAgreement::free_truth_unknown
-          : tf                                     ? (eo_matched ? CellAgreement::occupied_both : CellAgreement::free_truth_occupied)
+          : tf                                     ? (eo_matched ? CellAgreement::occupied_both : CellAgreement::occupied_grid_only)
           : to_unmatched                           ? CellAgreement::occupied_truth_only
           : (to || eo_matched)                     ? CellAgreement::occupied_both
           : ef                                     ? CellAgreement::free_grid_only
-          : eo                                     ? CellAgreement::free_truth_occupied
+          : eo                                     ? CellAgreement::occupied_grid_only
                                                    : CellAgreement::unseen_both;
     }
   s.iou_free = iou(free_both, free_either);

@@ -79,7 +79,7 @@ TEST(GridTruth, EachCellSaysWhereTheGridAndTheTruthAgree) {
   EXPECT_EQ(s.lattice_width, 140);
   EXPECT_EQ(s.cells[at(2.0, 2.0)], CellAgreement::free_both);
   EXPECT_EQ(s.cells[at(1.0, 1.0)], CellAgreement::free_truth_unknown);
-  EXPECT_EQ(s.cells[at(3.0, 2.0)], CellAgreement::free_truth_occupied);
+  EXPECT_EQ(s.cells[at(3.0, 2.0)], CellAgreement::occupied_grid_only);
   EXPECT_EQ(s.cells[at(0.025, 1.5)], CellAgreement::occupied_both);
   EXPECT_EQ(s.cells[at(5.5, 1.0)], CellAgreement::free_grid_only);
   EXPECT_EQ(s.cells[at(5.5, 2.0)], CellAgreement::unseen_both);

@@ -131,8 +131,8 @@ void add_grid(CLI::App& eval, int& status) {
       ->check(CLI::Range(1.0, 200.0));
   cmd->add_option("--floor-z", o->floor_z, "The scene's floor height in the world (default 0)");
   cmd->add_option("--diff-png", o->diff_png,
-                  "Write a picture of the agreement: green free in both, red free but unknown in the grid, orange free "
-                  "but occupied in the grid, white walls in both, magenta true walls the grid lacks, blue free in the "
+                  "Write a picture of the agreement: green free in both, red free but unknown in the grid, orange "
+                  "occupied in the grid with no true wall within a cell, white walls in both, magenta true walls the grid lacks, blue free in the "
                   "grid only, dark grey seen by neither");
   cmd->add_flag("--json", o->json, "Print JSON instead of a table");
   cmd->callback([o, &status] {

@@ -38,7 +38,7 @@ void run_eval_grid(const GridEvalOptions& o) {
         const A a = s.cells[static_cast<std::size_t>(r) * s.lattice_width + c];
         const products::Rgb colour = a == A::free_both              ? products::Rgb{40, 150, 60}
                                      : a == A::free_truth_unknown   ? products::Rgb{220, 40, 40}
-                                     : a == A::free_truth_occupied  ? products::Rgb{255, 150, 0}
+                                     : a == A::occupied_grid_only  ? products::Rgb{255, 150, 0}
                                      : a == A::occupied_both        ? products::Rgb{255, 255, 255}
                                      : a == A::occupied_truth_only  ? products::Rgb{230, 0, 230}
                                      : a == A::free_grid_only       ? products::Rgb{60, 110, 255}

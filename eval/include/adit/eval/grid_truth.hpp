@@ -42,10 +42,10 @@ struct GridTruthOptions {
 
 // What the grid and the truth say of one lattice cell (GridTruthScore::cells).
 enum class CellAgreement : std::uint8_t {
-  unscored,          // out of range of the path
+  unscored,              // out of range of the path
   free_both,
   free_truth_unknown,    // free in the truth, unknown in the grid
-  free_truth_occupied,   // free in the truth, occupied in the grid (and no true wall within a cell)
+  occupied_grid_only,    // occupied in the grid with no true wall within a cell (the truth free or unseen there)
   occupied_both,         // within one cell of each other
   occupied_truth_only,   // a seeable true wall the grid has nothing of within a cell
   free_grid_only,        // free in the grid where the truth is not seeable free
