@@ -155,7 +155,6 @@ GridTruthScore score_grid(const GridView& grid, std::span<const Triangle> scene,
   std::size_t est_matched = 0, truth_unmatched = 0;
   s.lattice_width = l.w;
   s.lattice_height = l.h;
-  s.lattice_cell_m = l.cell;
   s.cells.assign(n, CellAgreement::unscored);
   for (int r = 0; r < l.h; ++r)
     for (int c = 0; c < l.w; ++c) {

@@ -122,7 +122,7 @@ std::vector<CrossSection> cut_sections(std::span<const Eigen::Vector3f> points, 
     near.clear();
     for (const Eigen::Vector3f& p : points)
       if ((p.head<2>().cast<double>() - nominal.head<2>()).squaredNorm() <= reach * reach) near.push_back(p);
-    std::optional<CrossSection> chosen;
+    std::optional<CrossSection> chosen, nominal_section;
     for (const double offset : offsets) {
       const double at = s + offset;
       if (at <= 0.0 || at >= chainage.back()) continue;
@@ -132,9 +132,10 @@ std::vector<CrossSection> cut_sections(std::span<const Eigen::Vector3f> points, 
         chosen = std::move(c);
         break;
       }
+      if (offset == 0.0) nominal_section = std::move(c);
     }
-    if (!chosen) {  // the walls break everywhere within reach: the section, without its width
-      chosen = measure_section(near, path, chainage, s, o);
+    if (!chosen) {  // the walls break everywhere within reach: the nominal section, without its width
+      chosen = std::move(nominal_section);
       chosen->walls_regular = false;
       chosen->width_m = kNaN;
     }

@@ -120,24 +120,25 @@ SessionInputs read_session_inputs(const std::filesystem::path& session_dir, doub
   in.thin_voxel_m = thin_voxel_m < 0.0 ? map_voxel_m : thin_voxel_m;
   const std::filesystem::path map_file = map_file_of(session_dir);
   in.read_points = protocol::MapFileReader(map_file).count();
-  // Thinned, the points kept are counted in a first pass over the file and
-  // room made for exactly them: a vector grown as they come would hold up to
-  // three times their bytes while it moves (503 MB for a 60-minute drive's
-  // thinned map, docs/decisions/066-loop-memory-on-long-sessions.md).
+  // One pass over the file, each point the thinning keeps handed to `take`.
+  const auto for_each_kept = [&](const auto& take) {
+    protocol::MapFileReader reader(map_file);
+    VoxelThinner thinner(in.thin_voxel_m, in.read_points);
+    for (std::span<const protocol::MapPoint> block = reader.next(); !block.empty(); block = reader.next())
+      for (const protocol::MapPoint& p : block)
+        if (thinner.keep(p)) take(p);
+  };
+  // Thinned, the points kept are counted in a first pass and room made for
+  // exactly them: a vector grown as they come would hold up to three times
+  // their bytes while it moves (503 MB for a 60-minute drive's thinned map,
+  // docs/decisions/066-loop-memory-on-long-sessions.md).
   std::size_t kept = in.read_points;
   if (in.thin_voxel_m > 0.0) {
     kept = 0;
-    protocol::MapFileReader counting(map_file);
-    VoxelThinner thinner(in.thin_voxel_m, in.read_points);
-    for (std::span<const protocol::MapPoint> block = counting.next(); !block.empty(); block = counting.next())
-      for (const protocol::MapPoint& p : block) kept += thinner.keep(p);
+    for_each_kept([&](const protocol::MapPoint&) { ++kept; });
   }
   in.points.reserve(kept);
-  protocol::MapFileReader reader(map_file);
-  VoxelThinner thinner(in.thin_voxel_m, in.read_points);
-  for (std::span<const protocol::MapPoint> block = reader.next(); !block.empty(); block = reader.next())
-    for (const protocol::MapPoint& p : block)
-      if (thinner.keep(p)) in.points.push_back(p);
+  for_each_kept([&](const protocol::MapPoint& p) { in.points.push_back(p); });
   in.thinned = in.read_points - in.points.size();
   if (in.points.empty()) throw InputError(map_file.string(), "", "the map has no points");
   in.body_poses = slam::read_tum(session_dir / "map_trajectory.tum");

@@ -41,10 +41,10 @@ std::shared_ptr<FrameSpill> FrameSpill::open(const std::filesystem::path& dir) {
     if (fd >= 0) ::unlink(name.c_str());
   }
   if (fd < 0) throw InputError(dir.string(), "", std::string("cannot make a spill file: ") + std::strerror(errno));
-  return std::make_shared<FrameSpill>(Key{}, fd, dir);
+  return std::make_shared<FrameSpill>(Key{}, fd);
 }
 
-FrameSpill::FrameSpill(Key, int fd, std::filesystem::path dir) : fd_(fd), dir_(std::move(dir)) {}
+FrameSpill::FrameSpill(Key, int fd) : fd_(fd) {}
 
 FrameSpill::~FrameSpill() { ::close(fd_); }
 

@@ -59,9 +59,8 @@ struct GridTruthScore {
   double iou_occupied = 0.0;
   double iou_occupied_within_1_cell = 0.0;
   double iou_known = 0.0;  // seen (free or occupied) against seeable
-  // The truth's lattice (row 0 at the grid's origin_y) and each cell's agreement, for a picture.
+  // The truth's lattice (options.cell_m; row 0 at the grid's origin_y) and each cell's agreement, for a picture.
   int lattice_width = 0, lattice_height = 0;
-  double lattice_cell_m = 0.0;
   std::vector<CellAgreement> cells;
 };
 

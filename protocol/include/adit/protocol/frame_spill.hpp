@@ -27,7 +27,7 @@ class FrameSpill : public std::enable_shared_from_this<FrameSpill> {
   // A spill file in `dir`; throws adit::InputError naming the folder when it
   // cannot make one there.
   static std::shared_ptr<FrameSpill> open(const std::filesystem::path& dir);
-  FrameSpill(Key, int fd, std::filesystem::path dir);
+  FrameSpill(Key, int fd);
   ~FrameSpill();
   FrameSpill(const FrameSpill&) = delete;
   FrameSpill& operator=(const FrameSpill&) = delete;
@@ -41,14 +41,12 @@ class FrameSpill : public std::enable_shared_from_this<FrameSpill> {
   std::uint64_t disk_bytes() const;
   std::uint64_t failed_writes() const { return failed_writes_.load(std::memory_order_relaxed); }
   std::uint64_t failed_reads() const { return failed_reads_.load(std::memory_order_relaxed); }
-  const std::filesystem::path& dir() const { return dir_; }
 
  private:
   friend class SpilledFrame;
   void release(std::uint64_t offset, std::uint32_t size);
 
   int fd_;
-  std::filesystem::path dir_;
   std::atomic<std::uint64_t> end_{0};  // where the next frame goes (writers take their range first)
   std::atomic<std::uint64_t> live_bytes_{0};
   std::atomic<std::uint64_t> failed_writes_{0};
@@ -67,7 +65,6 @@ class SpilledFrame {
   // The frame's bytes into `out` (resized); false, and counted in the
   // file's failed_reads(), when the file cannot be read.
   bool read(std::vector<std::uint8_t>& out) const;
-  std::uint32_t size() const { return size_; }
 
  private:
   std::shared_ptr<FrameSpill> file_;
