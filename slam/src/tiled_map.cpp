@@ -147,6 +147,45 @@ bool TiledVoxelMap::VoxelBits::contains(std::uint32_t block, std::uint32_t bit) 
   return at != VoxelIndex::kEmpty && (bitmaps_[at][bit >> 6] >> (bit & 63U) & 1U) != 0;
 }
 
+void TiledVoxelMap::holds(std::span<const Eigen::Vector3f> points, std::vector<std::uint8_t>& held,
+                          int reach_voxels) const {
+  held.assign(points.size(), 0);
+  const Tile* tile = nullptr;
+  TileCoord current{};
+  bool looked_up = false;
+  const std::uint8_t confirmed = std::max<std::uint8_t>(config_.min_hits, 1);
+  const auto holds_voxel_of = [&](const Eigen::Vector3f& p) {
+    const TileCoord coord = tile_of(p);
+    if (!looked_up || coord != current) {
+      looked_up = true;
+      current = coord;
+      const auto it = tiles_.find(coord);
+      tile = it == tiles_.end() ? nullptr : &it->second;
+    }
+    if (tile == nullptr) return false;
+    const std::uint32_t voxel = voxel_of(p, origin_of(coord));
+    if (!tile->stored.empty()) {
+      const auto [block, bit] = block_of(voxel);
+      if (tile->stored.contains(block, bit)) return true;
+    }
+    const std::uint32_t candidate = tile->voxels.find(voxel);
+    return candidate != VoxelIndex::kEmpty && tile->hits[candidate] >= confirmed;
+  };
+  const int reach = std::max(reach_voxels, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;
+    bool found = holds_voxel_of(p);
+    for (int dx = -reach; dx <= reach && !found; ++dx)
+      for (int dy = -reach; dy <= reach && !found; ++dy)
+        for (int dz = -reach; dz <= reach && !found; ++dz)
+          if (dx != 0 || dy != 0 || dz != 0)
+            found = holds_voxel_of(p + config_.voxel_m * Eigen::Vector3f(static_cast<float>(dx), static_cast<float>(dy),
+                                                                          static_cast<float>(dz)));
+    held[i] = found ? 1 : 0;
+  }
+}
+
 std::vector<TileCoord> TiledVoxelMap::evicted_hit_by(std::span<const Eigen::Vector3f> points) const {
   std::set<TileCoord> hit;
   if (evicted_.empty()) return {};

@@ -79,6 +79,33 @@ TEST(TiledVoxelMap, SkipsNonFinitePoints) {
   EXPECT_EQ(map.tile_count(), 1U);
 }
 
+TEST(TiledVoxelMap, HoldsSaysWhichPointsFallInAConfirmedOrStoredVoxel) {
+  TiledVoxelMap map({20.0F, 0.1F, 2});
+  const std::vector<Eigen::Vector3f> twice{{1.01F, 1.01F, 1.01F}};
+  map.add(twice, {}, 1.0);
+  map.add(twice, {}, 2.0);                                   // confirmed
+  map.add(std::vector<Eigen::Vector3f>{{3.01F, 1.01F, 1.01F}}, {}, 3.0);  // a candidate only
+  map.add(std::vector<Eigen::Vector3f>{{25.0F, 1.0F, 1.0F}}, {}, 4.0);
+  map.add(std::vector<Eigen::Vector3f>{{25.0F, 1.0F, 1.0F}}, {}, 5.0);
+  map.evict({1, 0, 0});
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Eigen::Vector3f> probes{{1.09F, 1.05F, 1.0F},  // the confirmed voxel
+                                            {1.11F, 1.05F, 1.0F},  // beside it
+                                            {3.05F, 1.05F, 1.05F}, // the candidate's
+                                            {25.0F, 1.0F, 1.0F},   // in the evicted tile
+                                            {nan, 0.0F, 0.0F},
+                                            {-5.0F, 1.0F, 1.0F}};  // no tile
+  std::vector<std::uint8_t> held;
+  map.holds(probes, held);
+  EXPECT_EQ(held, (std::vector<std::uint8_t>{1, 0, 0, 0, 0, 0}));
+  const TiledVoxelMap::Evicted out = map.evict({0, 0, 0});
+  map.restore({0, 0, 0}, out.points);  // the confirmed voxel now a stored bit
+  map.holds(probes, held);
+  EXPECT_EQ(held, (std::vector<std::uint8_t>{1, 0, 0, 0, 0, 0}));
+  map.holds(probes, held, 1);  // a voxel beside a held one counts too
+  EXPECT_EQ(held, (std::vector<std::uint8_t>{1, 1, 0, 0, 0, 0}));
+}
+
 TEST(TiledVoxelMap, RejectsUnusableSizes) {
   EXPECT_NE(tiled_map_config_problem({0.0F, 0.05F}), "");
   EXPECT_NE(tiled_map_config_problem({20.0F, -1.0F}), "");

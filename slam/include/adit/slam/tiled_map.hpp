@@ -113,6 +113,11 @@ class TiledVoxelMap {
   // The evicted tiles that any of `points` falls into, in coordinate order:
   // what must be restored before add() takes them.
   std::vector<TileCoord> evicted_hit_by(std::span<const Eigen::Vector3f> points) const;
+  // Per point, 1 when its voxel, or one within `reach_voxels` of it along
+  // each axis, is in the map (confirmed, or stored by a restore()), else 0
+  // (also for non-finite points and tiles not resident: restore those first).
+  // `held` gets one entry per point.
+  void holds(std::span<const Eigen::Vector3f> points, std::vector<std::uint8_t>& held, int reach_voxels = 0) const;
   const TiledMapConfig& config() const { return config_; }
 
   TileCoord tile_of(const Eigen::Vector3f& p) const;
