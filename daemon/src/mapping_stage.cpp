@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include <malloc.h>
@@ -225,6 +226,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
     if (grid_ms_ != nullptr && grid_ms_->size() < kTimingCapacity)
       grid_ms_->push_back(1e-6 * static_cast<double>(monotonic_ns() - grid_start_ns));
   }
+  if (revisits_) drop_revisits(slot.stamp_ns);
   if (spill_) restore_tiles(map_.evicted_hit_by(deskewed_));
   map_.add(deskewed_, intensities_, 1e-9 * static_cast<double>(slot.stamp_ns));
   journal_new_points();  // before eviction: an evicted tile's points are all in the journal
@@ -260,6 +262,30 @@ void MappingStage::insert_into_grid(std::int64_t stamp_ns, const Eigen::Vector3f
   grid_points_.clear();
   for (const Eigen::Vector3f& p : deskewed_) grid_points_.push_back(c * p);
   grid_->insert(c * origin, grid_points_);
+}
+
+void MappingStage::follow_graph(const CorrectionBoard* graph) {
+  graph_ = graph;
+  if (graph_ != nullptr && config_.merge_revisits) revisits_.emplace();
+}
+
+// The scan's points (deskewed_, map frame) whose place an earlier pass mapped
+// become NaN, which add() skips: placed by the latest correction where that
+// pass put the place, their voxel is in the map (tiles evicted there read
+// back first, as for the scan's own).
+void MappingStage::drop_revisits(std::int64_t stamp_ns) {
+  std::shared_ptr<const slam::CorrectionTrack> correction = graph_->latest();
+  if (correction.get() != revisits_->track()) revisits_->follow(std::move(correction));
+  revisits_->place_in_earlier_pass(deskewed_, stamp_ns, earlier_);
+  if (spill_) restore_tiles(map_.evicted_hit_by(earlier_));
+  map_.holds(earlier_, held_, revisits_->config().reach_voxels);
+  std::uint64_t dropped = 0;
+  for (std::size_t i = 0; i < deskewed_.size(); ++i) {
+    if (held_[i] == 0) continue;
+    deskewed_[i] = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    ++dropped;
+  }
+  stats_.revisit_points.fetch_add(dropped, std::memory_order_relaxed);
 }
 
 // The points each resident tile confirmed since its last journal record.

@@ -574,6 +574,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"tiles_checked_for_loops", s.tiles_checked_for_loops.load()},
                  {"tiles_moved_by_loops", s.tiles_moved_by_loops.load()},
                  {"points_moved_by_loops", s.points_moved_by_loops.load()},
+                 {"revisit_points", s.revisit_points.load()},
                  {"spilled_keyframes", s.spilled_keyframes.load()},
                  {"lost_candidates", s.lost_candidates.load()}, {"tile_file_errors", s.tile_file_errors.load()},
                  {"dropped_in_evicted", s.dropped_in_evicted.load()}}},

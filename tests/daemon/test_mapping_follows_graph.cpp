@@ -63,6 +63,10 @@ struct StageRun {
   std::map<slam::GridPatchCoord, std::vector<std::int8_t>> patches;
   int patch_cells = 0;
   float resolution_m = 0.0F;
+  bool merge_revisits = true;                                   // map.merge_revisits
+  std::int64_t third_ns = 3'000'000'000;                        // the third scan's time
+  Eigen::Isometry3d third_pose = Eigen::Isometry3d::Identity();  // and its pose
+  std::size_t map_points = 0;                                   // after the run
 
   // The occupied cells' centres (x, y), map frame.
   std::vector<Eigen::Vector2f> occupied() {
@@ -87,6 +91,7 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   config.map.publish_period_s = 0.05;
   config.grid.enabled = run.grid;
   config.grid.publish_period_s = 0.05;
+  config.map.merge_revisits = run.merge_revisits;
   std::atomic<bool> stop{false};
   constexpr std::size_t kMaxPoints = 2000;
   Handoff<MapSlot> scans(4, Overflow::wait, [] {
@@ -114,10 +119,11 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
     run.patches[c].assign(cells.begin(), cells.end());
   });
   stage.start();
-  const auto push = [&](std::int64_t stamp_ns) {
+  const auto push = [&](std::int64_t stamp_ns, const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity()) {
     MapSlot* slot = scans.acquire_or_wait([] { return true; });
     ASSERT_NE(slot, nullptr);
     fill_wall(*slot, stamp_ns);
+    slot->pose = pose;
     scans.publish(slot);
   };
   push(1'000'000'000);
@@ -125,9 +131,10 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   for (int i = 0; i < 200 && run.sent.count() == 0; ++i) std::this_thread::sleep_for(10ms);
   ASSERT_GT(run.sent.count(), 0U) << "the first scan's tiles never went out";
   if (correction) board.post(*correction);
-  push(3'000'000'000);
+  push(run.third_ns, run.third_pose);
   scans.close();
   stage.join();
+  run.map_points = stage.map().size();
 }
 
 TEST(MappingFollowsGraph, TilesSentBeforeACorrectionGoAgainMovedByIt) {
@@ -231,6 +238,31 @@ TEST(MappingFollowsGraph, ScansAfterACorrectionGoIntoTheGridPlacedByIt) {
   const auto [low0, high0] = wall_span(unmoved);
   EXPECT_NEAR(high0, 3.0F, 0.1F);
   EXPECT_NEAR(low0, -3.0F, 0.1F);
+}
+
+// A revisit (map.merge_revisits): the third scan sees the same wall 97 s
+// later with the odometry 0.5 m off along x, which the graph's correction
+// takes back. Its points lie, by the correction, where the first scan's are:
+// none is added. Without merging they would all be added again, 0.5 m away.
+TEST(MappingFollowsGraph, ARevisitAddsNothingThatAnEarlierPassMapped) {
+  const std::vector<std::int64_t> stamps{1'000'000'000, 100'000'000'000};
+  const std::vector<Eigen::Isometry3d> graph{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  const slam::CorrectionTrack track(stamps, graph, std::vector{Eigen::Isometry3d::Identity(), shifted(0.5, 0)});
+  StageRun merged;
+  merged.third_ns = stamps[1];
+  merged.third_pose = shifted(0.5, 0);
+  run_stage(merged, track);
+  constexpr std::size_t kWall = 61 * 21;
+  EXPECT_EQ(merged.map_points, kWall);
+  EXPECT_EQ(merged.stats.revisit_points.load(), kWall);
+
+  StageRun unmerged;
+  unmerged.merge_revisits = false;
+  unmerged.third_ns = stamps[1];
+  unmerged.third_pose = shifted(0.5, 0);
+  run_stage(unmerged, track);
+  EXPECT_EQ(unmerged.map_points, 2 * kWall);
+  EXPECT_EQ(unmerged.stats.revisit_points.load(), 0U);
 }
 
 }  // namespace

@@ -41,6 +41,7 @@
 #include "adit/slam/live_grid.hpp"
 #include "adit/slam/lie.hpp"
 #include "adit/slam/map_refiner.hpp"
+#include "adit/slam/revisit_filter.hpp"
 #include "adit/slam/tiled_map.hpp"
 #include "adit/slam/tum.hpp"
 #include "adit/slam/voxel_downsample.hpp"
@@ -77,8 +78,10 @@ class MappingStage {
   // kTileMoveM (a few tiles each flush, at most kReplaceBudgetMs of it).
   // Each scan goes into the live grid placed by the latest correction too (at
   // its time: the newest keyframe's, held), so the grid goes on where the
-  // tiles are; cells already in the grid stay where they were put.
-  void follow_graph(const CorrectionBoard* graph) { graph_ = graph; }
+  // tiles are; cells already in the grid stay where they were put. With
+  // map.merge_revisits a point whose place an earlier pass mapped, by the
+  // latest correction, is not added (slam/revisit_filter.hpp).
+  void follow_graph(const CorrectionBoard* graph);
   static constexpr double kTileMoveM = 0.02;
   static constexpr std::int64_t kReplaceBudgetMs = 20;
   // Before start(): how many points sent as tiles still wait for the tile
@@ -135,6 +138,7 @@ class MappingStage {
   bool tile_backlog_full() const { return tile_backlog_ && tile_backlog_() > kTileBacklogPoints; }
   void flush_grid();
   void insert_into_grid(std::int64_t stamp_ns, const Eigen::Vector3f& origin);
+  void drop_revisits(std::int64_t stamp_ns);
   void journal_new_points();
   void tile_file_error(const std::string& problem);
   void follow_level(const Eigen::Vector3d& up, std::int64_t stamp_ns);
@@ -189,6 +193,9 @@ class MappingStage {
   std::vector<double>* grid_ms_ = nullptr;
   std::vector<std::int8_t> grid_cells_;      // one patch, for the sink
   std::vector<Eigen::Vector3f> grid_points_; // a scan placed by the graph's correction, for the grid
+  std::optional<slam::RevisitFilter> revisits_;  // with follow_graph() and map.merge_revisits
+  std::vector<Eigen::Vector3f> earlier_;     // a scan's points where an earlier pass put their place
+  std::vector<std::uint8_t> held_;           // ... and whether the map holds that voxel
   slam::TumWriter map_trajectory_;
   // Per-scan buffers, reserved for the largest scan.
   std::vector<Eigen::Vector3f> points_;

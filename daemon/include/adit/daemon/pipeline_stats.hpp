@@ -84,6 +84,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> tiles_checked_for_loops{0};  // live tiles checked against a new loop correction
   std::atomic<std::uint64_t> tiles_moved_by_loops{0};     // ... and sent again, moved (map.loops_move_map)
   std::atomic<std::uint64_t> points_moved_by_loops{0};    // their points
+  std::atomic<std::uint64_t> revisit_points{0};           // not added: an earlier pass mapped their place (map.merge_revisits)
   std::atomic<std::uint64_t> compacted_tiles{0};      // crowded tiles written out, keeping a bit per voxel
   std::atomic<std::uint64_t> lost_candidates{0};      // voxels hit < min_hits times in evicted tiles
   std::atomic<std::uint64_t> spilled_keyframes{0};    // keyframes whose scan went to keyframes_dir

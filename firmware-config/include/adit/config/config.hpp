@@ -200,6 +200,11 @@ struct MapSection {
   // most on the long drives that close loops); false = the map as the
   // mapping thread placed it, the graph's poses in keyframes.tum only.
   bool loops_move_map = true;
+  // With loops_move_map: a point whose place an earlier pass mapped (by the
+  // graph) is not added again, so a route driven again does not add itself
+  // beside the first pass by the drift (slam/revisit_filter.hpp, decision
+  // 068). false = every pass adds what is new in the odometry's frame.
+  bool merge_revisits = true;
   // With an IMU, the graph lets the keyframes' measured up wander as the
   // accelerometer's bias walks (imu.accel_bias_walk): a loop that closes in
   // height then levels the route (docs/LOOPS.md). false = the ups as measured.

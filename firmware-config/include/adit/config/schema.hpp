@@ -208,6 +208,7 @@ void describe(V& v, MapSection& s) {
   v.optional("refine", s.refine);
   v.optional("loop_closure", s.loop_closure);
   v.optional("loops_move_map", s.loops_move_map);
+  v.optional("merge_revisits", s.merge_revisits);
   v.optional("loops_tilt_walk", s.loops_tilt_walk);
   v.optional("loops_optimize_every_s", s.loops_optimize_every_s, Range<double>{0.0, 600.0});
 }
