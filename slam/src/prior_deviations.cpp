@@ -7,13 +7,6 @@
 #include "adit/slam/voxel_key.hpp"
 
 namespace adit::slam {
-namespace {
-
-struct KeyHash {
-  std::size_t operator()(const VoxelKey& k) const { return voxel_hash(k); }
-};
-
-}  // namespace
 
 std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
                                      std::span<const Eigen::Vector3f> viewpoints, const PriorMap& prior,
@@ -22,7 +15,7 @@ std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
   views.add(viewpoints);
   // The prior's points by cell of max_distance_m: the 27 cells round a point hold every one within reach.
   const float inv = 1.0F / config.max_distance_m;
-  std::unordered_map<VoxelKey, std::vector<std::uint32_t>, KeyHash> cells;
+  std::unordered_map<VoxelKey, std::vector<std::uint32_t>, VoxelKeyHash> cells;
   for (std::size_t i = 0; i < prior.points.size(); ++i) cells[voxel_key(prior.points[i], inv)].push_back(static_cast<std::uint32_t>(i));
   const float reach2 = config.max_distance_m * config.max_distance_m;
   std::vector<float> out(points.size(), config.max_distance_m);
@@ -65,7 +58,7 @@ std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
 
 std::vector<float> smooth_deviations(std::span<const Eigen::Vector3f> points, std::span<const float> deviations,
                                      float voxel_m) {
-  std::unordered_map<VoxelKey, std::pair<double, int>, KeyHash> sums;
+  std::unordered_map<VoxelKey, std::pair<double, int>, VoxelKeyHash> sums;
   const float inv = 1.0F / voxel_m;
   for (std::size_t i = 0; i < points.size(); ++i) {
     auto& [sum, n] = sums[voxel_key(points[i], inv)];
@@ -85,11 +78,11 @@ std::vector<DeviationRegion> deviation_regions(std::span<const Eigen::Vector3f> 
                                                std::span<int> member) {
   std::fill(member.begin(), member.end(), -1);
   // Deviating points by voxel.
-  std::unordered_map<VoxelKey, std::vector<std::size_t>, KeyHash> voxels;
+  std::unordered_map<VoxelKey, std::vector<std::size_t>, VoxelKeyHash> voxels;
   const float inv = 1.0F / config.region_voxel_m;
   for (std::size_t i = 0; i < points.size(); ++i)
     if (std::abs(deviations[i]) > config.threshold_m) voxels[voxel_key(points[i], inv)].push_back(i);
-  std::unordered_map<VoxelKey, int, KeyHash> label;
+  std::unordered_map<VoxelKey, int, VoxelKeyHash> label;
   std::vector<DeviationRegion> regions;
   std::vector<std::vector<std::size_t>> region_points;
   std::vector<VoxelKey> stack;

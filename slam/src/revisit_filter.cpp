@@ -6,27 +6,14 @@
 
 namespace adit::slam {
 
-namespace {
-
-// 21 bits per axis, offset so that ±1 M blocks fit: a block's key.
-std::uint64_t block_key(const Eigen::Vector3f& p, float block_m) {
-  const auto axis = [&](float v) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / block_m)) + (std::int64_t{1} << 20)) &
-           ((std::uint64_t{1} << 21) - 1);
-  };
-  return axis(p.x()) << 42 | axis(p.y()) << 21 | axis(p.z());
-}
-
-}  // namespace
-
 void RevisitFilter::follow(std::shared_ptr<const CorrectionTrack> track) {
   track_ = std::move(track);
   cells_.clear();
   if (track_ == nullptr) return;
   const std::vector<Eigen::Vector3d>& positions = track_->graph_positions();
-  const auto cell_m = static_cast<float>(config_.radius_m);
+  const auto per_cell = static_cast<float>(1.0 / config_.radius_m);
   for (std::size_t k = 0; k < positions.size(); ++k)
-    cells_[block_key(positions[k].cast<float>(), cell_m)].push_back(static_cast<std::uint32_t>(k));
+    cells_[voxel_key(positions[k].cast<float>(), per_cell)].push_back(static_cast<std::uint32_t>(k));
 }
 
 void RevisitFilter::place_in_earlier_pass(std::span<const Eigen::Vector3f> points, std::int64_t stamp_ns,
@@ -37,20 +24,22 @@ void RevisitFilter::place_in_earlier_pass(std::span<const Eigen::Vector3f> point
   const Eigen::Isometry3d now = track_->at(stamp_ns);
   const Eigen::Isometry3f now_f = now.cast<float>();
   const std::int64_t newest = stamp_ns - static_cast<std::int64_t>(std::llround(config_.min_age_s * 1e9));
-  block_keyframe_.clear();
-  to_earlier_.clear();
+  block_transform_.clear();
+  keyframe_transform_.clear();
+  transforms_.clear();
+  const float per_block = 1.0F / config_.block_m;
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite()) continue;
     const Eigen::Vector3f graph_point = now_f * points[i];
-    const std::uint64_t key = block_key(graph_point, config_.block_m);
-    auto [block, inserted] = block_keyframe_.try_emplace(key, -1);
-    if (inserted) block->second = first_pass_keyframe(graph_point, newest);
-    const std::int64_t k = block->second;
-    if (k < 0) continue;
-    auto [transform, fresh] = to_earlier_.try_emplace(k);
-    if (fresh)
-      transform->second = (track_->corrections()[static_cast<std::size_t>(k)].inverse() * now).cast<float>();
-    earlier[i] = transform->second * points[i];
+    auto [block, inserted] = block_transform_.try_emplace(voxel_key(graph_point, per_block), -1);
+    if (inserted) {
+      const std::int64_t k = first_pass_keyframe(graph_point, newest);
+      if (k < 0) continue;
+      auto [transform, fresh] = keyframe_transform_.try_emplace(k, static_cast<std::int32_t>(transforms_.size()));
+      if (fresh) transforms_.push_back((track_->corrections()[static_cast<std::size_t>(k)].inverse() * now).cast<float>());
+      block->second = transform->second;
+    }
+    if (block->second >= 0) earlier[i] = transforms_[static_cast<std::size_t>(block->second)] * points[i];
   }
 }
 
@@ -64,14 +53,12 @@ std::int64_t RevisitFilter::first_pass_keyframe(const Eigen::Vector3f& graph_poi
   const std::vector<Eigen::Vector3d>& positions = track_->graph_positions();
   const std::vector<std::int64_t>& stamps = track_->stamps_ns();
   const double r2 = config_.radius_m * config_.radius_m;
-  const auto cell_m = static_cast<float>(config_.radius_m);
+  const VoxelKey centre = voxel_key(graph_point, static_cast<float>(1.0 / config_.radius_m));
   std::size_t first = positions.size();
   for (int dx = -1; dx <= 1; ++dx)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dz = -1; dz <= 1; ++dz) {
-        const Eigen::Vector3f probe =
-            graph_point + cell_m * Eigen::Vector3f(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
-        const auto cell = cells_.find(block_key(probe, cell_m));
+        const auto cell = cells_.find({centre.x + dx, centre.y + dy, centre.z + dz});
         if (cell == cells_.end()) continue;
         for (const std::uint32_t k : cell->second) {
           if (k >= first || stamps[k] > newest_ns) break;

@@ -36,6 +36,7 @@
 #include <Eigen/Geometry>
 
 #include "adit/slam/correction_track.hpp"
+#include "adit/slam/voxel_key.hpp"
 
 namespace adit::slam {
 
@@ -71,9 +72,12 @@ class RevisitFilter {
   RevisitConfig config_;
   std::shared_ptr<const CorrectionTrack> track_;
   // The track's keyframes by their graph position, in radius_m cubes, oldest first.
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
-  std::unordered_map<std::uint64_t, std::int64_t> block_keyframe_;  // block → keyframe, −1: none
-  std::unordered_map<std::int64_t, Eigen::Isometry3f> to_earlier_;  // keyframe → C(t_k)⁻¹·C(t)
+  std::unordered_map<VoxelKey, std::vector<std::uint32_t>, VoxelKeyHash> cells_;
+  // This scan's: per block of points its index in transforms_ (−1: no
+  // earlier pass), per keyframe the same, and each keyframe's C(t_k)⁻¹·C(t).
+  std::unordered_map<VoxelKey, std::int32_t, VoxelKeyHash> block_transform_;
+  std::unordered_map<std::int64_t, std::int32_t> keyframe_transform_;
+  std::vector<Eigen::Isometry3f> transforms_;
 };
 
 }  // namespace adit::slam

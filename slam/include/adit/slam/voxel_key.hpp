@@ -2,6 +2,7 @@
 // Integer voxel coordinates of a point and their spatial hash.
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -35,5 +36,10 @@ inline std::uint32_t voxel_hash(const VoxelKey& key) {
   return (static_cast<std::uint32_t>(key.x) * 73856093U) ^ (static_cast<std::uint32_t>(key.y) * 19349663U) ^
          (static_cast<std::uint32_t>(key.z) * 83492791U);
 }
+
+// voxel_hash for std::unordered_map.
+struct VoxelKeyHash {
+  std::size_t operator()(const VoxelKey& key) const { return voxel_hash(key); }
+};
 
 }  // namespace adit::slam
