@@ -172,31 +172,59 @@ std::optional<MapFrame> stored_session_frame(const std::filesystem::path& dir) {
   return map_frame_of(export_frame(anchor, level), correction);
 }
 
-bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
-                           const slam::CorrectionTrack* track) {
+namespace {
+
+// `file`'s poses while it is not placed yet (a first line kPlacedPrefix
+// says it is: nullopt); throws as place_trajectory_file says. `file` exists.
+std::optional<slam::Trajectory> read_unplaced(const std::filesystem::path& file) {
   std::ifstream in(file);
-  if (!in) {
-    if (!std::filesystem::exists(file)) return false;
-    throw InputError(file.string(), "", "cannot be read");
-  }
-  if (track != nullptr && track->empty()) track = nullptr;
-  if (frame.source == ExportSource::odometry && track == nullptr) return true;  // nothing to move
+  if (!in) throw InputError(file.string(), "", "cannot be read");
   std::string first;
   std::getline(in, first);
-  if (first.starts_with(kPlacedPrefix)) return true;
+  if (first.starts_with(kPlacedPrefix)) return std::nullopt;
   in.clear();
   in.seekg(0);
-  slam::Trajectory t = slam::read_tum(in, file);
+  return slam::read_tum(in, file);
+}
+
+}  // namespace
+
+bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
+                           const slam::CorrectionTrack* track) {
+  if (!std::filesystem::exists(file)) return false;
+  if (track != nullptr && track->empty()) track = nullptr;
+  if (frame.source == ExportSource::odometry && track == nullptr) return true;  // nothing to move
+  std::optional<slam::Trajectory> t = read_unplaced(file);
+  if (!t) return true;
   const Eigen::Isometry3d& a = frame.from_odometry;
-  for (std::size_t i = 0; i < t.poses.size(); ++i) {
-    const auto stamp_ns = static_cast<std::int64_t>(std::llround(t.stamps[i] * 1e9));
-    t.poses[i] = track != nullptr ? a * track->at(stamp_ns) * t.poses[i] : a * t.poses[i];
+  for (std::size_t i = 0; i < t->poses.size(); ++i) {
+    const auto stamp_ns = static_cast<std::int64_t>(std::llround(t->stamps[i] * 1e9));
+    t->poses[i] = track != nullptr ? a * track->at(stamp_ns) * t->poses[i] : a * t->poses[i];
   }
   std::ostringstream out;
   out << placed_line(frame.source, track != nullptr) << "\n# timestamp tx ty tz qx qy qz qw\n";
-  slam::write_tum(out, t);
+  slam::write_tum(out, *t);
   write_durably(file, out.str());
   return true;
+}
+
+void place_session_trajectories(const std::filesystem::path& dir, const ExportFrame& frame,
+                                const slam::CorrectionTrack* track) {
+  const std::filesystem::path map_poses = dir / "map_trajectory.tum";
+  const std::filesystem::path odometry = dir / "trajectory.tum";
+  // The odometry's first: its track is made from the map's poses as they
+  // were built, before they are placed.
+  std::optional<slam::Trajectory> built_at;
+  if (track != nullptr && !track->empty() && std::filesystem::exists(map_poses)) built_at = read_unplaced(map_poses);
+  if (built_at && std::filesystem::exists(odometry)) {
+    if (const std::optional<slam::Trajectory> poses = read_unplaced(odometry)) {
+      const slam::CorrectionTrack moved = slam::retargeted(*track, *built_at, *poses);
+      place_trajectory_file(odometry, frame, &moved);
+    }
+  } else {
+    place_trajectory_file(odometry, frame, track);
+  }
+  place_trajectory_file(map_poses, frame, track);
 }
 
 nlohmann::json frame_summary(const ExportFrame& frame) {

@@ -516,8 +516,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
       keyframes.poses.push_back(placed_by * (graph != nullptr && i < graph->size() ? (*graph)[i] : k.pose));
     }
     // The trajectories as the map files: moved by the graph, in the export frame.
-    for (const char* f : {"trajectory.tum", "map_trajectory.tum"})
-      place_trajectory_file(dir / f, frame, corrected ? &track : nullptr);
+    place_session_trajectories(dir, frame, corrected ? &track : nullptr);
     slam::write_tum(dir / "keyframes.tum", keyframes);
     files.push_back("keyframes.tum");
     std::uintmax_t grid_bytes = 0;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "adit/slam/trajectory_interpolate.hpp"
+
 namespace adit::slam {
 
 CorrectionTrack::CorrectionTrack(std::span<const std::int64_t> stamps_ns, std::span<const Eigen::Isometry3d> graph,
@@ -111,6 +113,25 @@ CorrectionTrack CorrectionTrack::slice_for(std::span<const MapSample> samples) c
     slice.steps_.push_back(next == k + 1 ? steps_[k] : log_se3(corrections_[k].inverse() * corrections_[next]));
   }
   return slice;
+}
+
+CorrectionTrack retargeted(const CorrectionTrack& track, const Trajectory& built_at, const Trajectory& poses) {
+  if (track.empty() || built_at.empty()) return {};
+  std::vector<std::int64_t> stamps;
+  std::vector<Eigen::Isometry3d> graph;
+  std::vector<Eigen::Isometry3d> odometry;
+  stamps.reserve(poses.size());
+  graph.reserve(poses.size());
+  odometry.reserve(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto stamp_ns = static_cast<std::int64_t>(std::llround(poses.stamps[i] * 1e9));
+    if (!stamps.empty() && stamp_ns <= stamps.back()) continue;  // a repeated stamp: the first pose stands
+    const double t = std::clamp(poses.stamps[i], built_at.stamps.front(), built_at.stamps.back());
+    stamps.push_back(stamp_ns);
+    graph.push_back(track.at(stamp_ns) * interpolate_pose(built_at, t).value_or(built_at.poses.front()));
+    odometry.push_back(poses.poses[i]);
+  }
+  return CorrectionTrack(stamps, graph, odometry);
 }
 
 double CorrectionTrack::max_translation_m() const {

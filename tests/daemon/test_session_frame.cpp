@@ -207,6 +207,49 @@ TEST(SessionFrame, ATrajectoryIsMovedByTheGraphsCorrectionAsTheMapIs) {
   }
 }
 
+// The odometry's trajectory.tum is not the path the map was built at
+// (map_trajectory.tum: the refinement moved it), and the graph's correction
+// is against the latter: both files end where the graph put the map's poses.
+TEST(SessionFrame, BothTrajectoriesEndWhereTheGraphPutTheMapsPoses) {
+  const test::TempFolder dir;
+  slam::Trajectory built_at;
+  slam::Trajectory odometry;
+  std::vector<std::int64_t> stamps_ns;
+  for (int i = 0; i < 6; ++i) {
+    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+    m.linear() = Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    m.translation() = Eigen::Vector3d(1.0 * i, 0.2 * i, 0.0);
+    stamps_ns.push_back(1'700'000'000'000'000'000 + 100'000'000LL * i);
+    const double t = 1e-9 * static_cast<double>(stamps_ns.back());
+    built_at.push_back(t, m);
+    m.translation().z() += 0.05 * i;  // the odometry climbs; the map's refinement held it level
+    odometry.push_back(t, m);
+  }
+  Eigen::Isometry3d last = built_at.poses[5];
+  last.translation() += Eigen::Vector3d(0.1, -0.3, 0.02);
+  const std::vector<std::int64_t> keyframes{stamps_ns[0], stamps_ns[5]};
+  const std::vector<Eigen::Isometry3d> graph{built_at.poses[0], last};
+  const std::vector<Eigen::Isometry3d> map_keyframes{built_at.poses[0], built_at.poses[5]};
+  const slam::CorrectionTrack track(keyframes, graph, map_keyframes);
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.linear() = Eigen::AngleAxisd(0.4 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const ExportFrame frame = export_frame(std::nullopt, level);
+  slam::write_tum(dir.path() / "trajectory.tum", odometry);
+  slam::write_tum(dir.path() / "map_trajectory.tum", built_at);
+  place_session_trajectories(dir.path(), frame, &track);
+  place_session_trajectories(dir.path(), frame, &track);  // again (a recovery): unchanged
+  for (const char* name : {"trajectory.tum", "map_trajectory.tum"}) {
+    const slam::Trajectory back = slam::read_tum(dir.path() / name);
+    ASSERT_EQ(back.size(), built_at.size()) << name;
+    for (std::size_t i = 0; i < back.size(); ++i) {
+      const Eigen::Isometry3d want = level * track.at(stamps_ns[i]) * built_at.poses[i];
+      EXPECT_LT((want.translation() - back.poses[i].translation()).norm(), 2e-6) << name << " " << i;
+      EXPECT_TRUE(want.linear().isApprox(back.poses[i].linear(), 1e-6)) << name << " " << i;
+    }
+    EXPECT_LT(((level * last).translation() - back.poses[5].translation()).norm(), 2e-6) << name;
+  }
+}
+
 TEST(SessionFrame, TheMapCornerStaysBelowAMovedMap) {
   const std::vector<slam::TileCoord> coords{{0, 0, 0}, {1, 2, 0}, {-1, 0, 1}};
   const double tile = 20.0;

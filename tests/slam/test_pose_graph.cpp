@@ -188,6 +188,33 @@ TEST(CorrectionTrack, InterpolatesBetweenKeyframesAndHoldsBeyond) {
   EXPECT_NEAR(track.max_rotation_rad(), 0.1, 1e-9);
 }
 
+// The odometry's poses P differ from those the map was built at, M (the
+// map's refinement moved them): retargeted, the track takes each P(t) to
+// C(t)·M(t), where the graph put the map's pose, between and beyond the keyframes.
+TEST(CorrectionTrack, RetargetedTakesOtherPosesWhereTheGraphPutTheMapsPose) {
+  const std::vector<std::int64_t> keyframes{1'000'000'000, 3'000'000'000};
+  const std::vector<Eigen::Isometry3d> map_keyframes{pose(0, 0, 0), pose(20, 0, 0.1)};
+  const CorrectionTrack track(keyframes, std::vector{pose(0, 0, 0), pose(20, 0.4, 0.12)}, map_keyframes);
+  Trajectory built_at;
+  Trajectory odometry;
+  for (int i = 0; i <= 8; ++i) {  // 0.5 s apart from 0.5 s to 4.5 s: before, between and beyond the keyframes
+    const double t = 0.5 * (i + 1);
+    built_at.push_back(t, pose(10.0 * (t - 1.0), 0.0, 0.05 * (t - 1.0)));
+    Eigen::Isometry3d p = built_at.poses.back();
+    p.translation().z() += 0.1 * t;  // the odometry climbed where the map did not
+    odometry.push_back(t, p);
+  }
+  const CorrectionTrack moved = retargeted(track, built_at, odometry);
+  for (std::size_t i = 0; i < odometry.size(); ++i) {
+    const auto ns = static_cast<std::int64_t>(std::llround(odometry.stamps[i] * 1e9));
+    const Eigen::Isometry3d want = track.at(ns) * built_at.poses[i];
+    EXPECT_TRUE((moved.at(ns) * odometry.poses[i]).isApprox(want, 1e-9)) << i;
+    EXPECT_GT(((track.at(ns) * odometry.poses[i]).translation() - want.translation()).norm(), 0.04) << i;
+  }
+  EXPECT_TRUE(retargeted(track, Trajectory{}, odometry).empty());
+  EXPECT_TRUE(retargeted(CorrectionTrack{}, built_at, odometry).empty());
+}
+
 // The live tiles follow the graph: a sample moves by the correction at its
 // scan's time; a tile is sent again when a new correction moves any of its
 // samples by more than the threshold.

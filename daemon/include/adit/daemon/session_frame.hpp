@@ -60,6 +60,15 @@ std::optional<Eigen::Isometry3d> read_level_frame(const std::filesystem::path& f
 bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
                            const slam::CorrectionTrack* track = nullptr);
 
+// A finished session's two trajectories in `dir` placed as its map files:
+// map_trajectory.tum (the poses the map was built at, M) by `track`'s C(t),
+// trajectory.tum (the odometry's, P, which the map's refinement moved to M)
+// by slam::retargeted: each pose to A·C(t)·M(t), where the graph put the
+// map's pose. Without `track` (or when map_trajectory.tum is placed already
+// or missing) both as place_trajectory_file does.
+void place_session_trajectories(const std::filesystem::path& dir, const ExportFrame& frame,
+                                const slam::CorrectionTrack* track);
+
 // The graph's last correction C (graph <- odometry), written durably into
 // tiles_graph/; read back as read_prior_frame reads the anchor.
 void write_graph_correction(const std::filesystem::path& file, const Eigen::Isometry3d& graph_from_odometry);

@@ -14,6 +14,7 @@
 
 #include "adit/slam/lie.hpp"
 #include "adit/slam/tiled_map.hpp"
+#include "adit/slam/trajectory.hpp"
 
 namespace adit::slam {
 
@@ -47,6 +48,16 @@ class CorrectionTrack {
   std::vector<Eigen::Isometry3d> corrections_;
   std::vector<Vector6d> steps_;  // log(C_k⁻¹·C_k+1)
 };
+
+// `track`, made against the poses the map was built at (`built_at`, M), for
+// other poses of the same motion (`poses`, P: the odometry's, which the map's
+// refinement moved to M): at each of their stamps t the correction
+// C(t)·M(t)·P(t)⁻¹, M interpolated between built_at's poses and held beyond
+// its ends, so P(t) goes where the graph put the map's pose at t. `track`
+// alone would move P(t) by C(t) and keep the refinement's difference
+// M(t)·P(t)⁻¹ out (tenths of a metre after a few minutes). Empty when
+// `track` or `built_at` is.
+CorrectionTrack retargeted(const CorrectionTrack& track, const Trajectory& built_at, const Trajectory& poses);
 
 // The map following the graph: `in` into `out`, each sample moved by
 // placed_by·C(t) at its scan's time t (C: `track`, identity when null). The
