@@ -95,8 +95,13 @@ void MappingStage::spill_to(const std::filesystem::path& tiles_dir, const std::f
 }
 
 std::optional<Eigen::Isometry3d> MappingStage::level() const {
-  const std::lock_guard lock(level_mutex_);
+  const std::lock_guard lock(frame_mutex_);
   return level_;
+}
+
+Eigen::Isometry3d MappingStage::refinement() const {
+  const std::lock_guard lock(frame_mutex_);
+  return refinement_;
 }
 
 void MappingStage::follow_level(const Eigen::Vector3d& up, std::int64_t stamp_ns) {
@@ -116,7 +121,7 @@ void MappingStage::keep_level() {
   try {
     const Eigen::Isometry3d level = slam::level_from_up(*latest_up_);
     {
-      const std::lock_guard lock(level_mutex_);
+      const std::lock_guard lock(frame_mutex_);
       level_ = level;
     }
     if (!level_file_.empty()) write_level_frame(level_file_, level);
@@ -125,7 +130,7 @@ void MappingStage::keep_level() {
     level_off_ = true;
     std::error_code ignored;  // the exports stay unlevelled, as the recovery's would
     if (!level_file_.empty()) std::filesystem::remove(level_file_, ignored);
-    const std::lock_guard lock(level_mutex_);
+    const std::lock_guard lock(frame_mutex_);
     level_.reset();
   }
 }
@@ -207,6 +212,10 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   // the scans before it (slam::MapRefiner says why).
   const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;
   map_trajectory_.write(slot.stamp_ns, map_pose);
+  if (refiner_) {
+    const std::lock_guard lock(frame_mutex_);
+    refinement_ = map_pose * slot.pose.inverse();
+  }
   if (journal_ != nullptr) journal_->map_pose(slot.stamp_ns, map_pose);
   const bool keyframe = keyframe_selector_.take(map_pose);
   if (keyframe) {

@@ -256,6 +256,9 @@ std::vector<StageLoad> Pipeline::loads() const {
 std::optional<Eigen::Isometry3d> Pipeline::level() const {
   return impl_->mapping ? impl_->mapping->level() : std::nullopt;
 }
+Eigen::Isometry3d Pipeline::refinement() const {
+  return impl_->mapping ? impl_->mapping->refinement() : Eigen::Isometry3d::Identity();
+}
 const slam::LiveGrid* Pipeline::grid() const { return impl_->mapping ? impl_->mapping->grid() : nullptr; }
 
 const slam::TiledVoxelMap& Pipeline::map() const { return impl_->mapping ? impl_->mapping->map() : impl_->empty_map; }

@@ -144,10 +144,12 @@ ExportFrame export_frame(const std::optional<Eigen::Isometry3d>& anchor, const s
   return {};
 }
 
-std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optional<Eigen::Isometry3d>& correction) {
-  if (base.source == ExportSource::odometry && !correction) return std::nullopt;
+std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optional<Eigen::Isometry3d>& correction,
+                                     const Eigen::Isometry3d& refinement) {
+  const bool refined = !refinement.isApprox(Eigen::Isometry3d::Identity(), 1e-12);
+  if (base.source == ExportSource::odometry && !correction && !refined) return std::nullopt;
   const Eigen::Isometry3d& tiles = base.from_odometry;
-  const Eigen::Isometry3d odometry = correction ? tiles * *correction : tiles;
+  const Eigen::Isometry3d odometry = (correction ? tiles * *correction : tiles) * refinement;
   const auto put = [](const Eigen::Isometry3d& t, std::array<double, 3>& p, std::array<double, 4>& q) {
     const Eigen::Quaterniond r(t.linear());
     p = {t.translation().x(), t.translation().y(), t.translation().z()};
@@ -156,7 +158,8 @@ std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optiona
   MapFrame f;
   f.source = base.source == ExportSource::prior_map ? kFrameSourcePriorMap
              : base.source == ExportSource::level   ? kFrameSourceLevel
-                                                    : kFrameSourceLoops;
+             : correction                           ? kFrameSourceLoops
+                                                    : kFrameSourceOdometry;
   put(odometry, f.position, f.orientation);
   put(tiles, f.tiles_position, f.tiles_orientation);
   return f;

@@ -90,13 +90,15 @@ nlohmann::json prior_summary(const PriorLocaliser* prior, const std::string& sou
 // The running session's map frame for frame_t: the prior's once found, else
 // gravity's level once the odometry has an up (`level`), the tiles placed by
 // the graph's latest correction when they follow it (`loops`:
-// map.loops_move_map; map_frame.hpp).
+// map.loops_move_map), the poses by the map's `refinement` of the odometry
+// (map_frame.hpp).
 MapFrame session_frame(const PriorLocaliser* prior, const std::optional<Eigen::Isometry3d>& level,
-                       const LoopClosureStage* loops) {
+                       const LoopClosureStage* loops, const Eigen::Isometry3d& refinement) {
   const std::shared_ptr<const slam::CorrectionTrack> track = loops != nullptr ? loops->live().latest() : nullptr;
   const std::optional<Eigen::Isometry3d> anchor = prior != nullptr ? prior->anchor() : std::nullopt;
   return map_frame_of(export_frame(anchor, anchor ? std::nullopt : level),
-                      track != nullptr && !track->empty() ? std::optional(track->corrections().back()) : std::nullopt)
+                      track != nullptr && !track->empty() ? std::optional(track->corrections().back()) : std::nullopt,
+                      refinement)
       .value_or(MapFrame{});
 }
 
@@ -811,7 +813,7 @@ StatusSample Sessions::status_sample() {
   last_datagrams_ = datagrams;
   const LoopClosureStage* loops = pipeline_->loop_closure();
   const LoopClosureStage* moving = config_.map.loops_move_map ? loops : nullptr;
-  sample.frame = session_frame(pipeline_->prior_localiser(), pipeline_->level(), moving);
+  sample.frame = session_frame(pipeline_->prior_localiser(), pipeline_->level(), moving, pipeline_->refinement());
   if (moving != nullptr) sample.graph = moving->live().latest();
   if (loops != nullptr) sample.loops = loop_status_of(s, loops->live().latest().get(), moving != nullptr);
   sample.fault = session_faults(s, datagrams, imu_source, sample.disk_free_bytes);

@@ -250,6 +250,33 @@ TEST(SessionFrame, BothTrajectoriesEndWhereTheGraphPutTheMapsPoses) {
   }
 }
 
+// frame_t's map <- odometry is A·C·D: the poses land among the tiles, which
+// hold the scans at the refined poses; map <- tiles stays A.
+TEST(SessionFrame, ThePosesArePlacedByTheMapsRefinement) {
+  Eigen::Isometry3d refinement = Eigen::Isometry3d::Identity();
+  refinement.translation() = Eigen::Vector3d(0.02, -0.01, -0.4);
+  refinement.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  correction.translation() = Eigen::Vector3d(0.3, 0.0, 0.1);
+  const auto odometry_of = [](const MapFrame& f) {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.translation() = Eigen::Vector3d(f.position[0], f.position[1], f.position[2]);
+    t.linear() = Eigen::Quaterniond(f.orientation[0], f.orientation[1], f.orientation[2], f.orientation[3]).toRotationMatrix();
+    return t;
+  };
+  EXPECT_FALSE(map_frame_of(ExportFrame{}, std::nullopt).has_value());
+  const std::optional<MapFrame> own = map_frame_of(ExportFrame{}, std::nullopt, refinement);
+  ASSERT_TRUE(own.has_value()) << "the refinement alone moves the poses";
+  EXPECT_EQ(own->source, kFrameSourceOdometry);
+  EXPECT_TRUE(odometry_of(*own).isApprox(refinement, 1e-9));
+  EXPECT_EQ(own->tiles_position, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  const ExportFrame anchored = export_frame(sample_anchor(), std::nullopt);
+  const std::optional<MapFrame> all = map_frame_of(anchored, correction, refinement);
+  ASSERT_TRUE(all.has_value());
+  EXPECT_TRUE(odometry_of(*all).isApprox(sample_anchor() * correction * refinement, 1e-9));
+  EXPECT_NEAR(all->tiles_position[2], sample_anchor().translation().z(), 1e-12);
+}
+
 TEST(SessionFrame, TheMapCornerStaysBelowAMovedMap) {
   const std::vector<slam::TileCoord> coords{{0, 0, 0}, {1, 2, 0}, {-1, 0, 1}};
   const double tile = 20.0;

@@ -6,7 +6,10 @@
 // else the odometry's own; the tiles are in the odometry frame, or in the
 // pose graph's when the loop closure moves the map (map.loops_move_map),
 // which the graph's latest correction C places: map <- tiles = A,
-// map <- odometry = A·C (docs/LOOPS.md, "Live tiles").
+// map <- odometry = A·C·D (docs/LOOPS.md, "Live tiles"). D is the map's
+// refinement of the odometry at the latest scan mapped (M·O⁻¹: the tiles are
+// built at the refined poses M, the poses published are the odometry's O;
+// slam::MapRefiner), so a pose lands where its scan went into the tiles.
 
 #include <array>
 #include <cstdint>
@@ -39,8 +42,10 @@ struct ExportFrame {
 ExportFrame export_frame(const std::optional<Eigen::Isometry3d>& anchor, const std::optional<Eigen::Isometry3d>& level);
 
 // The frame of a session placed by `base` (A: the prior's anchor or
-// gravity's level) and whose tiles the graph's `correction` (C, the latest)
-// moved; nullopt when it has neither (the odometry's own frame).
-std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optional<Eigen::Isometry3d>& correction);
+// gravity's level), whose tiles the graph's `correction` (C, the latest)
+// moved and whose poses the map's `refinement` (D) places among its tiles;
+// nullopt when it has none of them (the odometry's own frame).
+std::optional<MapFrame> map_frame_of(const ExportFrame& base, const std::optional<Eigen::Isometry3d>& correction,
+                                     const Eigen::Isometry3d& refinement = Eigen::Isometry3d::Identity());
 
 }  // namespace adit::daemon

@@ -69,6 +69,11 @@ class MappingStage {
   static constexpr double kLevelPeriodS = 2.0;
   // Any thread: the level last kept (slam::level_from_up of the odometry's up); nullopt before.
   std::optional<Eigen::Isometry3d> level() const;
+  // Any thread: M·O⁻¹ at the last scan mapped, its map pose M (refined,
+  // slam::MapRefiner) against its odometry pose O; identity before one. The
+  // tiles hold the scans at M, the poses are published at O: this places a
+  // pose among the tiles (frame_t, map_frame.hpp).
+  Eigen::Isometry3d refinement() const;
   // Before start(): each keyframe also goes to `loops` (the loop-closure stage's queue).
   void feed_loops(KeyframeQueue* loops) { loops_ = loops; }
   // Before start(): the tiles sent go placed by the loop closure's latest
@@ -163,8 +168,11 @@ class MappingStage {
   std::optional<Eigen::Vector3d> kept_up_;    // the one level_ was made from
   std::int64_t kept_up_ns_ = 0;
   bool level_off_ = false;  // keeping it failed: the session stays in the odometry frame
-  mutable std::mutex level_mutex_;            // kept a few times a session, read by the status at 2 Hz
+  // The level (kept a few times a session) and the refinement (every scan),
+  // read by the status at 2 Hz.
+  mutable std::mutex frame_mutex_;
   std::optional<Eigen::Isometry3d> level_;
+  Eigen::Isometry3d refinement_ = Eigen::Isometry3d::Identity();
   std::size_t keyframes_in_ram_from_ = 0; // keyframes before this one had their scans written out
   std::uint64_t keyframe_bytes_ = 0;
   KeyframeQueue* loops_ = nullptr;

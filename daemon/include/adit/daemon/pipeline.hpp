@@ -117,6 +117,9 @@ class Pipeline {
   // Any thread: gravity's level as the mapping thread last kept it
   // (MappingStage::level); nullopt before the odometry had an up, or without one.
   std::optional<Eigen::Isometry3d> level() const;
+  // Any thread: the map's refinement of the odometry at the last scan mapped
+  // (MappingStage::refinement); identity without a mapping stage.
+  Eigen::Isometry3d refinement() const;
   // The live 2D grid (grid.enabled), complete after join(); null without it.
   const slam::LiveGrid* grid() const;
   // The loop-closure stage (map.loop_closure), complete after join(); null without it.
