@@ -85,6 +85,7 @@ std::size_t fill_line_of_sight(Grid2d& g, std::span<const Eigen::Vector3f> viewp
       const double a = 2 * M_PI * k / rays, dx = std::cos(a), dy = std::sin(a);
       cells.clear();
       bool bounded = false;
+      std::size_t seen = 0;  // cells up to the last one already free
       // Every cell the ray crosses, in order (Amanatides and Woo, "A fast voxel
       // traversal algorithm for ray tracing", Eurographics 1987): t is the
       // distance along the ray in cells, t_c and t_r where it next crosses a
@@ -102,6 +103,7 @@ std::size_t fill_line_of_sight(Grid2d& g, std::span<const Eigen::Vector3f> viewp
           break;
         }
         cells.push_back(k2);
+        if (g.cells[k2] == kFree) seen = cells.size();
         if (t_c < t_r) {
           t = t_c;
           t_c += delta_c;
@@ -112,7 +114,9 @@ std::size_t fill_line_of_sight(Grid2d& g, std::span<const Eigen::Vector3f> viewp
           r += step_r;
         }
       }
-      if (!bounded) continue;
+      // A ray that met no obstacle (through a sparse far wall, a door) fills
+      // only up to the last cell already seen free along it.
+      if (!bounded) cells.resize(seen);
       for (const std::size_t k2 : cells)
         if (g.cells[k2] == kUnknown) {
           g.cells[k2] = kFree;

@@ -1,5 +1,6 @@
-// The 2D line-of-sight fill: free up to an observed obstacle, nothing where a
-// ray leaves without meeting one, and every cell a ray crosses.
+// The 2D line-of-sight fill: free up to an observed obstacle; where a ray
+// leaves without meeting one, free only up to the last cell already seen free
+// on it; every cell a ray crosses.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -30,6 +31,21 @@ TEST(LineOfSightFill, FreeUpToTheWallAndNothingWhereRaysMeetNone) {
   EXPECT_EQ(g.at(g.col_of(9.0), g.row_of(5.0)), kUnknown);   // behind it
   EXPECT_EQ(g.at(g.col_of(1.0), g.row_of(5.0)), kUnknown);   // away from it: the ray leaves the grid unbounded
   EXPECT_EQ(g.at(g.col_of(5.0), g.row_of(9.5)), kUnknown);   // past the wall's end
+}
+
+// A ray through a gap (a door, a sparse far wall) meets no obstacle: it fills
+// the unknown cells between free ones it crosses, and nothing past the last.
+TEST(LineOfSightFill, AnUnboundedRayFillsOnlyUpToTheLastCellSeenFree) {
+  Grid2d g = walled();
+  const int row = g.row_of(9.0);  // past the wall's end: the ray along y = 9 m meets nothing
+  g.at(g.col_of(4.0), row) = kFree;
+  g.at(g.col_of(6.0), row) = kFree;  // the last seen free on it
+  const std::vector<Eigen::Vector3f> view{{2.0F, 9.0F, 0.5F}};
+  fill_line_of_sight(g, view, 40.0, 1.0);
+  EXPECT_EQ(g.at(g.col_of(3.0), row), kFree);
+  EXPECT_EQ(g.at(g.col_of(5.0), row), kFree);
+  EXPECT_EQ(g.at(g.col_of(7.0), row), kUnknown);
+  EXPECT_EQ(g.at(g.col_of(1.0), row), kUnknown);  // the other way nothing was seen
 }
 
 TEST(LineOfSightFill, ARayCrossesEveryCellOnItsWay) {
