@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "adit/daemon/mapping_stage.hpp"
+#include "map_slots.hpp"
 
 namespace adit::daemon {
 namespace {
@@ -94,13 +95,7 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   config.map.merge_revisits = run.merge_revisits;
   std::atomic<bool> stop{false};
   constexpr std::size_t kMaxPoints = 2000;
-  Handoff<MapSlot> scans(4, Overflow::wait, [] {
-    MapSlot s;
-    s.points.reserve(kMaxPoints);
-    s.times_s.reserve(kMaxPoints);
-    s.intensities.reserve(kMaxPoints);
-    return s;
-  });
+  Handoff<MapSlot> scans(4, Overflow::wait, test::map_slot_with_room(kMaxPoints));
   CorrectionBoard board;
   MappingStage stage(
       config, slam::OdometryConfig{}, scans, kMaxPoints,

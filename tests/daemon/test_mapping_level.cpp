@@ -13,6 +13,7 @@
 #include "adit/daemon/session_frame.hpp"
 #include "adit/slam/levelling.hpp"
 #include "adit/slam/map_refiner.hpp"
+#include "map_slots.hpp"
 #include "temp_file.hpp"
 
 namespace adit::daemon {
@@ -133,13 +134,7 @@ TEST(MappingLevel, TheRefinementTakesTheOdometrysPoseToTheMapsPose) {
     }
   std::atomic<bool> stop{false};
   PipelineStats stats;
-  Handoff<MapSlot> scans(4, Overflow::wait, [] {
-    MapSlot s;
-    s.points.reserve(kMaxPoints);
-    s.times_s.reserve(kMaxPoints);
-    s.intensities.reserve(kMaxPoints);
-    return s;
-  });
+  Handoff<MapSlot> scans(4, Overflow::wait, test::map_slot_with_room(kMaxPoints));
   config::Config config;
   config.grid.enabled = false;
   ASSERT_TRUE(config.map.refine);

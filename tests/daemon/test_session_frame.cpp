@@ -154,21 +154,27 @@ TEST(SessionFrame, ATrajectoryIsMovedIntoThePriorsFrameOnce) {
   }
 }
 
+// `n` poses 0.1 s apart, turning by `yaw` rad and moving by `step` a pose,
+// and their stamps (ns).
+slam::Trajectory turning_path(int n, double yaw, const Eigen::Vector3d& step, std::vector<std::int64_t>& stamps_ns) {
+  slam::Trajectory t;
+  for (int i = 0; i < n; ++i) {
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.linear() = Eigen::AngleAxisd(yaw * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    p.translation() = step * i;
+    stamps_ns.push_back(1'700'000'000'000'000'000 + 100'000'000LL * i);
+    t.push_back(1e-9 * static_cast<double>(stamps_ns.back()), p);
+  }
+  return t;
+}
+
 // With loop closure the map files are moved by the graph's correction C(t)
 // (slam::CorrectionTrack); the trajectories go with them, then into the
 // prior's frame when anchored: anchor·C(t)·T, once.
 TEST(SessionFrame, ATrajectoryIsMovedByTheGraphsCorrectionAsTheMapIs) {
   const test::TempFolder dir;
-  slam::Trajectory t;
   std::vector<std::int64_t> stamps_ns;
-  for (int i = 0; i < 5; ++i) {
-    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
-    p.linear() = Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    p.translation() = Eigen::Vector3d(0.5 * i, 0.1 * i, 0.0);
-    stamps_ns.push_back(1'700'000'000'000'000'000 + 100'000'000LL * i);
-    t.stamps.push_back(1e-9 * static_cast<double>(stamps_ns.back()));
-    t.poses.push_back(p);
-  }
+  const slam::Trajectory t = turning_path(5, 0.1, Eigen::Vector3d(0.5, 0.1, 0.0), stamps_ns);
   // Keyframes 0 and 4: the graph levelled the first (pitched 0.3°) and moved the last 0.2 m up.
   Eigen::Isometry3d first = t.poses[0];
   first.linear() = Eigen::AngleAxisd(0.3 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix() * first.linear();
@@ -212,19 +218,11 @@ TEST(SessionFrame, ATrajectoryIsMovedByTheGraphsCorrectionAsTheMapIs) {
 // is against the latter: both files end where the graph put the map's poses.
 TEST(SessionFrame, BothTrajectoriesEndWhereTheGraphPutTheMapsPoses) {
   const test::TempFolder dir;
-  slam::Trajectory built_at;
-  slam::Trajectory odometry;
   std::vector<std::int64_t> stamps_ns;
-  for (int i = 0; i < 6; ++i) {
-    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-    m.linear() = Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    m.translation() = Eigen::Vector3d(1.0 * i, 0.2 * i, 0.0);
-    stamps_ns.push_back(1'700'000'000'000'000'000 + 100'000'000LL * i);
-    const double t = 1e-9 * static_cast<double>(stamps_ns.back());
-    built_at.push_back(t, m);
-    m.translation().z() += 0.05 * i;  // the odometry climbs; the map's refinement held it level
-    odometry.push_back(t, m);
-  }
+  const slam::Trajectory built_at = turning_path(6, 0.05, Eigen::Vector3d(1.0, 0.2, 0.0), stamps_ns);
+  slam::Trajectory odometry = built_at;
+  for (std::size_t i = 0; i < odometry.size(); ++i)
+    odometry.poses[i].translation().z() += 0.05 * static_cast<double>(i);  // it climbs; the refinement held the map level
   Eigen::Isometry3d last = built_at.poses[5];
   last.translation() += Eigen::Vector3d(0.1, -0.3, 0.02);
   const std::vector<std::int64_t> keyframes{stamps_ns[0], stamps_ns[5]};
