@@ -129,9 +129,12 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
       }
       // The loop closure's progress (loop_status_t) goes with every status.
       EXPECT_TRUE(status.loops.has_value());
-      if (status.frame->position != status.frame->tiles_position) {
+      // With a correction the graph's path (graph_path_t) goes with it. (The
+      // poses' transform differs from the tiles' from the first scan on: it
+      // carries the map's refinement too, map_frame.hpp.)
+      if (status.graph != nullptr) {
         ++frames_with_correction;
-        EXPECT_NE(status.graph, nullptr) << "the graph's path (graph_path_t) goes with its correction";
+        EXPECT_NE(status.frame->position, status.frame->tiles_position);
         if (status.loops) {
           EXPECT_GT(status.loops->accepted, 0) << "a correction comes from a loop";
           EXPECT_GT(status.loops->last_loop_utime, 0);
