@@ -190,6 +190,21 @@ std::optional<slam::Trajectory> read_unplaced(const std::filesystem::path& file)
   return slam::read_tum(in, file);
 }
 
+// `t`, read from `file`, rewritten there as place_trajectory_file says
+// (`track` null or not empty).
+void write_placed(const std::filesystem::path& file, const ExportFrame& frame, const slam::CorrectionTrack* track,
+                  slam::Trajectory t) {
+  const Eigen::Isometry3d& a = frame.from_odometry;
+  for (std::size_t i = 0; i < t.poses.size(); ++i) {
+    const auto stamp_ns = static_cast<std::int64_t>(std::llround(t.stamps[i] * 1e9));
+    t.poses[i] = track != nullptr ? a * track->at(stamp_ns) * t.poses[i] : a * t.poses[i];
+  }
+  std::ostringstream out;
+  out << placed_line(frame.source, track != nullptr) << "\n# timestamp tx ty tz qx qy qz qw\n";
+  slam::write_tum(out, t);
+  write_durably(file, out.str());
+}
+
 }  // namespace
 
 bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame& frame,
@@ -197,17 +212,7 @@ bool place_trajectory_file(const std::filesystem::path& file, const ExportFrame&
   if (!std::filesystem::exists(file)) return false;
   if (track != nullptr && track->empty()) track = nullptr;
   if (frame.source == ExportSource::odometry && track == nullptr) return true;  // nothing to move
-  std::optional<slam::Trajectory> t = read_unplaced(file);
-  if (!t) return true;
-  const Eigen::Isometry3d& a = frame.from_odometry;
-  for (std::size_t i = 0; i < t->poses.size(); ++i) {
-    const auto stamp_ns = static_cast<std::int64_t>(std::llround(t->stamps[i] * 1e9));
-    t->poses[i] = track != nullptr ? a * track->at(stamp_ns) * t->poses[i] : a * t->poses[i];
-  }
-  std::ostringstream out;
-  out << placed_line(frame.source, track != nullptr) << "\n# timestamp tx ty tz qx qy qz qw\n";
-  slam::write_tum(out, *t);
-  write_durably(file, out.str());
+  if (std::optional<slam::Trajectory> t = read_unplaced(file)) write_placed(file, frame, track, std::move(*t));
   return true;
 }
 
@@ -219,15 +224,17 @@ void place_session_trajectories(const std::filesystem::path& dir, const ExportFr
   // were built, before they are placed.
   std::optional<slam::Trajectory> built_at;
   if (track != nullptr && !track->empty() && std::filesystem::exists(map_poses)) built_at = read_unplaced(map_poses);
-  if (built_at && std::filesystem::exists(odometry)) {
-    if (const std::optional<slam::Trajectory> poses = read_unplaced(odometry)) {
-      const slam::CorrectionTrack moved = slam::retargeted(*track, *built_at, *poses);
-      place_trajectory_file(odometry, frame, &moved);
-    }
-  } else {
+  if (!built_at) {
     place_trajectory_file(odometry, frame, track);
+    place_trajectory_file(map_poses, frame, track);
+    return;
   }
-  place_trajectory_file(map_poses, frame, track);
+  if (std::filesystem::exists(odometry))
+    if (std::optional<slam::Trajectory> poses = read_unplaced(odometry)) {
+      const slam::CorrectionTrack moved = slam::retargeted(*track, *built_at, *poses);
+      write_placed(odometry, frame, moved.empty() ? nullptr : &moved, std::move(*poses));
+    }
+  write_placed(map_poses, frame, track, std::move(*built_at));
 }
 
 nlohmann::json frame_summary(const ExportFrame& frame) {
