@@ -206,9 +206,18 @@ std::size_t TiledVoxelMap::memory_bytes() const {
   std::size_t bytes = 0;
   for (const auto& [coord, tile] : tiles_)
     bytes += sizeof(coord) + sizeof(tile) + 4 * sizeof(void*) +  // std::map node
-             tile.voxels.memory_bytes() + tile.candidates.capacity() * sizeof(MapSample) + tile.hits.capacity() +
-             tile.points.capacity() * sizeof(MapSample) + tile.stored.memory_bytes();
+             compactable_bytes(tile) + tile.stored.memory_bytes();
   return bytes;
+}
+
+std::size_t TiledVoxelMap::compactable_bytes(const TileCoord& coord) const {
+  const auto it = tiles_.find(coord);
+  return it == tiles_.end() ? 0 : compactable_bytes(it->second);
+}
+
+std::size_t TiledVoxelMap::compactable_bytes(const Tile& tile) {
+  return tile.voxels.memory_bytes() + tile.candidates.capacity() * sizeof(MapSample) + tile.hits.capacity() +
+         tile.points.capacity() * sizeof(MapSample);
 }
 
 std::uint32_t TiledVoxelMap::VoxelIndex::find_or_insert(std::uint32_t voxel, std::uint32_t next) {
@@ -309,9 +318,29 @@ std::vector<TileCoord> TileEviction::cold_tiles(const TiledVoxelMap& map, const 
 
 std::vector<TileCoord> TileEviction::crowded_tiles(const TiledVoxelMap& map) const {
   std::vector<TileCoord> crowded;
-  if (config_.compact_voxels == 0) return crowded;
-  for (const TileCoord& coord : map.tile_coords())
-    if (map.held_voxels(coord) > config_.compact_voxels) crowded.push_back(coord);
+  std::vector<std::pair<std::size_t, TileCoord>> others;  // (bytes a compaction frees, tile) of the rest
+  std::size_t bytes = config_.resident_bytes > 0 ? map.memory_bytes() : 0;
+  for (const TileCoord& coord : map.tile_coords()) {
+    const std::size_t freed = map.compactable_bytes(coord);
+    if (config_.compact_voxels > 0 && map.held_voxels(coord) > config_.compact_voxels) {
+      crowded.push_back(coord);
+      bytes -= std::min(bytes, freed);
+    } else if (freed > 0) {
+      others.emplace_back(freed, coord);
+    }
+  }
+  if (bytes <= config_.resident_bytes) return crowded;
+  // Largest first; ties in coordinate order, so the choice does not depend on the sort.
+  std::sort(others.begin(), others.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  const std::size_t target = config_.resident_bytes / 4 * 3;
+  for (const auto& [freed, coord] : others) {
+    if (bytes <= target) break;
+    crowded.push_back(coord);
+    bytes -= std::min(bytes, freed);
+  }
+  std::sort(crowded.begin(), crowded.end());
   return crowded;
 }
 

@@ -265,6 +265,32 @@ TEST(TileEviction, ATileHoldingMoreThanCompactVoxelsIsCrowded) {
   EXPECT_EQ(map.held_voxels({0, 0, 0}), 0U);
 }
 
+TEST(TileEviction, OverItsBudgetTheMapCompactsItsLargestTilesDownToThreeQuartersOfIt) {
+  TiledVoxelMap map({20.0F, 0.05F, 2});
+  map.add(block(1.0F), {}, 0.0);  // tile (0, 0, 0): 400 voxels
+  for (int b = 0; b < 10; ++b) map.add(block(21.0F + 0.5F * static_cast<float>(b)), {}, 0.0);  // (1, 0, 0): 4,000
+  map.add(std::vector<Eigen::Vector3f>{{41.0F, 1.0F, 1.0F}}, {}, 0.0);  // (2, 0, 0): 1
+  const std::size_t total = map.memory_bytes();
+  const TileCoord small{0, 0, 0};
+  const TileCoord large{1, 0, 0};
+  ASSERT_GT(map.compactable_bytes(large), 4 * map.compactable_bytes(small));
+  EXPECT_TRUE(TileEviction({50.0F, 20, 0, total}).crowded_tiles(map).empty());
+  // Just over: the largest goes, and what stays is within three quarters of the budget.
+  ASSERT_LE(total - map.compactable_bytes(large), (total - 1) / 4 * 3);
+  EXPECT_EQ(TileEviction({50.0F, 20, 0, total - 1}).crowded_tiles(map), (std::vector<TileCoord>{large}));
+  // A budget nothing fits in: every tile a compaction would shrink, in coordinate order.
+  EXPECT_EQ(TileEviction({50.0F, 20, 0, 1}).crowded_tiles(map), (std::vector<TileCoord>{small, large, {2, 0, 0}}));
+  // A tile over compact_voxels counts as freed: with it, nothing more is needed.
+  EXPECT_EQ(TileEviction({50.0F, 20, 1000, total - 1}).crowded_tiles(map), (std::vector<TileCoord>{large}));
+
+  std::vector<MapSample> stored = map.evict(large).points;
+  map.restore(large, stored);
+  EXPECT_LE(map.memory_bytes(), (total - 1) / 4 * 3);
+  // Compacted, it frees nothing more, so it is not chosen again while nothing is new in it.
+  EXPECT_EQ(map.compactable_bytes(large), 0U);
+  EXPECT_EQ(TileEviction({50.0F, 20, 0, 1}).crowded_tiles(map), (std::vector<TileCoord>{small, {2, 0, 0}}));
+}
+
 TEST(TileEviction, DistanceToATileIsZeroInsideAndToTheNearestFaceOrCornerOutside) {
   EXPECT_FLOAT_EQ(distance_to_tile({0, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 0.0F);
   EXPECT_FLOAT_EQ(distance_to_tile({1, 0, 0}, 20.0F, {5.0F, 5.0F, 5.0F}), 15.0F);

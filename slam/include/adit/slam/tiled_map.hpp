@@ -93,6 +93,10 @@ class TiledVoxelMap {
   std::size_t dropped_in_evicted() const { return dropped_in_evicted_; }  // add(): points in an evicted tile
   // Bytes held by the resident tiles' vectors and indices (capacities, not sizes).
   std::size_t memory_bytes() const;
+  // Bytes a compaction of one resident tile (evict, then restore) would free:
+  // its candidates, hits, points and voxel index; its stored voxels' bits stay.
+  // 0 when it is not resident.
+  std::size_t compactable_bytes(const TileCoord& coord) const;
 
   // A resident tile leaves RAM: returns its confirmed points and whether it had
   // changed since the last take_changed() (then the caller still owes it to
@@ -167,6 +171,7 @@ class TiledVoxelMap {
   // (block, bit) of a voxel index for VoxelBits.
   std::pair<std::uint32_t, std::uint32_t> block_of(std::uint32_t voxel) const;
   Tile& new_tile(const TileCoord& coord);
+  static std::size_t compactable_bytes(const Tile& tile);
   std::uint32_t voxel_of(const Eigen::Vector3f& p, const Eigen::Vector3f& origin) const;
   Eigen::Vector3f origin_of(const TileCoord& coord) const;
 
@@ -194,10 +199,18 @@ class TiledVoxelMap {
 // coming back to would still grow in RAM: a tile holding more than
 // `compact_voxels` voxels is crowded, and the caller evicts and restores it at
 // once, so its points go to the store and only a bit per voxel stays.
+//
+// The tiles around the sensor grow too, each by less: lap after lap of a
+// route adds what the drifting odometry puts beside the earlier laps. With a
+// budget of `resident_bytes`, when the resident tiles hold more, the tiles
+// that would free most are crowded as well, until what stays is within three
+// quarters of the budget (the quarter is room to grow before the next round,
+// so compactions come in rounds, not at every keyframe).
 struct TileEvictionConfig {
   float radius_m = 50.0F;
   int after_keyframes = 20;        // ≤ 0: never evict
   std::size_t compact_voxels = 0;  // 0: never compact
+  std::size_t resident_bytes = 0;  // 0: no budget
 };
 
 class TileEviction {
@@ -205,7 +218,9 @@ class TileEviction {
   explicit TileEviction(const TileEvictionConfig& config) : config_(config) {}
   // Once per keyframe: the resident tiles that are cold now, in coordinate order.
   std::vector<TileCoord> cold_tiles(const TiledVoxelMap& map, const Eigen::Vector3f& sensor);
-  // The resident tiles holding more than compact_voxels voxels, in coordinate order.
+  // The resident tiles to compact, in coordinate order: those holding more
+  // than compact_voxels voxels, and while the map is over its budget, the
+  // largest (by compactable_bytes) down to three quarters of it.
   std::vector<TileCoord> crowded_tiles(const TiledVoxelMap& map) const;
 
  private:
