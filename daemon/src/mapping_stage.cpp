@@ -47,7 +47,7 @@ slam::LiveGridConfig grid_config_of(const config::GridSection& g) {
 // sensor's offset from the body is small: the margin covers both.
 slam::TileEvictionConfig eviction_config_of(const config::MapSection& m) {
   return {static_cast<float>(m.max_range_m + m.evict_margin_m), m.evict_after_keyframes,
-          static_cast<std::size_t>(m.compact_tile_voxels)};
+          static_cast<std::size_t>(m.compact_tile_voxels), static_cast<std::size_t>(m.resident_tiles_mb * 1e6)};
 }
 
 }  // namespace
@@ -239,10 +239,16 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   if (spill_) restore_tiles(map_.evicted_hit_by(deskewed_));
   map_.add(deskewed_, intensities_, 1e-9 * static_cast<double>(slot.stamp_ns));
   journal_new_points();  // before eviction: an evicted tile's points are all in the journal
+  if (keyframe) {
+    const std::uint64_t bytes = map_.memory_bytes();  // a walk over the tiles
+    if (bytes > stats_.map_bytes_peak.load(std::memory_order_relaxed))
+      stats_.map_bytes_peak.store(bytes, std::memory_order_relaxed);
+  }
   if (spill_ && keyframe) {
     const std::vector<slam::TileCoord> cold = eviction_.cold_tiles(map_, map_pose.translation().cast<float>());
-    const std::vector<slam::TileCoord> crowded = eviction_.crowded_tiles(map_);
     evict_tiles(cold);
+    // After the eviction: a tile both cold and crowded leaves RAM, and is not read back to be compacted.
+    const std::vector<slam::TileCoord> crowded = eviction_.crowded_tiles(map_);
     compact_tiles(crowded);
 #ifdef __GLIBC__
     // The freed tiles lie amid the mapping thread's arena, which glibc gives

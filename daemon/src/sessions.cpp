@@ -572,6 +572,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"mapped_scans", s.mapped_scans.load()}, {"dropped_scans", s.dropped_map_scans.load()},
                  {"evicted_tiles", s.evicted_tiles.load()}, {"restored_tiles", s.restored_tiles.load()},
                  {"compacted_tiles", s.compacted_tiles.load()},
+                 {"peak_resident_tiles_mb", 1e-6 * static_cast<double>(s.map_bytes_peak.load())},
                  {"tiles_checked_for_loops", s.tiles_checked_for_loops.load()},
                  {"tiles_moved_by_loops", s.tiles_moved_by_loops.load()},
                  {"points_moved_by_loops", s.points_moved_by_loops.load()},

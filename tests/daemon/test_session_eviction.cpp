@@ -58,7 +58,8 @@ struct SessionRun {
 // drive leaves tiles behind (evict_after_keyframes 0: every tile stays in RAM);
 // compact_tile_voxels 0: never compacted.
 SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels,
-                       double keyframe_distance_m = 1.0, double keyframe_angle_deg = 10.0) {
+                       double keyframe_distance_m = 1.0, double keyframe_angle_deg = 10.0,
+                       double resident_tiles_mb = 0.0) {
   const std::filesystem::path session = driving_session();
   // As fast as possible: a replay waits, nothing is dropped. The journal is
   // kept, so that the map can be rebuilt from it too (expect_every_point_everywhere).
@@ -67,8 +68,10 @@ SessionRun map_session(const std::filesystem::path& work, int evict_after_keyfra
       {"", "", true,
        fmt::format("map:\n  tile_size_m: 5\n  max_range_m: 5\n  evict_margin_m: 1\n  evict_after_keyframes: {}\n"
                    "  compact_tile_voxels: {}\n  keyframe_distance_m: {}\n  keyframe_angle_deg: {}\n"
+                   "  resident_tiles_mb: {}\n"
                    "session:\n  exports: [ply, las]\n  keep_journal: true\nthreads:\n  lock_memory: false\n",
-                   evict_after_keyframes, compact_tile_voxels, keyframe_distance_m, keyframe_angle_deg)});
+                   evict_after_keyframes, compact_tile_voxels, keyframe_distance_m, keyframe_angle_deg,
+                   resident_tiles_mb)});
   std::filesystem::create_directories(work);
   const std::filesystem::path config_file = work / "aditd.yaml";
   std::ofstream(config_file) << yaml;
@@ -197,6 +200,25 @@ TEST_F(SessionEviction, CrowdedTilesAreCompactedAndTheMapStillHoldsEveryPoint) {
   expect_every_point_everywhere(compacting, work / "compacting" / "aditd.yaml");
   // Each compaction drops the tile's unconfirmed voxels: what differs is bounded by them.
   const Comparison c = compare_maps(kept, compacting);
+  EXPECT_LE(c.kept_missing, map["lost_candidates"].get<std::size_t>());
+  EXPECT_LE(c.new_points, map["lost_candidates"].get<std::size_t>());
+}
+
+TEST_F(SessionEviction, OverTheBudgetTheLargestTilesAreCompactedAndTheMapStillHoldsEveryPoint) {
+  const SessionRun kept = map_session(work / "kept", 0, 0);
+  const SessionRun unbounded = map_session(work / "unbounded", 3, 0);
+  const double peak_mb = unbounded.summary["map"]["peak_resident_tiles_mb"];
+  ASSERT_GT(peak_mb, 0.0);
+  EXPECT_EQ(unbounded.summary["map"]["compacted_tiles"], 0);
+  // Half of what the tiles held at most: compacted in rounds, never far over it.
+  const double budget_mb = peak_mb / 2;
+  const SessionRun bounded = map_session(work / "bounded", 3, 0, 1.0, 10.0, budget_mb);
+  const nlohmann::json& map = bounded.summary["map"];
+  EXPECT_GT(map["compacted_tiles"].get<std::size_t>(), 0U) << map.dump();
+  EXPECT_LT(map["peak_resident_tiles_mb"].get<double>(), 0.75 * peak_mb) << map.dump();
+  EXPECT_EQ(map["tiles"], kept.summary["map"]["tiles"]);
+  expect_every_point_everywhere(bounded, work / "bounded" / "aditd.yaml");
+  const Comparison c = compare_maps(kept, bounded);
   EXPECT_LE(c.kept_missing, map["lost_candidates"].get<std::size_t>());
   EXPECT_LE(c.new_points, map["lost_candidates"].get<std::size_t>());
 }

@@ -186,6 +186,9 @@ struct MapSection {
   // A tile holding more voxels than this in RAM (the sensor stays near it or
   // keeps coming back) is written out and keeps one bit per voxel; 0 = never.
   int compact_tile_voxels = 100'000;
+  // The resident tiles' budget (MB): over it, the largest are written out the
+  // same way until they hold three quarters of it; 0 = no budget.
+  double resident_tiles_mb = 32.0;
   // Each scan's pose is refined against a dense map of the scans mapped
   // before it (slam::MapRefiner) before it enters the map; false = the map
   // takes the odometry's poses as they are.

@@ -205,6 +205,7 @@ void describe(V& v, MapSection& s) {
   v.optional("evict_margin_m", s.evict_margin_m, Range<double>{0.0, 1000.0});
   v.optional("evict_after_keyframes", s.evict_after_keyframes, Range<int>{0, 1000000});
   v.optional("compact_tile_voxels", s.compact_tile_voxels, Range<int>{0, 100000000});
+  v.optional("resident_tiles_mb", s.resident_tiles_mb, Range<double>{0.0, 1e6});
   v.optional("refine", s.refine);
   v.optional("loop_closure", s.loop_closure);
   v.optional("loops_move_map", s.loops_move_map);
