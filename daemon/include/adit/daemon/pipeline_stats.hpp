@@ -76,7 +76,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> keyframes{0};
   // What the mapping thread holds and sends away (eviction: tiles the sensor has left go to disk).
   std::atomic<std::uint64_t> map_bytes{0};            // resident tiles' vectors and indices
-  std::atomic<std::uint64_t> map_bytes_peak{0};       // the most they held at a keyframe, before compacting
+  std::atomic<std::uint64_t> map_bytes_peak{0};       // the most they held at a keyframe, before evicting and compacting
   std::atomic<std::uint64_t> keyframe_bytes{0};       // keyframes' downsampled scans
   std::atomic<std::uint64_t> resident_tiles{0};
   std::atomic<std::uint64_t> grid_patches{0};         // the live 2D grid's patches
