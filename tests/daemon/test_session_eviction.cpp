@@ -56,7 +56,7 @@ struct SessionRun {
 
 // Small tiles (5 m) and a short mapping range (5 m, margin 1 m) so that the
 // drive leaves tiles behind (evict_after_keyframes 0: every tile stays in RAM);
-// compact_tile_voxels 0: never compacted.
+// compact_tile_voxels 0: never compacted; resident_tiles_mb 0: no budget.
 SessionRun map_session(const std::filesystem::path& work, int evict_after_keyframes, int compact_tile_voxels,
                        double keyframe_distance_m = 1.0, double keyframe_angle_deg = 10.0,
                        double resident_tiles_mb = 0.0) {
