@@ -18,4 +18,10 @@ bool keep_large_blocks_mmapped(std::size_t threshold_bytes) {
 #endif
 }
 
+void return_free_pages() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
 }  // namespace adit::daemon

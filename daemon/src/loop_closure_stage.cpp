@@ -11,6 +11,7 @@
 
 #include "adit/common/clock.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/slam/gravity.hpp"
 
 namespace adit::daemon {
@@ -44,6 +45,7 @@ LoopClosureStage::LoopClosureStage(const config::Config& config, PipelineStats& 
     : stats_(stats),
       live_source_(live),
       thread_("loops", config::ThreadSettings{}, stop),  // SCHED_OTHER whatever the other stages use, never FIFO
+      keyframes_(live ? 0 : kMaxKeyframesBehind),
       closer_(loop_closure_config(config, loops)) {}
 
 void LoopClosureStage::start() {
@@ -84,6 +86,10 @@ void LoopClosureStage::loop() {
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,
                 closer_.stats().last_optimization_s, c.translation().norm());
       if (closer_.stats().accepted > 0) live_.post(closer_.correction_track());
+      // The solve's blocks (Ceres, CHOLMOD: thousands, sized by the graph)
+      // are freed, but their pages stay in this thread's arena, a high-water
+      // mark that grows with the graph (allocator.hpp).
+      return_free_pages();
     }
     if (closer_.scans().read_errors() + closer_.scans().write_errors() > file_errors_before)
       log::warn("loops: {}", closer_.scans().last_error());

@@ -11,12 +11,11 @@
 #include <limits>
 #include <thread>
 
-#include <malloc.h>
-
 #include <fmt/format.h>
 
 #include "adit/common/clock.hpp"
 #include "adit/common/log.hpp"
+#include "adit/daemon/allocator.hpp"
 #include "adit/daemon/extrinsics.hpp"
 #include "adit/daemon/session_frame.hpp"
 #include "adit/protocol/map_export.hpp"
@@ -221,7 +220,7 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   if (keyframe) {
     keyframe_downsampler_.downsample(deskewed_, static_cast<float>(config_.keyframe_voxel_m), keyframe_points_);
     keyframes_.push_back({slot.stamp_ns, map_pose, keyframe_points_});
-    if (loops_ != nullptr) loops_->push({slot.stamp_ns, map_pose, keyframe_points_});
+    if (loops_ != nullptr) loops_->push({slot.stamp_ns, map_pose, keyframe_points_}, [this] { return thread_.idle(); });
     if (journal_ != nullptr) journal_->keyframe(slot.stamp_ns, map_pose, keyframe_points_);
     keyframe_bytes_ += sizeof(slam::Keyframe) + keyframes_.back().points.capacity() * sizeof(Eigen::Vector3f);
     stats_.keyframes.store(keyframes_.size(), std::memory_order_relaxed);
@@ -250,11 +249,8 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
     // After the eviction: a tile both cold and crowded leaves RAM, and is not read back to be compacted.
     const std::vector<slam::TileCoord> crowded = eviction_.crowded_tiles(map_);
     compact_tiles(crowded);
-#ifdef __GLIBC__
-    // The freed tiles lie amid the mapping thread's arena, which glibc gives
-    // back to the kernel only from its top: return the free pages now.
-    if (!cold.empty() || !crowded.empty()) malloc_trim(0);
-#endif
+    // The freed tiles lie amid the mapping thread's arena (allocator.hpp).
+    if (!cold.empty() || !crowded.empty()) return_free_pages();
   }
   if (!keyframes_dir_.empty() && keyframe) spill_keyframes();
   stats_.mapped_scans.fetch_add(1, std::memory_order_relaxed);

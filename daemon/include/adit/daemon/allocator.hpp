@@ -19,4 +19,11 @@ namespace adit::daemon {
 // where it cannot be set (not glibc, or mallopt refused).
 bool keep_large_blocks_mmapped(std::size_t threshold_bytes = std::size_t{1} << 20);
 
+// Gives the free pages of every arena back to the kernel (glibc's
+// malloc_trim(0)); a thread's arena otherwise returns memory only from its
+// top, so the high-water mark of a burst of small blocks (a tile evicted, a
+// pose-graph solve) stays resident. It walks the heap: call it after such a
+// burst, never per item. Does nothing where malloc is not glibc's.
+void return_free_pages();
+
 }  // namespace adit::daemon

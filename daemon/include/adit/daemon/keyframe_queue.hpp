@@ -1,11 +1,15 @@
 #pragma once
-// Keyframes from the mapping thread to the loop-closure thread. No capacity
-// and under a mutex: a keyframe comes about once a metre, the graph needs
-// every one (a dropped keyframe would cut the odometry chain), and neither
-// side is the odometry thread. push() never waits for the consumer. Behind a
-// live source the consumer keeps it short by skipping loop searches while
-// it is long (loop_closure_stage.hpp).
+// Keyframes from the mapping thread to the loop-closure thread, under a mutex:
+// a keyframe comes about once a metre, the graph needs every one (a dropped
+// keyframe would cut the odometry chain), and neither side is the odometry
+// thread. With no capacity (behind a live source) push() never waits; the
+// consumer keeps the queue short by skipping loop searches while it is long
+// (loop_closure_stage.hpp). With a capacity (a replay, which searches every
+// keyframe) push() waits for room: as fast as it goes, the mapping ran ahead
+// of the graph and the queue held 1,700 keyframe scans (45 MB) by the end of
+// the 30-minute drive (decision 071).
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -25,9 +29,23 @@ struct KeyframeItem {
 
 class KeyframeQueue {
  public:
-  void push(KeyframeItem item) {
+  // 0: no capacity.
+  explicit KeyframeQueue(std::size_t capacity = 0) : capacity_(capacity) {}
+
+  // Queues `item`. While `capacity` items wait, it waits for room, calling
+  // `idle()` every kRoomPoll: the producer's heartbeat, which says false once
+  // the pipeline stops; then it queues the item anyway (none is ever dropped).
+  template <typename Idle>
+  void push(KeyframeItem item, Idle&& idle) {
     {
-      const std::lock_guard lock(mutex_);
+      std::unique_lock lock(mutex_);
+      while (capacity_ > 0 && !room_or_closed()) {
+        if (room_.wait_for(lock, kRoomPoll, [&] { return room_or_closed(); })) break;
+        lock.unlock();
+        const bool wait_on = idle();
+        lock.lock();
+        if (!wait_on) break;
+      }
       items_.push_back(std::move(item));
     }
     ready_.notify_one();
@@ -48,6 +66,8 @@ class KeyframeQueue {
     if (items_.empty()) return std::nullopt;
     KeyframeItem item = std::move(items_.front());
     items_.pop_front();
+    lock.unlock();
+    room_.notify_one();
     return item;
   }
   bool closed_and_empty() const {
@@ -60,8 +80,13 @@ class KeyframeQueue {
   }
 
  private:
+  static constexpr std::chrono::milliseconds kRoomPoll{100};
+  bool room_or_closed() const { return items_.size() < capacity_ || closed_; }  // under mutex_
+
+  const std::size_t capacity_;
   mutable std::mutex mutex_;
   std::condition_variable ready_;
+  std::condition_variable room_;
   std::deque<KeyframeItem> items_;
   bool closed_ = false;
 };

@@ -7,15 +7,16 @@
 //       counts in PipelineStats (loop_*), read after join(); live, the
 //       correction after each optimisation that accepted a loop (live()).
 // Thread "loops", lowered to nice 10 on top of its thread settings: it takes
-// the CPU the other stages leave. It never blocks another stage: the mapping
-// thread only pushes into the queue; the odometry never sees it. At the end
-// it drains the queue and, with `refine_at_end`, optimises the whole graph
-// once more before the exports.
-// Behind a live source, with more than kMaxKeyframesBehind keyframes waiting,
-// keyframes join the graph without a loop search (LoopCloser::add_keyframe's
-// `search`) until the queue is short again: the queue and the loops' delay
-// stay bounded on a core too slow for the graph. A replay searches every
-// keyframe, so that it gives the same graph on any machine.
+// the CPU the other stages leave. The odometry never sees it; the mapping
+// thread only pushes into the queue. At the end it drains the queue and, with
+// `refine_at_end`, optimises the whole graph once more before the exports.
+// Behind a live source it never blocks another stage: with more than
+// kMaxKeyframesBehind keyframes waiting, keyframes join the graph without a
+// loop search (LoopCloser::add_keyframe's `search`) until the queue is short
+// again, so the queue and the loops' delay stay bounded on a core too slow for
+// the graph. A replay searches every keyframe, so that it gives the same graph
+// on any machine, and its mapping thread waits while kMaxKeyframesBehind
+// keyframes wait (KeyframeQueue's capacity), so the queue's scans stay bounded.
 
 #include <atomic>
 #include <filesystem>
