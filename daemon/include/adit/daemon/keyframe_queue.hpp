@@ -6,8 +6,8 @@
 // consumer keeps the queue short by skipping loop searches while it is long
 // (loop_closure_stage.hpp). With a capacity (a replay, which searches every
 // keyframe) push() waits for room: as fast as it goes, the mapping ran ahead
-// of the graph and the queue held 1,700 keyframe scans (45 MB) by the end of
-// the 30-minute drive (decision 071).
+// of the graph and the queue held about 1,600 keyframe scans (45 MB) by the
+// end of the 30-minute drive (decision 071).
 
 #include <chrono>
 #include <condition_variable>
@@ -57,6 +57,7 @@ class KeyframeQueue {
       closed_ = true;
     }
     ready_.notify_all();
+    room_.notify_all();
   }
   // Waits up to `timeout` for an item; nullopt when none came (or closed and empty).
   template <typename Duration>
