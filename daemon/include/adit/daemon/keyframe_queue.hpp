@@ -39,8 +39,7 @@ class KeyframeQueue {
   void push(KeyframeItem item, Idle&& idle) {
     {
       std::unique_lock lock(mutex_);
-      while (capacity_ > 0 && !room_or_closed()) {
-        if (room_.wait_for(lock, kRoomPoll, [&] { return room_or_closed(); })) break;
+      while (capacity_ > 0 && !room_.wait_for(lock, kRoomPoll, [&] { return room_or_closed(); })) {
         lock.unlock();
         const bool wait_on = idle();
         lock.lock();
