@@ -18,22 +18,34 @@ std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
   std::unordered_map<VoxelKey, std::vector<std::uint32_t>, VoxelKeyHash> cells;
   for (std::size_t i = 0; i < prior.points.size(); ++i) cells[voxel_key(prior.points[i], inv)].push_back(static_cast<std::uint32_t>(i));
   const float reach2 = config.max_distance_m * config.max_distance_m;
+  const float patch = config.patch_spacings * prior.point_spacing_m;
+  const float patch2 = patch * patch;
   std::vector<float> out(points.size(), config.max_distance_m);
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points[i];
     const VoxelKey c = voxel_key(p, inv);
+    // The smallest distance to a piece of the prior's surface: a point's plane
+    // where p lies over its patch, else the point itself (module header).
     float best = reach2;
     std::int64_t nearest = -1;
+    bool on_plane = false;
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const auto it = cells.find(VoxelKey{c.x + dx, c.y + dy, c.z + dz});
           if (it == cells.end()) continue;
           for (const std::uint32_t k : it->second) {
-            const float d2 = (prior.points[k] - p).squaredNorm();
-            if (d2 < best) {
-              best = d2;
+            const Eigen::Vector3f delta = p - prior.points[k];
+            const float d2 = delta.squaredNorm();
+            if (d2 >= reach2) continue;
+            const Eigen::Vector3f& n = prior.normals[k];
+            const float along = n.dot(delta);
+            const bool over_patch = !n.isZero() && d2 - along * along <= patch2;
+            const float candidate = over_patch ? along * along : d2;
+            if (candidate < best) {
+              best = candidate;
               nearest = k;
+              on_plane = over_patch;
             }
           }
         }
@@ -41,7 +53,7 @@ std::vector<float> signed_deviations(std::span<const Eigen::Vector3f> points,
     const Eigen::Vector3f delta = p - prior.points[static_cast<std::size_t>(nearest)];
     Eigen::Vector3f normal = prior.normals[static_cast<std::size_t>(nearest)];
     float d = 0.0F;
-    if (!normal.isZero()) {
+    if (on_plane) {
       d = normal.dot(delta);
     } else {
       d = delta.norm();

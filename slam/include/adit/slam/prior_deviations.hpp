@@ -2,10 +2,17 @@
 // As-built against as-designed: each map point's signed distance to the
 // prior's surface, and the regions that deviate by more than a threshold.
 //
-// The distance is along the normal of the prior point nearest the map point
-// (point-to-plane, as the registration measures: a prior sampled every 10 cm
-// is up to 7 cm away point-to-point from a point lying on its surface; where
-// that point has no normal, an edge, the point-to-point distance). Its sign faces the observer: positive in front of the designed
+// The distance is to the nearest piece of the prior's surface: over the prior
+// points within reach, the smallest of the distance to a point's plane (its
+// normal) where the map point lies over that point's patch (its foot on the
+// plane within `patch_spacings` of the prior's point spacing), and the
+// distance to a point itself (where no patch covers the map point, or the
+// point has no normal: an edge, clutter). A prior sampled every 10 cm is up to
+// 7 cm away point-to-point from a point lying on its surface, so the planes
+// carry the measure; taking the nearest patch, not the nearest point's plane,
+// keeps a point near a corner on its own surface (the corner's samples have
+// no normal, or one fitted across both faces), as CloudCompare's cloud-to-cloud
+// distance with local models does. Its sign faces the observer: positive in front of the designed
 // surface (something built into the designed space: furniture, a wall moved
 // in), negative behind it (a wall moved out, a missing column's place). A
 // point with no prior surface within `max_distance_m` stands in the designed
@@ -24,6 +31,7 @@ namespace adit::slam {
 struct DeviationConfig {
   float threshold_m = 0.05F;       // |deviation| above this: deviating
   float max_distance_m = 0.5F;     // beyond: the designed free space
+  float patch_spacings = 1.5F;     // a prior point's plane covers what lies within this many point spacings of it
   float region_voxel_m = 0.2F;     // connectivity of a region
   std::size_t min_region_points = 50;
   float viewpoint_voxel_m = 5.0F;  // viewpoints are looked up within 1.5 of these voxels (farther: the sign stays +)
