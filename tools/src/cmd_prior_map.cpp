@@ -142,18 +142,23 @@ int deviations(const DeviationOptions& o) {
   std::vector<int> member(points.size());
   const std::vector<slam::DeviationRegion> regions = slam::deviation_regions(points, dev, config, member);
 
+  const std::vector<int> truth =
+      o.truth_scene.empty() ? std::vector<int>{} : truth_labels(points, o.truth_scene, prior.map, o.threshold_m);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   const std::filesystem::path cloud_file = std::filesystem::path(o.out) / "deviations.ply";
   std::vector<std::array<float, 3>> xyz(points.size());
   std::vector<float> region_field(points.size());
+  std::vector<float> truth_field(truth.size());  // with --truth-scene: each point's label, to see the errors
   for (std::size_t i = 0; i < points.size(); ++i) {
     xyz[i] = {points[i].x(), points[i].y(), points[i].z()};
     region_field[i] = static_cast<float>(member[i]);
+    if (!truth.empty()) truth_field[i] = static_cast<float>(truth[i]);
   }
-  const std::array<protocol::ScalarField, 3> fields{protocol::ScalarField{"deviation", dev},
-                                                    protocol::ScalarField{"raw_deviation", raw},
-                                                    protocol::ScalarField{"region", region_field}};
+  std::vector<protocol::ScalarField> fields{protocol::ScalarField{"deviation", dev},
+                                            protocol::ScalarField{"raw_deviation", raw},
+                                            protocol::ScalarField{"region", region_field}};
+  if (!truth.empty()) fields.push_back(protocol::ScalarField{"truth", truth_field});
   protocol::write_scalar_field_ply(cloud_file, xyz, fields);
   nlohmann::json j;
   j["map_points"] = points.size();
@@ -169,8 +174,7 @@ int deviations(const DeviationOptions& o) {
                             {"size_m", {size.x(), size.y(), size.z()}}, {"mean_deviation_m", g.mean_m},
                             {"max_abs_deviation_m", g.max_abs_m}});
   }
-  if (!o.truth_scene.empty()) {
-    const std::vector<int> truth = truth_labels(points, o.truth_scene, prior.map, o.threshold_m);
+  if (!truth.empty()) {
     const auto score = [&](auto predicted) {
       std::size_t tp = 0, fp = 0, fn = 0;
       for (std::size_t i = 0; i < points.size(); ++i) {
