@@ -89,11 +89,26 @@ std::vector<DeviationRegion> deviation_regions(std::span<const Eigen::Vector3f> 
                                                std::span<const float> deviations, const DeviationConfig& config,
                                                std::span<int> member) {
   std::fill(member.begin(), member.end(), -1);
-  // Deviating points by voxel.
-  std::unordered_map<VoxelKey, std::vector<std::size_t>, VoxelKeyHash> voxels;
+  // Deviating points by voxel, among all the points of each voxel; a voxel
+  // deviates when at least region_min_share of its points do (a vote: range
+  // noise alone puts a few percent of a surface's points past the threshold,
+  // scattered, and would otherwise link whole walls into regions).
+  struct Voxel {
+    std::size_t points = 0;
+    std::vector<std::size_t> deviating;
+  };
+  std::unordered_map<VoxelKey, Voxel, VoxelKeyHash> all;
   const float inv = 1.0F / config.region_voxel_m;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (std::abs(deviations[i]) > config.threshold_m) voxels[voxel_key(points[i], inv)].push_back(i);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    Voxel& v = all[voxel_key(points[i], inv)];
+    ++v.points;
+    if (std::abs(deviations[i]) > config.threshold_m) v.deviating.push_back(i);
+  }
+  std::unordered_map<VoxelKey, std::vector<std::size_t>, VoxelKeyHash> voxels;
+  for (auto& [key, v] : all)
+    if (!v.deviating.empty() &&
+        static_cast<double>(v.deviating.size()) >= config.region_min_share * static_cast<double>(v.points))
+      voxels.emplace(key, std::move(v.deviating));
   std::unordered_map<VoxelKey, int, VoxelKeyHash> label;
   std::vector<DeviationRegion> regions;
   std::vector<std::vector<std::size_t>> region_points;

@@ -169,5 +169,30 @@ TEST_F(PriorMapTest, MovedWallIsTheDeviatingRegion) {
   EXPECT_LT(static_cast<double>(deviating), 0.001 * static_cast<double>(unchanged)) << deviating << " of " << unchanged;
 }
 
+// Range noise puts a few percent of an unchanged wall's points past the
+// threshold, scattered over it; they are no region. A patch that really
+// deviates is one, and only its points are members.
+TEST(DeviationRegions, ScatteredNoiseIsNoRegionAPatchIs) {
+  std::vector<Eigen::Vector3f> wall;
+  std::vector<float> dev;
+  for (int i = 0; i < 500; ++i)
+    for (int k = 0; k < 150; ++k) {  // 10 x 3 m every 2 cm
+      const float x = 0.02F * static_cast<float>(i), z = 0.02F * static_cast<float>(k);
+      wall.emplace_back(x, 0.0F, z);
+      const bool patch = x >= 6.0F && x < 7.0F && z >= 1.0F && z < 2.0F;
+      dev.push_back(patch ? 0.2F : ((i * 150 + k) % 31 == 0 ? 0.06F : 0.01F));  // 3 % noise past 5 cm
+    }
+  DeviationConfig config;
+  std::vector<int> member(wall.size());
+  const std::vector<DeviationRegion> regions = deviation_regions(wall, dev, config, member);
+  ASSERT_EQ(regions.size(), 1U);
+  EXPECT_NEAR(regions[0].centroid.x(), 6.5F, 0.05F);
+  EXPECT_NEAR(regions[0].centroid.z(), 1.5F, 0.05F);
+  EXPECT_EQ(regions[0].points, 2500U);  // the patch's 50 x 50 points
+  std::size_t members_off_the_patch = 0;
+  for (std::size_t i = 0; i < wall.size(); ++i) members_off_the_patch += (member[i] >= 0 && dev[i] != 0.2F) ? 1 : 0;
+  EXPECT_EQ(members_off_the_patch, 0U);
+}
+
 }  // namespace
 }  // namespace adit::slam

@@ -69,6 +69,7 @@ struct DeviationOptions {
   float threshold_m = 0.05F;
   float smooth_m = 0.0F;  // measured: it costs recall more than it buys precision (docs/decisions)
   std::size_t min_region_points = 50;
+  float region_share = slam::DeviationConfig{}.region_min_share;
   bool aligned = false;
   bool json = false;
 };
@@ -137,6 +138,7 @@ int deviations(const DeviationOptions& o) {
   slam::DeviationConfig config;
   config.threshold_m = o.threshold_m;
   config.min_region_points = o.min_region_points;
+  config.region_min_share = o.region_share;
   const std::vector<float> raw = slam::signed_deviations(points, views, prior.map, config);
   const std::vector<float> dev = o.smooth_m > 0.0F ? slam::smooth_deviations(points, raw, o.smooth_m) : raw;
   std::vector<int> member(points.size());
@@ -203,8 +205,9 @@ int deviations(const DeviationOptions& o) {
     fmt::print("{}\n", j.dump(2));
     return kExitOk;
   }
-  fmt::print("deviation cloud: {} ({} points, scalar fields 'deviation' (m, + in front of the design) and 'region')\n",
-             cloud_file.string(), points.size());
+  fmt::print("deviation cloud: {} ({} points, scalar fields 'deviation' (m, + in front of the design), 'raw_deviation', "
+             "'region'{})\n",
+             cloud_file.string(), points.size(), truth.empty() ? "" : " and 'truth' (1 a real difference, 0 none, -1 unknown)");
   fmt::print("{} points deviate by more than {:.3f} m; {} regions of at least {} points:\n", deviating, o.threshold_m,
              regions.size(), o.min_region_points);
   for (std::size_t r = 0; r < regions.size() && r < 30; ++r) {
@@ -246,6 +249,8 @@ void register_prior_map_commands(CLI::App& app, int& status) {
   dev->add_option("--out", d->out, "Folder for deviations.ply and deviations.json")->required();
   dev->add_option("--threshold", d->threshold_m, "Deviation that counts, m")->check(CLI::PositiveNumber)->capture_default_str();
   dev->add_option("--min-region-points", d->min_region_points, "Smaller regions are left out as noise")->capture_default_str();
+  dev->add_option("--region-share", d->region_share, "A 0.2 m voxel joins a region when this share of its points deviates")
+      ->check(CLI::Range(0.0F, 1.0F))->capture_default_str();
   dev->add_option("--smooth", d->smooth_m, "Average the deviations over voxels of this edge, m (0: raw)")->capture_default_str();
   dev->add_flag("--aligned", d->aligned, "The map is already in the prior's frame (no localisation)");
   dev->add_option("--truth-scene", d->truth_scene, "A simulated session's scene.ply: precision and recall of the real differences");

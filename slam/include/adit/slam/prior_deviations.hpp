@@ -16,8 +16,9 @@
 // surface (something built into the designed space: furniture, a wall moved
 // in), negative behind it (a wall moved out, a missing column's place). A
 // point with no prior surface within `max_distance_m` stands in the designed
-// free space: +max_distance_m. Regions: the deviating points grouped by
-// 26-connected voxels (a flood fill), the small ones left out as noise.
+// free space: +max_distance_m. Regions: the voxels where at least
+// `region_min_share` of the map points deviate, grouped by 26-connection (a
+// flood fill), the small ones left out as noise.
 
 #include <span>
 #include <vector>
@@ -33,6 +34,7 @@ struct DeviationConfig {
   float max_distance_m = 0.5F;     // beyond: the designed free space
   float patch_spacings = 1.5F;     // a prior point's plane covers what lies within this many point spacings of it
   float region_voxel_m = 0.2F;     // connectivity of a region
+  float region_min_share = 0.25F;  // a voxel joins a region when this share of its points deviates
   std::size_t min_region_points = 50;
   float viewpoint_voxel_m = 5.0F;  // viewpoints are looked up within 1.5 of these voxels (farther: the sign stays +)
 };
@@ -58,7 +60,8 @@ struct DeviationRegion {
   float max_abs_m = 0.0F;
 };
 
-// Regions of points with |deviation| > threshold_m, largest first; `member`
+// Regions of points with |deviation| > threshold_m, in voxels where enough of
+// the points deviate (DeviationConfig), largest first; `member`
 // (if not empty, points.size() long) gets each point's region index, or -1.
 std::vector<DeviationRegion> deviation_regions(std::span<const Eigen::Vector3f> points,
                                                std::span<const float> deviations, const DeviationConfig& config,
