@@ -36,6 +36,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libfaketime            # tests: the wall clock stepped under aditd (tests/daemon/test_clock_steps.cpp)
   chromium               # the console's browser tests: headless, driven over the DevTools protocol
+  time python3           # benchmark scripts: GNU time's peak resident size, small JSON and binary reading
 )
 # node and npm run the browser tests (puppeteer-core, tests/console); a node
 # already installed (e.g. from NodeSource) is used as it is.
