@@ -26,7 +26,7 @@ LoopCloser::LoopCloser(const LoopClosureConfig& config)
 }
 
 bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                              std::span<const Eigen::Vector3f> points, bool search) {
+                              std::span<const Eigen::Vector3f> points, bool search, bool anchored) {
   const std::size_t k = graph_.nodes.size();
   const std::int64_t search_start_ns = monotonic_ns();
   std::vector<Eigen::Vector3f> kept, query;  // query: only when it will be one
@@ -55,6 +55,12 @@ bool LoopCloser::add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& od
     const Eigen::Vector3d up_body = odometry_pose.linear().transpose() * Eigen::Vector3d::UnitZ();
     graph_.gravity.push_back(
         {k, up_body, 1.0 / (config_.gravity_sigma_rad * config_.gravity_sigma_rad), 1e-9 * static_cast<double>(stamp_ns)});
+  }
+  if (anchored) {
+    Matrix6d information = Matrix6d::Zero();
+    information.diagonal() << Eigen::Vector3d::Constant(1.0 / (config_.anchored_sigma_m * config_.anchored_sigma_m)),
+        Eigen::Vector3d::Constant(1.0 / (config_.anchored_sigma_rad * config_.anchored_sigma_rad));
+    graph_.absolute.push_back({k, odometry_pose, information});
   }
   odometry_.push_back(odometry_pose);
   stamps_.push_back(stamp_ns);

@@ -47,6 +47,32 @@ struct RelativePoseFactor {
   Matrix6d L;
 };
 
+// Absolute pose: e = [p − p_z ; 2·vec(q_z⁻¹·q)], whitened as above.
+struct AbsolutePoseFactor {
+  AbsolutePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information)
+      : p_z(z.translation()), q_z(z.linear()), L(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* q_, const T* p_, T* r_) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
+    const Eigen::Quaternion<T> q_err = q_z.template cast<T>().conjugate() * q;
+    Eigen::Matrix<T, 6, 1> e;
+    e << p - p_z.template cast<T>(), T(2.0) * q_err.vec();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(r_);
+    r = L.template cast<T>() * e;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<AbsolutePoseFactor, 6, 4, 3>(new AbsolutePoseFactor(z, sqrt_information));
+  }
+
+  Eigen::Vector3d p_z;
+  Eigen::Quaterniond q_z;
+  Matrix6d L;
+};
+
 // Gravity: R·u_b − e_z, as the registration's gravity term
 // (slam/registration.hpp, GravityPrior); yaw is free.
 struct GravityFactor {

@@ -42,6 +42,11 @@ PoseGraphSolution optimize(PoseGraph& graph, const PoseGraphSolverConfig& config
     problem.AddResidualBlock(detail::RelativePoseFactor::create(e.measurement, sqrt_information(e.information)), loss,
                              q[e.from].coeffs().data(), p[e.from].data(), q[e.to].coeffs().data(), p[e.to].data());
   }
+  for (const AbsolutePoseEdge& a : graph.absolute) {
+    if (a.node >= n) continue;
+    problem.AddResidualBlock(detail::AbsolutePoseFactor::create(a.measurement, sqrt_information(a.information)), nullptr,
+                             q[a.node].coeffs().data(), p[a.node].data());
+  }
   // Tilt offsets (PoseGraph::tilt_walk_rad_per_sqrt_s), started from the last solve's.
   const bool walk = graph.tilt_walk_rad_per_sqrt_s > 0.0 && !graph.gravity.empty();
   std::vector<Eigen::Vector2d> delta(walk ? graph.gravity.size() : 0, Eigen::Vector2d::Zero());
@@ -69,8 +74,12 @@ PoseGraphSolution optimize(PoseGraph& graph, const PoseGraphSolverConfig& config
     }
     problem.SetManifold(q[i].coeffs().data(), new ceres::EigenQuaternionManifold);  // owned by problem
   }
-  problem.SetParameterBlockConstant(q[0].coeffs().data());
-  problem.SetParameterBlockConstant(p[0].data());
+  const bool placed = std::any_of(graph.absolute.begin(), graph.absolute.end(),
+                                  [n](const AbsolutePoseEdge& a) { return a.node < n; });
+  if (!placed) {  // else the absolute edges fix the frame, and node 0 moves with the rest
+    problem.SetParameterBlockConstant(q[0].coeffs().data());
+    problem.SetParameterBlockConstant(p[0].data());
+  }
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;

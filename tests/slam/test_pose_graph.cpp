@@ -161,6 +161,61 @@ TEST(PoseGraph, TheTiltWalkLevelsARouteClimbingWithTheAccelerometersBias) {
   EXPECT_LT(walk_tilt, 0.015);
 }
 
+// A corridor driven out and back, one node a metre: the first five nodes
+// were mapped before the odometry was anchored to a prior map, 4 cm off in
+// y in the prior's frame; from node 5 on the odometry holds to the prior
+// (the truth). Loops on the way back measure the true relative poses to the
+// first nodes. Held by absolute edges, the anchored nodes stay and the loops
+// bring the first nodes towards them; holding node 0 instead carries its
+// 4 cm onto every node the loops reach.
+struct AnchoredCorridor {
+  std::vector<Eigen::Isometry3d> truth;
+  PoseGraph graph;
+};
+
+AnchoredCorridor anchored_corridor(bool absolute) {
+  AnchoredCorridor c;
+  for (int k = 0; k <= 20; ++k) c.truth.push_back(pose(k, 0, 0));
+  for (int k = 20; k >= 0; --k) c.truth.push_back(pose(k, 0.5, M_PI));
+  const Eigen::Isometry3d off = pose(0, 0.04, 0);
+  std::vector<Eigen::Isometry3d> odometry;
+  for (std::size_t k = 0; k < c.truth.size(); ++k) odometry.push_back(k < 5 ? off * c.truth[k] : c.truth[k]);
+  c.graph.nodes = odometry;
+  for (std::size_t k = 1; k < odometry.size(); ++k) {
+    const Eigen::Isometry3d motion = odometry[k - 1].inverse() * odometry[k];
+    c.graph.edges.push_back({k - 1, k, motion, odometry_information(motion), EdgeKind::odometry});
+  }
+  const std::size_t last = c.truth.size() - 1;
+  for (std::size_t k = 0; k < 5; ++k)  // node last - k passes node k on the way back
+    c.graph.edges.push_back({k, last - k, c.truth[k].inverse() * c.truth[last - k], loop_information(), EdgeKind::loop});
+  if (absolute) {
+    Vector6d d;
+    d << Eigen::Vector3d::Constant(1 / (0.02 * 0.02)), Eigen::Vector3d::Constant(1 / (0.0035 * 0.0035));
+    for (std::size_t k = 5; k <= last; ++k) c.graph.absolute.push_back({k, odometry[k], d.asDiagonal()});
+  }
+  return c;
+}
+
+double worst_error(const AnchoredCorridor& c, std::size_t from, std::size_t to) {
+  double worst = 0.0;
+  for (std::size_t k = from; k < to; ++k)
+    worst = std::max(worst, (c.graph.nodes[k].translation() - c.truth[k].translation()).norm());
+  return worst;
+}
+
+TEST(PoseGraph, AbsoluteEdgesHoldTheAnchoredNodesAndTheLoopsMoveTheOthersTowardsThem) {
+  AnchoredCorridor held = anchored_corridor(true);
+  EXPECT_TRUE(optimize(held.graph).converged);
+  EXPECT_LT(worst_error(held, 5, held.truth.size()), 0.01);  // the anchored nodes stay on the prior
+  // The first ones come towards them, as far as the odometry edges into the
+  // anchor (which hold the 4 cm) let loops of 5 cm σ move them.
+  EXPECT_LT(worst_error(held, 0, 5), 0.03);
+  AnchoredCorridor fixed_first = anchored_corridor(false);
+  EXPECT_TRUE(optimize(fixed_first.graph).converged);
+  EXPECT_TRUE(fixed_first.graph.nodes[0].isApprox(anchored_corridor(false).graph.nodes[0], 1e-12));
+  EXPECT_GT(worst_error(fixed_first, 30, fixed_first.truth.size()), 0.03);  // the first node's 4 cm, carried back
+}
+
 TEST(PoseGraph, OdometryInformationLoosensWithDistance) {
   const Matrix6d near = odometry_information(pose(0.1, 0, 0));
   const Matrix6d far = odometry_information(pose(5.0, 0, 0));

@@ -72,6 +72,13 @@ struct LoopClosureConfig {
   // optimises every n nodes, hdl_graph_slam every few seconds, for the same
   // reason). 0 = after every keyframe that adds a loop. Decision 062.
   double optimize_every_s = 0.0;
+  // A keyframe mapped while the odometry was anchored to a prior map
+  // (add_keyframe's `anchored`) is held where it was mapped with these σ: the
+  // anchored odometry lies within 1-2 cm of the prior (docs/PRIOR-MAP.md). The
+  // loops then bring the keyframes mapped before the anchor towards the
+  // anchored ones, instead of carrying the first keyframe's offset onto them.
+  double anchored_sigma_m = 0.02;
+  double anchored_sigma_rad = 0.0035;  // 0.2°
 };
 
 // One candidate's fate, for the log and summary.json.
@@ -121,8 +128,10 @@ class LoopCloser {
   // With `search` false the keyframe joins the graph and the store (a later
   // one may find it) but seeks no loop and no optimisation runs: a caller
   // that has fallen behind catches up at a few milliseconds a keyframe.
+  // `anchored`: the pose was registered against a prior map as well, so it
+  // is held there (LoopClosureConfig::anchored_sigma_m).
   bool add_keyframe(std::int64_t stamp_ns, const Eigen::Isometry3d& odometry_pose,
-                    std::span<const Eigen::Vector3f> points, bool search = true);
+                    std::span<const Eigen::Vector3f> points, bool search = true, bool anchored = false);
 
   // The graph's estimate of every keyframe, in order.
   const std::vector<Eigen::Isometry3d>& poses() const { return graph_.nodes; }

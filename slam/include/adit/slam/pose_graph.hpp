@@ -38,10 +38,21 @@ struct GravityPriorEdge {
   double stamp_s = 0.0;      // when it was measured (the tilt walk's time step)
 };
 
+// A node's pose measured in the graph's own frame: a keyframe mapped while
+// the odometry was registered against a prior map (slam::PriorMapTerm) is
+// placed by that prior, not by the chain of odometry before it.
+struct AbsolutePoseEdge {
+  std::size_t node = 0;
+  Eigen::Isometry3d measurement = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Identity();
+};
+
 struct PoseGraph {
-  std::vector<Eigen::Isometry3d> nodes;  // node 0 is held fixed: it defines the map frame
+  // Node 0 is held fixed, defining the map frame, unless absolute edges do.
+  std::vector<Eigen::Isometry3d> nodes;
   std::vector<PoseGraphEdge> edges;
   std::vector<GravityPriorEdge> gravity;
+  std::vector<AbsolutePoseEdge> absolute;
   // The measured ups may be off by a tilt that wanders: an accelerometer's
   // bias b walks (its random walk, in m/s³/√Hz), and the up it gives is off
   // by b/g rad. > 0: each gravity prior's up is turned by a tilt offset δ
