@@ -80,7 +80,7 @@ void LoopClosureStage::loop() {
       log::info("loops: caught up at keyframe {} ({} keyframes so far added without a search)", closer_.stats().keyframes,
                 closer_.stats().keyframes_not_searched);
     catching_up = !search;
-    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points, search)) {
+    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points, search, k->anchored)) {
       const Eigen::Isometry3d c = closer_.correction();
       log::info("loops: keyframe {}: {} loop(s) accepted, graph optimised in {:.3f} s; correction {:.3f} m",
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,

@@ -208,19 +208,24 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   else
     deskewer_.deskew(points_, times_, velocity, deskewed_);
   // The map's pose of the scan: the odometry's, refined against the map of
-  // the scans before it (slam::MapRefiner says why).
-  const Eigen::Isometry3d map_pose = refiner_ ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;
+  // the scans before it (slam::MapRefiner says why). Once the odometry is
+  // anchored to a prior map it registers against the prior as well, and its
+  // pose is taken as it is: refined against the scans mapped before the
+  // anchor, the map would keep their error (decision 073).
+  const bool refine = refiner_ && !slot.anchored;
+  const Eigen::Isometry3d map_pose = refine ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;
   map_trajectory_.write(slot.stamp_ns, map_pose);
   if (refiner_) {
     const std::lock_guard lock(frame_mutex_);
-    refinement_ = map_pose * slot.pose.inverse();
+    refinement_ = map_pose * slot.pose.inverse();  // identity once anchored
   }
   if (journal_ != nullptr) journal_->map_pose(slot.stamp_ns, map_pose);
   const bool keyframe = keyframe_selector_.take(map_pose);
   if (keyframe) {
     keyframe_downsampler_.downsample(deskewed_, static_cast<float>(config_.keyframe_voxel_m), keyframe_points_);
     keyframes_.push_back({slot.stamp_ns, map_pose, keyframe_points_});
-    if (loops_ != nullptr) loops_->push({slot.stamp_ns, map_pose, keyframe_points_}, [this] { return thread_.idle(); });
+    if (loops_ != nullptr)
+      loops_->push({slot.stamp_ns, map_pose, keyframe_points_, slot.anchored}, [this] { return thread_.idle(); });
     if (journal_ != nullptr) journal_->keyframe(slot.stamp_ns, map_pose, keyframe_points_);
     keyframe_bytes_ += sizeof(slam::Keyframe) + keyframes_.back().points.capacity() * sizeof(Eigen::Vector3f);
     stats_.keyframes.store(keyframes_.size(), std::memory_order_relaxed);

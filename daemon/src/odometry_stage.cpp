@@ -112,6 +112,7 @@ void OdometryStage::hand_to_mapping(const drivers::LidarScan& scan, const slam::
   m->pose = result.pose;
   m->valid = result.valid;
   m->inertial = result.inertial;
+  m->anchored = odometry_.odometry().prior_from_odometry().has_value();
   m->points.assign(odometry_.body_points().begin(), odometry_.body_points().end());
   m->times_s.assign(odometry_.body_times().begin(), odometry_.body_times().end());
   m->intensities.clear();

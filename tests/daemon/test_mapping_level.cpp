@@ -117,11 +117,15 @@ TEST(MappingLevel, AnUpThatCannotLevelEndsTheLevellingAndNoFileIsLeft) {
 }
 
 // A still sensor in a room's corner (two walls and the floor, 0.1 m apart)
-// whose odometry creeps 2 cm and 1 cm a scan in x and z: the refinement holds
-// the scans nearer the map of the first, and MappingStage::refinement (M·O⁻¹)
-// takes the crept odometry pose to the map's pose, as a MapRefiner given the
-// same scans gives it.
-TEST(MappingLevel, TheRefinementTakesTheOdometrysPoseToTheMapsPose) {
+// whose odometry creeps 2 cm and 1 cm a scan in x and z from the fourth scan;
+// the scans from `anchored_from` on come anchored to a prior map. Returns the
+// stage's refinement (M·O⁻¹) at the end, the last odometry pose and what a
+// MapRefiner given the same scans makes of it.
+struct CornerRun {
+  Eigen::Isometry3d refinement, odometry, map_pose;
+};
+
+CornerRun map_a_creeping_corner(int anchored_from) {
   constexpr std::size_t kMaxPoints = 8000;
   std::vector<Eigen::Vector3f> corner;
   for (int i = -30; i <= 30; ++i)
@@ -137,23 +141,23 @@ TEST(MappingLevel, TheRefinementTakesTheOdometrysPoseToTheMapsPose) {
   Handoff<MapSlot> scans(4, Overflow::wait, test::map_slot_with_room(kMaxPoints));
   config::Config config;
   config.grid.enabled = false;
-  ASSERT_TRUE(config.map.refine);
+  EXPECT_TRUE(config.map.refine);
   MappingStage stage(config, slam::OdometryConfig{}, scans, kMaxPoints, {}, stats, stop);
   stage.start();
   EXPECT_TRUE(stage.refinement().isApprox(Eigen::Isometry3d::Identity()));
   slam::MapRefinerConfig refine;
   refine.max_scan_points = kMaxPoints;
   slam::MapRefiner refiner(refine);
-  Eigen::Isometry3d odometry = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d map_pose = odometry;
+  CornerRun run{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
   for (int k = 0; k < 10; ++k) {
-    if (k >= 3) odometry.translation() += Eigen::Vector3d(0.02, 0.0, 0.01);
-    map_pose = refiner.refine(odometry, corner);
+    if (k >= 3) run.odometry.translation() += Eigen::Vector3d(0.02, 0.0, 0.01);
+    run.map_pose = refiner.refine(run.odometry, corner);
     MapSlot* slot = scans.acquire_or_wait([] { return true; });
-    ASSERT_NE(slot, nullptr);
+    if (slot == nullptr) break;
     slot->stamp_ns = 1'000'000'000 + 100'000'000LL * k;
     slot->valid = true;
-    slot->pose = odometry;
+    slot->anchored = k >= anchored_from;
+    slot->pose = run.odometry;
     slot->points.assign(corner.begin(), corner.end());
     slot->times_s.assign(corner.size(), 0.0F);
     slot->intensities.assign(corner.size(), 1.0F);
@@ -161,11 +165,27 @@ TEST(MappingLevel, TheRefinementTakesTheOdometrysPoseToTheMapsPose) {
   }
   scans.close();
   stage.join();
-  EXPECT_GT((map_pose.translation() - odometry.translation()).norm(), 0.05) << "the refinement held nothing back";
-  const Eigen::Isometry3d placed = stage.refinement() * odometry;
-  EXPECT_LT((placed.translation() - map_pose.translation()).norm(), 1e-4)
-      << placed.translation().transpose() << " against " << map_pose.translation().transpose();
-  EXPECT_TRUE(placed.linear().isApprox(map_pose.linear(), 1e-6));
+  run.refinement = stage.refinement();
+  return run;
+}
+
+// The refinement holds the scans nearer the map of the first, and
+// MappingStage::refinement takes the crept odometry pose to the map's pose,
+// as a MapRefiner given the same scans gives it.
+TEST(MappingLevel, TheRefinementTakesTheOdometrysPoseToTheMapsPose) {
+  const CornerRun run = map_a_creeping_corner(100);
+  EXPECT_GT((run.map_pose.translation() - run.odometry.translation()).norm(), 0.05) << "the refinement held nothing back";
+  const Eigen::Isometry3d placed = run.refinement * run.odometry;
+  EXPECT_LT((placed.translation() - run.map_pose.translation()).norm(), 1e-4)
+      << placed.translation().transpose() << " against " << run.map_pose.translation().transpose();
+  EXPECT_TRUE(placed.linear().isApprox(run.map_pose.linear(), 1e-6));
+}
+
+// Once the odometry is anchored to a prior map, its poses are the map's: the
+// map of the scans before the anchor would hold the map to their error.
+TEST(MappingLevel, AnAnchoredScanKeepsTheOdometrysPose) {
+  const CornerRun run = map_a_creeping_corner(5);
+  EXPECT_TRUE(run.refinement.isApprox(Eigen::Isometry3d::Identity(), 1e-12)) << run.refinement.matrix();
 }
 
 }  // namespace

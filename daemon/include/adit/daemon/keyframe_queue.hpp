@@ -25,6 +25,7 @@ struct KeyframeItem {
   std::int64_t stamp_ns = 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // where the map placed it
   std::vector<Eigen::Vector3f> points;                      // body frame, deskewed, downsampled
+  bool anchored = false;  // mapped while the odometry was anchored to a prior map (the graph holds it there)
 };
 
 class KeyframeQueue {

@@ -47,6 +47,7 @@ struct MapSlot {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   bool valid = false;
   bool inertial = false;  // the pose is the LiDAR-inertial odometry's
+  bool anchored = false;  // the pose was registered against a prior map too (slam::Odometry::anchor_to_prior)
   std::vector<Eigen::Vector3f> points;
   std::vector<float> times_s;
   std::vector<float> intensities;
