@@ -13,26 +13,39 @@
 
 namespace adit::slam::detail {
 
-// Relative pose (as the SE(3) pose-graph residual of Carlone et al., ICRA
-// 2015, §II, in the quaternion form of Ceres's pose_graph_3d example):
-//   p̂ = R_a⁻¹(p_b − p_a),  q̂ = q_a⁻¹·q_b
+// A measured pose z = (p_z, q_z) and the residual of an estimate (p̂, q̂) of it
+// (the SE(3) pose-graph residual of Carlone et al., ICRA 2015, §II, in the
+// quaternion form of Ceres's pose_graph_3d example):
 //   e = [p̂ − p_z ; 2·vec(q_z⁻¹·q̂)]        (2·vec ≈ the rotation vector for small errors)
 // whitened by the square root of the information, L with LᵀL = Λ.
-struct RelativePoseFactor {
-  RelativePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information)
+struct PoseResidual {
+  PoseResidual(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information)
       : p_z(z.translation()), q_z(z.linear()), L(sqrt_information) {}
+
+  template <typename T>
+  void operator()(const Eigen::Matrix<T, 3, 1>& p_hat, const Eigen::Quaternion<T>& q_hat, T* r_) const {
+    const Eigen::Quaternion<T> q_err = q_z.template cast<T>().conjugate() * q_hat;
+    Eigen::Matrix<T, 6, 1> e;
+    e << p_hat - p_z.template cast<T>(), T(2.0) * q_err.vec();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(r_);
+    r = L.template cast<T>() * e;
+  }
+
+  Eigen::Vector3d p_z;
+  Eigen::Quaterniond q_z;
+  Matrix6d L;
+};
+
+// Relative pose: p̂ = R_a⁻¹(p_b − p_a), q̂ = q_a⁻¹·q_b.
+struct RelativePoseFactor {
+  RelativePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information) : residual(z, sqrt_information) {}
 
   template <typename T>
   bool operator()(const T* qa_, const T* pa_, const T* qb_, const T* pb_, T* r_) const {
     const Eigen::Map<const Eigen::Quaternion<T>> qa(qa_), qb(qb_);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pa(pa_), pb(pb_);
     const Eigen::Quaternion<T> qa_inv = qa.conjugate();
-    const Eigen::Matrix<T, 3, 1> p_hat = qa_inv * (pb - pa);
-    const Eigen::Quaternion<T> q_err = q_z.template cast<T>().conjugate() * (qa_inv * qb);
-    Eigen::Matrix<T, 6, 1> e;
-    e << p_hat - p_z.template cast<T>(), T(2.0) * q_err.vec();
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(r_);
-    r = L.template cast<T>() * e;
+    residual(Eigen::Matrix<T, 3, 1>(qa_inv * (pb - pa)), Eigen::Quaternion<T>(qa_inv * qb), r_);
     return true;
   }
 
@@ -42,25 +55,17 @@ struct RelativePoseFactor {
         new RelativePoseFactor(z, sqrt_information));
   }
 
-  Eigen::Vector3d p_z;
-  Eigen::Quaterniond q_z;
-  Matrix6d L;
+  PoseResidual residual;
 };
 
-// Absolute pose: e = [p − p_z ; 2·vec(q_z⁻¹·q)], whitened as above.
+// Absolute pose: p̂ = p, q̂ = q (a node held where a prior map placed it).
 struct AbsolutePoseFactor {
-  AbsolutePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information)
-      : p_z(z.translation()), q_z(z.linear()), L(sqrt_information) {}
+  AbsolutePoseFactor(const Eigen::Isometry3d& z, const Matrix6d& sqrt_information) : residual(z, sqrt_information) {}
 
   template <typename T>
   bool operator()(const T* q_, const T* p_, T* r_) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
-    const Eigen::Quaternion<T> q_err = q_z.template cast<T>().conjugate() * q;
-    Eigen::Matrix<T, 6, 1> e;
-    e << p - p_z.template cast<T>(), T(2.0) * q_err.vec();
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(r_);
-    r = L.template cast<T>() * e;
+    residual(Eigen::Matrix<T, 3, 1>(Eigen::Map<const Eigen::Matrix<T, 3, 1>>(p_)),
+             Eigen::Quaternion<T>(Eigen::Map<const Eigen::Quaternion<T>>(q_)), r_);
     return true;
   }
 
@@ -68,9 +73,7 @@ struct AbsolutePoseFactor {
     return new ceres::AutoDiffCostFunction<AbsolutePoseFactor, 6, 4, 3>(new AbsolutePoseFactor(z, sqrt_information));
   }
 
-  Eigen::Vector3d p_z;
-  Eigen::Quaterniond q_z;
-  Matrix6d L;
+  PoseResidual residual;
 };
 
 // Gravity: R·u_b − e_z, as the registration's gravity term
