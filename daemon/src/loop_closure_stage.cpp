@@ -80,7 +80,9 @@ void LoopClosureStage::loop() {
       log::info("loops: caught up at keyframe {} ({} keyframes so far added without a search)", closer_.stats().keyframes,
                 closer_.stats().keyframes_not_searched);
     catching_up = !search;
-    if (closer_.add_keyframe(k->stamp_ns, k->pose, k->points, search, k->anchored)) {
+    const bool optimised = closer_.add_keyframe(k->stamp_ns, k->pose, k->points, search, k->anchored);
+    update_stats();  // before a correction is posted: a status showing it counts the loops that made it
+    if (optimised) {
       const Eigen::Isometry3d c = closer_.correction();
       log::info("loops: keyframe {}: {} loop(s) accepted, graph optimised in {:.3f} s; correction {:.3f} m",
                 closer_.stats().keyframes - 1, closer_.stats().accepted - accepted_before,
@@ -93,16 +95,15 @@ void LoopClosureStage::loop() {
     }
     if (closer_.scans().read_errors() + closer_.scans().write_errors() > file_errors_before)
       log::warn("loops: {}", closer_.scans().last_error());
-    update_stats();
   }
   if (thread_.stopping()) return;
   const std::int64_t t0 = monotonic_ns();
   closer_.refine();
   refine_time_s_ = 1e-9 * static_cast<double>(monotonic_ns() - t0);
+  update_stats();
   // The correction the map files follow, for the live tiles' last placement
   // (MappingStage::follow_final_correction) and the status's frame.
   if (closer_.stats().accepted > 0) live_.post(closer_.correction_track());
-  update_stats();
 }
 
 void LoopClosureStage::update_stats() {
