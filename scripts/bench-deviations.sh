@@ -40,13 +40,7 @@ for drive in "${drives[@]}"; do
     fi
     # The anchored run at the drive's own pace, as a payload maps it: replayed as fast as it goes, the odometry
     # runs on while the search does and maps most of the drive before it is anchored (docs/PRIOR-MAP.md).
-    mkdir -p "$work"
-    aditd_config "$session" "$work" "$([ "$kind" = anchored ] && echo 1 || echo 0)" > "$work/aditd.yaml"
-    printf 'session:\n  products: false\n' >> "$work/aditd.yaml"
-    [ -z "$extra" ] || printf '%s\n' "$extra" >> "$work/aditd.yaml"
-    "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
-      { echo "bench-deviations: $name $kind: aditd failed ($work/aditd.log)" >&2; exit 1; }
-    folder=$(ls -d "$work"/state/sessions/*/ | head -1)
+    folder=$(map_once "$session" "$work" "$extra" "$([ "$kind" = anchored ] && echo 1 || echo 0)") || exit 1
     anchored=$(field "$folder/summary.json" 'j["prior_map"].get("anchored", "-")')
     after=$(field "$folder/summary.json" '"%.1f" % j["prior_map"]["anchored_after_s"] if j["prior_map"].get("anchored") else "-"')
     if [ "$kind" = anchored ] && [ "$anchored" != True ]; then

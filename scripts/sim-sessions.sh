@@ -62,15 +62,16 @@ aditd_config() {
   printf 'threads:\n  lock_memory: false\n'
 }
 
-# map_once SESSION WORK [EXTRA_YAML]: aditd maps the session once (`--once`, as
-# fast as it goes) into WORK, reused while WORK/done exists; the benchmark makes
-# its own products, so aditd makes none. Prints the session folder aditd wrote.
+# map_once SESSION WORK [EXTRA_YAML [REPLAY_SPEED]]: aditd maps the session once
+# (`--once`; as fast as it goes unless REPLAY_SPEED is given: 1 = the drive's own
+# pace) into WORK, reused while WORK/done exists; the benchmark makes its own
+# products, so aditd makes none. Prints the session folder aditd wrote.
 map_once() {
-  local session=$1 work=$2 extra=${3:-}
+  local session=$1 work=$2 extra=${3:-} speed=${4:-0}
   if [ ! -f "$work/done" ]; then
     rm -rf "$work"
     mkdir -p "$work"
-    aditd_config "$session" "$work" > "$work/aditd.yaml"
+    aditd_config "$session" "$work" "$speed" > "$work/aditd.yaml"
     printf 'session:\n  products: false\n' >> "$work/aditd.yaml"
     [ -z "$extra" ] || printf '%s\n' "$extra" >> "$work/aditd.yaml"
     "$build/bin/aditd" --config "$work/aditd.yaml" --once > "$work/aditd.log" 2>&1 ||
