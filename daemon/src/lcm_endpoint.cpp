@@ -245,7 +245,7 @@ struct LcmEndpoint::Impl final : TileSink, GridPatchSink {
       drain_status();
       TileUpdate t;
       while (take_from(tiles, t)) {
-        publisher.update(t.key, t.points, t.utime);
+        publisher.update(t.key, t.first_point, t.points, t.utime);
         tile_points_waiting.fetch_sub(t.points.size(), std::memory_order_relaxed);
         // take_from gives the slot what `t` held: it must be nothing, or each
         // of the queue's slots would keep a whole tile's points (up to ~19 MB)

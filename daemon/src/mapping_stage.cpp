@@ -215,6 +215,8 @@ void MappingStage::map_scan(const MapSlot& slot, const slam::Vector6d& velocity)
   const bool refine = refiner_ && !slot.anchored;
   const Eigen::Isometry3d map_pose = refine ? refiner_->refine(slot.pose, deskewed_, slot.inertial) : slot.pose;
   map_trajectory_.write(slot.stamp_ns, map_pose);
+  newest_stamp_ns_ = slot.stamp_ns;
+  newest_position_ = map_pose.translation();
   if (refiner_) {
     const std::lock_guard lock(frame_mutex_);
     refinement_ = map_pose * slot.pose.inverse();  // identity once anchored
@@ -364,7 +366,8 @@ void MappingStage::compact_tiles(const std::vector<slam::TileCoord>& coords) {
       tile_file_error(problem);
       continue;
     }
-    if (map_.evict(coord).changed && sink_) send_tile(coord, tile_buffer);
+    const std::size_t stored = map_.stored_points(coord);
+    if (map_.evict(coord).changed && sink_) send_unsent(coord, stored, tile_buffer);
     journaled_.erase(coord);
     map_.restore(coord, tile_buffer);
     stats_.compacted_tiles.fetch_add(1, std::memory_order_relaxed);
@@ -394,8 +397,9 @@ void MappingStage::restore_tiles(const std::vector<slam::TileCoord>& coords) {
 void MappingStage::evict_tiles(const std::vector<slam::TileCoord>& coords) {
   std::vector<slam::MapSample> tile_buffer;
   for (const slam::TileCoord& coord : coords) {
-    const bool restored = map_.stored_points(coord) > 0;
-    if (!restored || !map_.tile(coord).empty()) {
+    const std::size_t stored = map_.stored_points(coord);
+    const bool fresh = stored == 0 || !map_.tile(coord).empty();
+    if (fresh) {
       std::string problem = spill_->whole_tile(map_, coord, tile_buffer);
       if (problem.empty()) problem = spill_->write(coord, tile_buffer);
       if (!problem.empty()) {
@@ -403,8 +407,10 @@ void MappingStage::evict_tiles(const std::vector<slam::TileCoord>& coords) {
         continue;
       }
     }
-    if (map_.evict(coord).changed && sink_ && spill_->whole_tile(map_, coord, tile_buffer).empty())
-      send_tile(coord, tile_buffer);
+    if (map_.evict(coord).changed && sink_) {
+      if (fresh) send_unsent(coord, stored, tile_buffer);
+      else if (spill_->whole_tile(map_, coord, tile_buffer).empty()) send_tile(coord, 0, tile_buffer);
+    }
     journaled_.erase(coord);
     stats_.evicted_tiles.fetch_add(1, std::memory_order_relaxed);
   }
@@ -425,18 +431,62 @@ std::string MappingStage::whole_tile(const slam::TileCoord& coord, std::vector<s
   return problem;
 }
 
-// A tile's whole content to the sink, placed by the graph's correction when
-// following it (each sample by the correction at its scan's time).
-void MappingStage::send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
-  if (graph_ != nullptr)
-    sent_with_[coord] = {placement_version_, placement_ ? placement_->slice_for(samples) : slam::CorrectionTrack{}};
-  if (placement_ == nullptr) {
-    sink_(coord, samples);
-    return;
+// A tile's points from `first` on (`samples`; 0: the whole tile) to the
+// sink, placed by the graph's correction when following it (each sample by
+// the correction at its scan's time).
+void MappingStage::send_tile(const slam::TileCoord& coord, std::size_t first, std::span<const slam::MapSample> samples) {
+  SentTile& sent = sent_[coord];
+  if (graph_ != nullptr) {
+    slam::CorrectionTrack slice = placement_ ? placement_->slice_for(samples) : slam::CorrectionTrack{};
+    sent.track = first > 0 ? sent.track.merged_with(slice) : std::move(slice);
+    double newest = first > 0 ? sent.newest_s : -std::numeric_limits<double>::infinity();
+    for (const slam::MapSample& s : samples) newest = std::max(newest, s.time_s);
+    sent.newest_s = newest;
   }
-  std::vector<slam::MapSample> placed;
-  slam::correct_samples(samples, placement_.get(), Eigen::Isometry3d::Identity(), placed);
-  sink_(coord, placed);
+  sent.version = placement_version_;
+  bool taken = false;
+  if (placement_ == nullptr) {
+    taken = sink_(coord, first, samples);
+  } else {
+    std::vector<slam::MapSample> placed;
+    slam::correct_samples(samples, placement_.get(), Eigen::Isometry3d::Identity(), placed);
+    taken = sink_(coord, first, placed);
+  }
+  sent.points = taken ? first + samples.size() : 0;  // not taken: the next update goes whole
+}
+
+// Where an update of a tile holding `total` points, the first `stored` of
+// them read back from its file, starts: after the points last sent, when
+// they were placed as tiles are now and the tile has kept them in the order
+// sent (all of its stored part, and what it holds in RAM has only grown);
+// else 0, the whole tile (decision 074).
+std::size_t MappingStage::unsent_from(const slam::TileCoord& coord, std::size_t stored, std::size_t total) const {
+  const auto sent = sent_.find(coord);
+  if (sent == sent_.end() || sent->second.version != placement_version_) return 0;
+  const std::size_t n = sent->second.points;
+  return n >= stored && n <= total ? n : 0;
+}
+
+// Of a tile's whole content (`whole`: its `stored` part, then what the map
+// holds in RAM), what was not sent yet.
+void MappingStage::send_unsent(const slam::TileCoord& coord, std::size_t stored,
+                               std::span<const slam::MapSample> whole) {
+  const std::size_t first = unsent_from(coord, stored, whole.size());
+  send_tile(coord, first, whole.subspan(first));
+}
+
+// Whether the live tiles take the graph's newest correction `latest` now: the
+// first one; once kPlacementPeriodS of the session has passed since the
+// tiles took one; or when it moves where the sensor is by more than
+// kPlacementMoveM (the pose a client draws with the latest correction would
+// stand that far off the tiles). Each time they take one, every tile that
+// changed goes whole and every tile sent is checked (decision 074).
+bool MappingStage::placement_due(const slam::CorrectionTrack* latest) const {
+  if (placement_ == nullptr || latest == nullptr) return true;
+  if (1e-9 * static_cast<double>(newest_stamp_ns_ - placement_stamp_ns_) >= kPlacementPeriodS) return true;
+  const Eigen::Isometry3d now = latest->at(newest_stamp_ns_);
+  const Eigen::Isometry3d before = placement_->at(newest_stamp_ns_);
+  return (now * newest_position_ - before * newest_position_).norm() > kPlacementMoveM;
 }
 
 void MappingStage::flush_tiles(bool final) {
@@ -444,18 +494,25 @@ void MappingStage::flush_tiles(bool final) {
   if (!sink_) return;
   if (graph_ != nullptr) {
     std::shared_ptr<const slam::CorrectionTrack> latest = graph_->latest();
-    if (latest != placement_) {  // a new optimisation: every tile sent is checked against it
+    if (latest != placement_ && (final || placement_due(latest.get()))) {  // every tile sent is checked against it
       placement_ = std::move(latest);
+      placement_stamp_ns_ = newest_stamp_ns_;
       ++placement_version_;
       recheck_.clear();
-      for (const auto& [coord, sent] : sent_with_) recheck_.push_back(coord);
+      for (const auto& [coord, sent] : sent_) recheck_.push_back(coord);
     }
   }
   std::vector<slam::MapSample> tile_buffer;
   std::span<const slam::MapSample> samples;
   for (const slam::TileCoord& coord : changed) {
-    if (const std::string problem = whole_tile(coord, tile_buffer, samples); problem.empty())
-      send_tile(coord, samples);
+    // What the tile gained, from RAM; the whole tile (its file read back)
+    // only when it was not sent placed as now.
+    const std::span<const slam::MapSample> held = map_.tile(coord);
+    const std::size_t stored = map_.stored_points(coord);
+    if (const std::size_t first = unsent_from(coord, stored, stored + held.size()); first >= stored)
+      send_tile(coord, first, held.subspan(first - stored));
+    else if (const std::string problem = whole_tile(coord, tile_buffer, samples); problem.empty())
+      send_tile(coord, 0, samples);
     else
       tile_file_error(problem);
   }
@@ -481,15 +538,23 @@ void MappingStage::replace_moved_tiles(bool all) {
     }
     const slam::TileCoord coord = recheck_.front();
     recheck_.pop_front();
-    const auto sent = sent_with_.find(coord);
-    if (sent == sent_with_.end() || sent->second.version == placement_version_) continue;  // sent since, by the latest
+    const auto sent = sent_.find(coord);
+    if (sent == sent_.end() || sent->second.version == placement_version_) continue;  // sent since, by the latest
+    // Most checks find nothing moved: the tile's corners tell without reading its points (decision 074).
+    const Eigen::Vector3d lo = Eigen::Vector3d(coord.x, coord.y, coord.z) * map_.config().tile_size_m;
+    const Eigen::AlignedBox3d box(lo, lo + Eigen::Vector3d::Constant(map_.config().tile_size_m));
+    if (!slam::correction_may_move(sent->second.track, placement_.get(), box, sent->second.newest_s, kTileMoveM)) {
+      stats_.tiles_checked_for_loops.fetch_add(1, std::memory_order_relaxed);
+      stats_.tiles_checked_by_corners.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
     if (const std::string problem = whole_tile(coord, tile_buffer, samples); !problem.empty()) {
       tile_file_error(problem);
       continue;
     }
     stats_.tiles_checked_for_loops.fetch_add(1, std::memory_order_relaxed);
     if (!slam::correction_moves(samples, &sent->second.track, placement_.get(), kTileMoveM)) continue;
-    send_tile(coord, samples);
+    send_tile(coord, 0, samples);
     stats_.tiles_moved_by_loops.fetch_add(1, std::memory_order_relaxed);
     stats_.points_moved_by_loops.fetch_add(samples.size(), std::memory_order_relaxed);
   }

@@ -137,7 +137,8 @@ int run(const config::Config& config, const std::filesystem::path& config_file, 
     if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_pose(p);
   };
   outputs.tile = [&endpoint_ptr](TileUpdate&& t) {
-    if (LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed)) e->publish_tile(std::move(t));
+    LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed);
+    return e != nullptr && e->publish_tile(std::move(t));
   };
   outputs.tile_backlog = [&endpoint_ptr]() -> std::uint64_t {
     const LcmEndpoint* e = endpoint_ptr.load(std::memory_order_relaxed);

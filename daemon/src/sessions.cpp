@@ -283,8 +283,9 @@ std::unique_ptr<Pipeline> Sessions::build_pipeline() const {
   options.sinks.imu_pose = outputs_.imu_pose;
   options.sinks.tile_backlog = outputs_.tile_backlog;
   if (outputs_.tile) {
-    options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::span<const slam::MapSample> points) {
-      tile(TileUpdate{realtime_us(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points)});
+    options.sinks.tile = [tile = outputs_.tile](const slam::TileCoord& c, std::size_t first_point,
+                                                std::span<const slam::MapSample> points) {
+      return tile(TileUpdate{realtime_us(), protocol::TileKey{c.x, c.y, c.z}, map_points_of(points), first_point});
     };
   }
   if (outputs_.grid) {
@@ -574,6 +575,7 @@ void Sessions::finish(std::unique_ptr<Pipeline> pipeline, std::string id, std::f
                  {"compacted_tiles", s.compacted_tiles.load()},
                  {"peak_resident_tiles_mb", 1e-6 * static_cast<double>(s.map_bytes_peak.load())},
                  {"tiles_checked_for_loops", s.tiles_checked_for_loops.load()},
+                 {"tiles_checked_by_corners", s.tiles_checked_by_corners.load()},
                  {"tiles_moved_by_loops", s.tiles_moved_by_loops.load()},
                  {"points_moved_by_loops", s.points_moved_by_loops.load()},
                  {"revisit_points", s.revisit_points.load()},

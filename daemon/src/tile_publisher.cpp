@@ -43,8 +43,15 @@ void TilePublisher::reset(std::string session_id, const std::filesystem::path& s
   queued_.clear();
 }
 
-void TilePublisher::update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime) {
-  if (store_.update(key, points, utime)) dirty_.insert(protocol::tile_id(key));
+void TilePublisher::update(protocol::TileKey key, std::size_t first_point,
+                           std::span<const protocol::MapPoint> points, std::int64_t utime) {
+  bool changed = false;
+  if (first_point == 0) {
+    changed = store_.update(key, points, utime);
+  } else if (const std::string problem = store_.append(key, first_point, points, utime, changed); !problem.empty()) {
+    if (counts_.updates_refused++ == 0) log::error("tile stream: {}", problem);
+  }
+  if (changed) dirty_.insert(protocol::tile_id(key));
   if (store_.spool_write_errors() > 0 && reported_write_errors_ == 0)
     log::error("tile stream: {} (such segments stay in RAM)", store_.first_write_problem());
   reported_write_errors_ = store_.spool_write_errors();

@@ -139,6 +139,31 @@ bool TileStore::update(protocol::TileKey key, std::span<const protocol::MapPoint
   // those whose frames are in a file need not be read back.
   const std::uint64_t before = ram_frame_bytes(tile);
   const std::size_t first = protocol::update_segments(key, points, params_, tile.version + 1, tile.segments);
+  return changed(tile, first, before, points.size(), utime);
+}
+
+std::string TileStore::append(protocol::TileKey key, std::size_t first_point,
+                              std::span<const protocol::MapPoint> tail, std::int64_t utime, bool& changed_out) {
+  changed_out = false;
+  const std::int64_t id = protocol::tile_id(key);
+  if (first_point > 0 && !tiles_.contains(id))
+    return fmt::format("tile {}: the update starts at point {} of a tile never sent", id, first_point);
+  EncodedTile& tile = tiles_[id];
+  tile.id = id;
+  tile.params = params_;
+  const std::uint64_t before = ram_frame_bytes(tile);
+  std::size_t first = 0;
+  if (std::string problem =
+          protocol::append_segments(key, first_point, tail, params_, tile.version + 1, tile.segments, first);
+      !problem.empty())
+    return fmt::format("tile {}: {}", id, problem);
+  changed_out = changed(tile, first, before, first_point + tail.size(), utime);
+  return {};
+}
+
+// After tile.segments were brought to the new content from segment `first` on.
+bool TileStore::changed(EncodedTile& tile, std::size_t first, std::uint64_t ram_before, std::size_t n_points,
+                        std::int64_t utime) {
   if (first == tile.segments.size() && tile.where.size() == tile.segments.size()) return false;
   // From `first` on, the old frames are replaced (or gone): garbage in the spool.
   for (std::size_t s = first; s < tile.where.size(); ++s)
@@ -147,11 +172,11 @@ bool TileStore::update(protocol::TileKey key, std::span<const protocol::MapPoint
   for (std::size_t s = first; s < tile.where.size(); ++s) tile.where[s] = {};  // the new frames are in RAM
   spill_frames(tile, first);
   compact_spool();
-  frame_bytes_in_ram_ = frame_bytes_in_ram_ - before + ram_frame_bytes(tile);
-  total_points_ += static_cast<std::int64_t>(points.size()) - tile.n_points;
+  frame_bytes_in_ram_ = frame_bytes_in_ram_ - ram_before + ram_frame_bytes(tile);
+  total_points_ += static_cast<std::int64_t>(n_points) - tile.n_points;
   tile.version += 1;
   tile.utime = utime;
-  tile.n_points = static_cast<std::int32_t>(points.size());
+  tile.n_points = static_cast<std::int32_t>(n_points);
   return true;
 }
 

@@ -226,6 +226,43 @@ std::size_t update_segments(TileKey key, std::span<const MapPoint> points, const
   return first;
 }
 
+std::string append_segments(TileKey key, std::size_t first_point, std::span<const MapPoint> tail,
+                            const TileParams& params, std::int32_t version, std::vector<TileSegment>& segments,
+                            std::size_t& first) {
+  if (std::string problem = tile_params_problem(params); !problem.empty()) return problem;
+  std::size_t held = 0;
+  for (const TileSegment& s : segments) held += s.n_points;
+  if (first_point > held) return fmt::format("the update starts at point {} of a tile holding {}", first_point, held);
+  if (first_point + tail.size() < held)
+    return fmt::format("the update would shrink the tile from {} to {} points", held, first_point + tail.size());
+  if (first_point + tail.size() > kMaxTilePoints) return "too many points for one tile";
+  if (tail.empty() && first_point == held) {  // nothing new
+    first = segments.size();
+    return {};
+  }
+  const std::size_t size = params.segment_points;
+  const std::size_t s = first_point / size;
+  std::vector<MapPoint> part;
+  part.reserve(first_point - s * size + tail.size());
+  if (const std::size_t head = first_point - s * size; head > 0) {
+    const TileSegment& segment = segments[s];  // exists: first_point <= held, and not on a boundary
+    if (segment.frame.empty()) return fmt::format("segment {} of the tile is not in RAM", s);
+    if (std::string problem = decode_segment(segment.frame, key, params.tile_size_m, params.quantum_m,
+                                             params.centred, part);
+        !problem.empty())
+      return fmt::format("segment {} of the tile: {}", s, problem);
+    if (part.size() < head) return fmt::format("segment {} of the tile holds {} points, not {}", s, part.size(), head);
+    part.resize(head);  // decoded points lie on the quantum grid: they quantise to the same values
+  }
+  part.insert(part.end(), tail.begin(), tail.end());
+  std::vector<TileSegment> rest(std::make_move_iterator(segments.begin() + static_cast<std::ptrdiff_t>(s)),
+                                std::make_move_iterator(segments.end()));
+  first = s + update_segments(key, part, params, version, rest);
+  segments.resize(s);
+  segments.insert(segments.end(), std::make_move_iterator(rest.begin()), std::make_move_iterator(rest.end()));
+  return {};
+}
+
 std::size_t first_segment_after(std::span<const TileSegment> segments, std::int32_t held_version) {
   for (std::size_t s = 0; s < segments.size(); ++s)
     if (segments[s].version > held_version) return s;

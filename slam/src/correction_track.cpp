@@ -2,6 +2,7 @@
 #include "adit/slam/correction_track.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -113,6 +114,84 @@ CorrectionTrack CorrectionTrack::slice_for(std::span<const MapSample> samples) c
     slice.steps_.push_back(next == k + 1 ? steps_[k] : log_se3(corrections_[k].inverse() * corrections_[next]));
   }
   return slice;
+}
+
+bool correction_may_move(const CorrectionTrack& a, const CorrectionTrack* b, const Eigen::AlignedBox3d& box,
+                         double newest_s, double min_move_m) {
+  if (a.empty()) return true;
+  const double limit2 = 0.25 * min_move_m * min_move_m;  // (min_move_m / 2)²
+  const auto moves_at = [&](std::int64_t ns) {
+    const Eigen::Isometry3d ca = a.at(ns);
+    const Eigen::Isometry3d cb = b == nullptr ? Eigen::Isometry3d::Identity() : b->at(ns);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d p = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+      if ((cb * p - ca * p).squaredNorm() > limit2) return true;
+    }
+    return false;
+  };
+  const std::vector<std::int64_t>& stamps = a.stamps_ns();
+  for (std::size_t k = 0; k < stamps.size(); ++k) {
+    if (moves_at(stamps[k])) return true;
+    if (k + 1 < stamps.size() && moves_at(stamps[k] + (stamps[k + 1] - stamps[k]) / 2)) return true;
+  }
+  const auto newest_ns = static_cast<std::int64_t>(std::llround(newest_s * 1e9));
+  if (b == nullptr || newest_ns <= stamps.back()) return false;
+  std::int64_t previous = stamps.back();
+  const std::vector<std::int64_t>& later = b->stamps_ns();
+  for (auto it = std::upper_bound(later.begin(), later.end(), previous); it != later.end() && *it < newest_ns; ++it) {
+    if (moves_at(previous + (*it - previous) / 2) || moves_at(*it)) return true;
+    previous = *it;
+  }
+  return moves_at(previous + (newest_ns - previous) / 2) || moves_at(newest_ns);
+}
+
+CorrectionTrack CorrectionTrack::merged_with(const CorrectionTrack& other) const {
+  if (other.stamps_.empty()) return *this;
+  if (stamps_.empty()) return other;
+  // Each keyframe of the union, from this slice (0) or the other (1), by stamp.
+  struct From {
+    int slice;
+    std::size_t k;
+  };
+  const std::array<const CorrectionTrack*, 2> slices{this, &other};
+  std::vector<From> order;
+  order.reserve(stamps_.size() + other.stamps_.size());
+  std::size_t i = 0, j = 0;
+  while (i < stamps_.size() || j < other.stamps_.size()) {
+    if (j == other.stamps_.size() || (i < stamps_.size() && stamps_[i] <= other.stamps_[j])) {
+      if (j < other.stamps_.size() && stamps_[i] == other.stamps_[j]) ++j;  // the same keyframe in both
+      order.push_back({0, i++});
+    } else {
+      order.push_back({1, j++});
+    }
+  }
+  CorrectionTrack merged;
+  for (std::size_t n = 0; n < order.size(); ++n) {
+    const CorrectionTrack& t = *slices[static_cast<std::size_t>(order[n].slice)];
+    const std::size_t k = order[n].k;
+    merged.stamps_.push_back(t.stamps_[k]);
+    merged.positions_.push_back(t.positions_[k]);
+    merged.corrections_.push_back(t.corrections_[k]);
+    if (n + 1 == order.size()) break;
+    // A pair next to each other in either slice keeps that slice's step (the
+    // same bits at its samples' times); no sample of either falls between
+    // any other pair.
+    const From next = order[n + 1];
+    const CorrectionTrack* both = nullptr;
+    for (int s = 0; s < 2 && both == nullptr; ++s) {
+      const CorrectionTrack& c = *slices[static_cast<std::size_t>(s)];
+      const auto a = std::lower_bound(c.stamps_.begin(), c.stamps_.end(), t.stamps_[k]);
+      if (a != c.stamps_.end() && *a == t.stamps_[k] && a + 1 != c.stamps_.end() &&
+          *(a + 1) == slices[static_cast<std::size_t>(next.slice)]->stamps_[next.k]) {
+        both = &c;
+        merged.steps_.push_back(c.steps_[static_cast<std::size_t>(a - c.stamps_.begin())]);
+      }
+    }
+    if (both == nullptr)
+      merged.steps_.push_back(
+          log_se3(t.corrections_[k].inverse() * slices[static_cast<std::size_t>(next.slice)]->corrections_[next.k]));
+  }
+  return merged;
 }
 
 CorrectionTrack retargeted(const CorrectionTrack& track, const Trajectory& built_at, const Trajectory& poses) {

@@ -139,6 +139,7 @@ struct ByteCounter : adit::daemon::TileSink {
 struct Update {
   adit::protocol::TileKey key;
   std::vector<MapPoint> points;
+  std::size_t first = 0;  // the tile's points from this one on
 };
 
 void BM_TileStreamDemoSession(benchmark::State& state) {
@@ -158,14 +159,16 @@ void BM_TileStreamDemoSession(benchmark::State& state) {
     std::deque<Update> queue;
     bool done = false;
     adit::daemon::PipelineOptions options;
-    options.sinks.tile = [&](const adit::slam::TileCoord& c, std::span<const adit::slam::MapSample> samples) {
-      Update u{{c.x, c.y, c.z}, {}};
+    options.sinks.tile = [&](const adit::slam::TileCoord& c, std::size_t first,
+                             std::span<const adit::slam::MapSample> samples) {
+      Update u{{c.x, c.y, c.z}, {}, first};
       u.points.reserve(samples.size());
       for (const auto& s : samples)
         u.points.push_back({s.position.x(), s.position.y(), s.position.z(), s.intensity, s.time_s});
       const std::lock_guard lock(mutex);
       queue.push_back(std::move(u));
       wake.notify_one();
+      return true;
     };
     // The default segment size and others, on the same hand-overs.
     const std::vector<std::uint32_t> sizes{params.segment_points, 256, 512, 2048, 4096};
@@ -180,6 +183,7 @@ void BM_TileStreamDemoSession(benchmark::State& state) {
     }
     std::size_t old_bytes = 0, updates = 0;
     std::map<adit::protocol::TileKey, std::vector<MapPoint>> old_dirty;
+    std::map<adit::protocol::TileKey, std::vector<MapPoint>> whole;  // each tile's content, for the old scheme
     Clock::time_point old_last{};
     const auto old_broadcast = [&](Clock::time_point now) {
       old_last = now;
@@ -196,8 +200,11 @@ void BM_TileStreamDemoSession(benchmark::State& state) {
         lock.unlock();
         for (Update& u : batch) {
           ++updates;
-          for (auto& publisher : publishers) publisher->update(u.key, u.points, 0);
-          old_dirty[u.key] = std::move(u.points);
+          for (auto& publisher : publishers) publisher->update(u.key, u.first, u.points, 0);
+          std::vector<MapPoint>& content = whole[u.key];
+          content.resize(u.first);
+          content.insert(content.end(), u.points.begin(), u.points.end());
+          old_dirty[u.key] = content;
         }
         const Clock::time_point now = Clock::now();
         for (auto& publisher : publishers) publisher->tick(now);

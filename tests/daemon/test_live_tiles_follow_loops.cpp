@@ -103,14 +103,19 @@ TEST(LiveTilesFollowLoops, TilesSentBeforeAClosureGoAgainMovedAndEndWhereTheExpo
   const std::filesystem::path config_file = loop_config("live-tiles-follow-loops");
 
   std::mutex mutex;
-  std::map<std::int64_t, std::vector<protocol::MapPoint>> first, newest;  // per tile: its first and newest update
+  // Per tile: its first content and its newest (each update's points from its first_point on).
+  std::map<std::int64_t, std::vector<protocol::MapPoint>> first, newest;
   std::size_t frames_with_correction = 0;
   Sessions::Outputs outputs;
   outputs.tile = [&](TileUpdate&& update) {
     const std::lock_guard lock(mutex);
     const std::int64_t id = protocol::tile_id(update.key);
-    if (!first.contains(id)) first[id] = update.points;
-    newest[id] = std::move(update.points);
+    std::vector<protocol::MapPoint>& content = newest[id];
+    EXPECT_LE(update.first_point, content.size()) << "tile " << id;
+    content.resize(std::min(update.first_point, content.size()));
+    content.insert(content.end(), update.points.begin(), update.points.end());
+    if (!first.contains(id)) first[id] = content;
+    return true;
   };
   Sessions sessions(config::load_config(config_file), outputs);
   const std::string id = sessions.start();

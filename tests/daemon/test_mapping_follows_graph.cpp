@@ -68,6 +68,12 @@ struct StageRun {
   std::int64_t third_ns = 3'000'000'000;                        // the third scan's time
   Eigen::Isometry3d third_pose = Eigen::Isometry3d::Identity();  // and its pose
   std::size_t map_points = 0;                                   // after the run
+  // With `second`: once the third scan's tiles went out, `second` is posted
+  // and a fourth scan at 4 s, 3 m to the left, is mapped (a fifth there
+  // too: it adds nothing, the same voxels); `mid` is each
+  // tile's content as sent before the stage ends (its last flush).
+  std::optional<slam::CorrectionTrack> second;
+  std::map<slam::TileCoord, std::vector<slam::MapSample>> mid;
 
   // The occupied cells' centres (x, y), map frame.
   std::vector<Eigen::Vector2f> occupied() {
@@ -99,10 +105,17 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   CorrectionBoard board;
   MappingStage stage(
       config, slam::OdometryConfig{}, scans, kMaxPoints,
-      [&run](const slam::TileCoord& coord, std::span<const slam::MapSample> samples) {
+      [&run](const slam::TileCoord& coord, std::size_t first, std::span<const slam::MapSample> samples) {
         const std::lock_guard lock(run.sent.mutex);
-        run.sent.tiles[coord].emplace_back(samples.begin(), samples.end());
+        std::vector<std::vector<slam::MapSample>>& sends = run.sent.tiles[coord];
+        // The tile's content after this send: what it held before `first`, then `samples`.
+        std::vector<slam::MapSample> content = sends.empty() ? std::vector<slam::MapSample>{} : sends.back();
+        EXPECT_LE(first, content.size());
+        content.resize(std::min(first, content.size()));
+        content.insert(content.end(), samples.begin(), samples.end());
+        sends.push_back(std::move(content));
         run.sent.when[coord].push_back(std::chrono::steady_clock::now());
+        return true;
       },
       run.stats, stop);
   stage.follow_graph(&board);
@@ -127,6 +140,24 @@ void run_stage(StageRun& run, const std::optional<slam::CorrectionTrack>& correc
   ASSERT_GT(run.sent.count(), 0U) << "the first scan's tiles never went out";
   if (correction) board.post(*correction);
   push(run.third_ns, run.third_pose);
+  if (run.second) {
+    // The first correction taken (its tiles checked), then the second posted.
+    for (int i = 0; i < 500 && run.stats.tiles_checked_for_loops.load() == 0; ++i) std::this_thread::sleep_for(10ms);
+    board.post(*run.second);
+    push(4'000'000'000, shifted(0, 3.0));
+    push(5'000'000'000, shifted(0, 3.0));  // a scan is mapped once the next one's pose came
+    const auto fourth_sent = [&run] {
+      const std::lock_guard lock(run.sent.mutex);
+      for (const auto& [coord, sends] : run.sent.tiles)
+        for (const slam::MapSample& s : sends.back())
+          if (s.time_s == 4.0) return true;
+      return false;
+    };
+    for (int i = 0; i < 500 && !fourth_sent(); ++i) std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(200ms);  // four more flushes: a correction due would have been taken
+    const std::lock_guard lock(run.sent.mutex);
+    for (const auto& [coord, sends] : run.sent.tiles) run.mid[coord] = sends.back();
+  }
   scans.close();
   stage.join();
   run.map_points = stage.map().size();
@@ -258,6 +289,44 @@ TEST(MappingFollowsGraph, ARevisitAddsNothingThatAnEarlierPassMapped) {
   run_stage(unmerged, track);
   EXPECT_EQ(unmerged.map_points, 2 * kWall);
   EXPECT_EQ(unmerged.stats.revisit_points.load(), 0U);
+}
+
+}  // namespace
+}  // namespace adit::daemon
+
+namespace adit::daemon {
+namespace {
+
+// Where a tile holds the fourth scan's points, against where the scan put
+// them: its wall's far end (6 m before any correction), less 6 m.
+double fourth_scan_offset(const std::map<slam::TileCoord, std::vector<slam::MapSample>>& tiles) {
+  double far = -1e9;
+  for (const auto& [coord, samples] : tiles)
+    for (const slam::MapSample& s : samples)
+      if (s.time_s == 4.0) far = std::max(far, static_cast<double>(s.position.y()));
+  return far - 6.0;
+}
+
+// The live tiles take a new correction at once when it moves the sensor's
+// place by more than kPlacementMoveM; a smaller one waits (kPlacementPeriodS,
+// or the end), the scans meanwhile placed as the tiles are (decision 074).
+TEST(MappingFollowsGraph, ACorrectionThatBarelyMovesTheSensorsPlaceWaitsForTheEnd) {
+  const std::vector<std::int64_t> stamps{1'000'000'000, 3'000'000'000};
+  const std::vector<Eigen::Isometry3d> odometry{Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  const slam::CorrectionTrack first(stamps, std::vector{shifted(0, 0.5), shifted(0, 0.7)}, odometry);
+  for (const double head : {0.03, 0.10}) {  // the second correction at 3 s and after: 3 or 10 cm more
+    ASSERT_LT(0.03, MappingStage::kPlacementMoveM);
+    ASSERT_GT(0.10, MappingStage::kPlacementMoveM);
+    StageRun run;
+    run.second = slam::CorrectionTrack(stamps, std::vector{shifted(0, 0.5), shifted(0, 0.7 + head)}, odometry);
+    run_stage(run, first);
+    ASSERT_FALSE(run.mid.empty());
+    const double taken = head < MappingStage::kPlacementMoveM ? 0.7 : 0.7 + head;
+    EXPECT_NEAR(fourth_scan_offset(run.mid), taken, 1e-4) << "head " << head;
+    std::map<slam::TileCoord, std::vector<slam::MapSample>> last;
+    for (const auto& [coord, sends] : run.sent.tiles) last[coord] = sends.back();
+    EXPECT_NEAR(fourth_scan_offset(last), 0.7 + head, 1e-4) << "at the end, every tile follows the latest";
+  }
 }
 
 }  // namespace

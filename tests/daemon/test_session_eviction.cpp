@@ -52,6 +52,9 @@ struct SessionRun {
   std::filesystem::path folder;
   nlohmann::json summary;
   std::map<std::int64_t, std::size_t> published;  // tile id → points in its newest live update
+  std::size_t updates = 0;       // tile updates published
+  std::size_t tail_updates = 0;  // ... of them, those that carried only what the tile gained
+  std::size_t out_of_step = 0;   // updates starting beyond what the tile held
 };
 
 // Small tiles (5 m) and a short mapping range (5 m, margin 1 m) so that the
@@ -81,7 +84,12 @@ SessionRun map_session(const std::filesystem::path& work, int evict_after_keyfra
   Sessions::Outputs outputs;
   outputs.tile = [&](TileUpdate&& update) {
     const std::lock_guard lock(mutex);
-    run.published[protocol::tile_id(update.key)] = update.points.size();
+    std::size_t& held = run.published[protocol::tile_id(update.key)];
+    ++run.updates;
+    if (update.first_point > 0) ++run.tail_updates;
+    if (update.first_point > held) ++run.out_of_step;
+    held = update.first_point + update.points.size();
+    return true;
   };
   Sessions sessions(config::load_config(config_file), outputs);
   const std::string id = sessions.start();
@@ -119,6 +127,15 @@ void expect_every_point_everywhere(const SessionRun& run, const std::filesystem:
     EXPECT_EQ(it->second, static_cast<std::size_t>(tile.n_points)) << "tile " << id;
   }
   EXPECT_EQ(run.published.size(), non_empty);
+  // A tile's updates carry what it gained (decision 074), through evictions,
+  // reloads and compactions, each from the point the tile held.
+  // Without a correction to re-place them, every update after a tile's first
+  // is what it gained.
+  EXPECT_EQ(run.out_of_step, 0U);
+  EXPECT_GT(run.tail_updates, 0U);
+  if (run.summary["loops"].value("optimizations", 0) == 0) {
+    EXPECT_EQ(run.tail_updates, run.updates - run.published.size()) << run.updates << " updates";
+  }
 
   // The session's journal holds the same map through every eviction, reload
   // and compaction: rebuilt from it alone, as after a crash, it has every point

@@ -48,7 +48,7 @@ TEST_F(TilePublisherTest, ChangedTilesGoOutAtMostOncePerPeriod) {
   publisher.reset("s1");
   Clock::time_point now = t0;
   for (int i = 0; i < 10; ++i) {  // the mapper changes the tile at 10 Hz
-    publisher.update({0, 0, 0}, random_points(100 + i, 1), i);
+    publisher.update({0, 0, 0}, 0, random_points(100 + i, 1), i);
     publisher.tick(now);
     now += 100ms;
   }
@@ -65,8 +65,8 @@ TEST_F(TilePublisherTest, ChangedTilesGoOutAtMostOncePerPeriod) {
 TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   publisher.reset("s1");
   Clock::time_point now = t0;
-  publisher.update({0, 0, 0}, random_points(40000, 2), 1);  // ~320 kB: 40 segments
-  publisher.update({1, 0, 0}, random_points(10, 3), 1);
+  publisher.update({0, 0, 0}, 0, random_points(40000, 2), 1);  // ~320 kB: 40 segments
+  publisher.update({1, 0, 0}, 0, random_points(10, 3), 1);
   run_for(now, 1.0);
   const std::int64_t big = protocol::tile_id({0, 0, 0});
   const std::int32_t n_segments = publisher.store().find(big)->n_segments();
@@ -92,7 +92,7 @@ TEST_F(TilePublisherTest, RequestsAreAnsweredWithOnlyWhatWasAskedFor) {
   EXPECT_TRUE(sink.indexes.empty());
 
   sink.chunks.clear();
-  publisher.update({0, 0, 0}, random_points(40000, 4), 2);  // version 2: every point differs
+  publisher.update({0, 0, 0}, 0, random_points(40000, 4), 2);  // version 2: every point differs
   r.tile_ids = {big};
   r.versions = {1};
   r.chunks = {-1};
@@ -140,7 +140,7 @@ TEST_F(TilePublisherTest, AnAppendedTileCostsOnlyItsNewSegments) {
   publisher.reset("s1");
   Clock::time_point now = t0;
   auto points = surface_points(0, 50'000);
-  publisher.update({0, 0, 0}, points, 1);
+  publisher.update({0, 0, 0}, 0, points, 1);
   run_for(now, 1.0);
   const std::size_t whole = sink.bytes();
   const std::int64_t id = protocol::tile_id({0, 0, 0});
@@ -153,7 +153,7 @@ TEST_F(TilePublisherTest, AnAppendedTileCostsOnlyItsNewSegments) {
 
   const auto more = surface_points(50'000, 300);  // the mapper appends 300 points
   points.insert(points.end(), more.begin(), more.end());
-  publisher.update({0, 0, 0}, points, 2);
+  publisher.update({0, 0, 0}, 0, points, 2);
   run_for(now, 1.0);
   // The partial segment 48 is now full (1024) and segment 49 holds 124:
   // those two go out, nothing else.
@@ -199,7 +199,7 @@ TEST_F(TilePublisherTest, AnAppendedTileCostsOnlyItsNewSegments) {
 
   // Handing over the same content again is no new version.
   sink.chunks.clear();
-  publisher.update({0, 0, 0}, points, 3);
+  publisher.update({0, 0, 0}, 0, points, 3);
   run_for(now, 1.0);
   EXPECT_TRUE(sink.chunks.empty());
   EXPECT_EQ(publisher.store().find(id)->version, 2);
@@ -209,7 +209,7 @@ TEST_F(TilePublisherTest, SegmentsArePaced) {
   RecordingSink paced_sink;
   TilePublisher paced({"rig1", {}, 1.0, 96000.0, 0.0, 1, {}}, paced_sink);  // 96 kB/s
   paced.reset("s1");
-  paced.update({0, 0, 0}, random_points(60000, 5), 1);  // ~480 kB in 59 segments of ~8 kB
+  paced.update({0, 0, 0}, 0, random_points(60000, 5), 1);  // ~480 kB in 59 segments of ~8 kB
   Clock::time_point now = t0;
   paced.tick(now);
   const auto frame_bytes = [&] {
@@ -272,6 +272,43 @@ TEST(TilePublisherStored, AnotherSessionIsServedFromTheLoaderOrRefusedWithItsRea
   EXPECT_EQ(publisher.store().total_points(), 2000);
   EXPECT_EQ(publisher.store().find(protocol::tile_id({2, 0, 0}))->n_segments(), 2);
   EXPECT_EQ(asked, (std::vector<std::string>{"nope", "old"}));
+}
+
+}  // namespace
+}  // namespace adit::daemon
+
+namespace adit::daemon {
+namespace {
+
+// A tile updated by what it gained (decision 074) is broadcast as one
+// updated whole; an update from a point the tile does not hold is refused,
+// counted, and leaves the tile as it was.
+TEST_F(TilePublisherTest, TailsUpdateTheTileAndAnUpdateOutOfStepIsRefused) {
+  publisher.reset("s1");
+  std::vector<protocol::MapPoint> points = random_points(1500, 8);
+  publisher.update({0, 0, 0}, 0, points, 1);
+  const auto more = random_points(700, 9);
+  publisher.update({0, 0, 0}, points.size(), more, 2);
+  points.insert(points.end(), more.begin(), more.end());
+  const std::int64_t id = protocol::tile_id({0, 0, 0});
+  ASSERT_NE(publisher.store().find(id), nullptr);
+  EXPECT_EQ(publisher.store().find(id)->version, 2);
+  EXPECT_EQ(publisher.store().find(id)->n_points, 2200);
+  TileStore whole({});
+  whole.update({0, 0, 0}, points, 2);
+  EXPECT_EQ(whole.find(id)->segments.back().content_hash, publisher.store().find(id)->segments.back().content_hash);
+
+  publisher.update({0, 0, 0}, 5000, more, 3);  // the tile holds 2200: an update was lost
+  EXPECT_EQ(publisher.counts().updates_refused, 1u);
+  EXPECT_EQ(publisher.store().find(id)->version, 2);
+  EXPECT_EQ(publisher.store().find(id)->n_points, 2200);
+  Clock::time_point now = t0;
+  run_for(now, 2.0);
+  ASSERT_EQ(sink.chunks.size(), 3u) << "one broadcast: the three segments of 2200 points";
+  for (const auto& c : sink.chunks) {
+    EXPECT_EQ(c.version, 2);
+    EXPECT_EQ(c.n_points, 2200);
+  }
 }
 
 }  // namespace

@@ -110,6 +110,43 @@ TEST(TileStore, SegmentsInTheSpoolFileServeTheSameBytesAsSegmentsInRam) {
   expect_same_tiles(in_ram, moved);
 }
 
+// The mapper sends a tile's new points only (decision 074): a store given
+// tails holds what one given each whole content holds, segment for segment,
+// whether a tail starts on a segment boundary or inside the last, partial
+// segment (decoded from its frame, in RAM).
+TEST(TileStore, TailsAppendedGiveTheSegmentsOfTheWholeContent) {
+  test::TempFolder folder;
+  TileStore whole({});
+  TileStore tails({}, folder.path());
+  ASSERT_TRUE(tails.spooling()) << tails.spool_problem();
+  std::vector<protocol::MapPoint> a;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::size_t> count(1, 2500);
+  for (int step = 0; step < 12; ++step) {
+    const std::size_t first = a.size();
+    const std::size_t n = step == 3 ? 1024 * 3 - first : count(rng);  // step 3 ends on a segment boundary
+    const auto more = random_points(n, 100 + static_cast<unsigned>(step));
+    a.insert(a.end(), more.begin(), more.end());
+    EXPECT_TRUE(whole.update({0, 0, 0}, a, step));
+    bool changed = false;
+    ASSERT_EQ(tails.append({0, 0, 0}, first, std::span(a).subspan(first), step, changed), "") << "step " << step;
+    EXPECT_TRUE(changed);
+    expect_same_tiles(whole, tails);
+    expect_only_partial_segments_in_ram(tails);
+  }
+  bool changed = true;
+  EXPECT_EQ(tails.append({0, 0, 0}, a.size(), {}, 20, changed), "");
+  EXPECT_FALSE(changed) << "nothing new: the version stays";
+
+  // What does not fit is refused by name and changes nothing.
+  const auto more = random_points(10, 99);
+  EXPECT_NE(tails.append({0, 0, 0}, a.size() + 1, more, 21, changed).find("starts at point"), std::string::npos);
+  EXPECT_NE(tails.append({0, 0, 0}, 10, more, 21, changed).find("shrink"), std::string::npos);
+  EXPECT_NE(tails.append({3, 0, 0}, 5, more, 21, changed).find("never sent"), std::string::npos);
+  EXPECT_FALSE(changed);
+  expect_same_tiles(whole, tails);
+}
+
 TEST(TileStore, TheSpoolFileIsRewrittenWithItsLiveFramesOnceGarbageOutgrowsThem) {
   test::TempFolder folder;
   TileStore in_ram({});
@@ -212,8 +249,8 @@ TEST(TileStore, APublisherWithASpoolSendsWhatOneInRamSendsAndCountsUnreadableSeg
   for (int step = 0; step < 3; ++step) {
     const auto more = random_points(1500, 20 + step);
     points.insert(points.end(), more.begin(), more.end());
-    in_ram.update({0, 0, 0}, points, step);
-    spooled.update({0, 0, 0}, points, step);
+    in_ram.update({0, 0, 0}, 0, points, step);
+    spooled.update({0, 0, 0}, 0, points, step);
     for (int i = 0; i < 150; ++i) {
       in_ram.tick(now);
       spooled.tick(now);

@@ -28,8 +28,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   publisher.reset("s1");
   std::vector<adit::protocol::MapPoint> points(64);
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = {0.1 * i, 0.2, 0.3, 1.0f, 0};
-  publisher.update({0, 0, 0}, points, 1);
-  publisher.update({-1, 2, 0}, points, 1);
+  publisher.update({0, 0, 0}, 0, points, 1);
+  publisher.update({-1, 2, 0}, 0, points, 1);
   publisher.answer(request);
   auto now = adit::daemon::TilePublisher::Clock::now();
   for (int i = 0; i < 4; ++i) publisher.tick(now += std::chrono::seconds(1));

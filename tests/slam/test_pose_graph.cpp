@@ -331,3 +331,105 @@ TEST(CorrectionTrack, ASliceGivesTheSameCorrectionAtItsSamplesTimes) {
 
 }  // namespace
 }  // namespace adit::slam
+
+namespace adit::slam {
+namespace {
+
+// A live tile sent in parts keeps one slice for all of them: two slices
+// merged give the track's own bits at the times of both parts.
+TEST(CorrectionTrack, TwoSlicesMergedAreTheTrackAtBothSetsOfTimes) {
+  std::vector<std::int64_t> stamps;
+  std::vector<Eigen::Isometry3d> graph, odometry;
+  for (int k = 0; k < 40; ++k) {
+    stamps.push_back(std::int64_t{k} * 100'000'000'000 / 4);  // every 25 s
+    Eigen::Isometry3d g = Eigen::Isometry3d::Identity();
+    g.translation() = Eigen::Vector3d(0.01 * k * k, 0.02 * k, -0.003 * k);
+    g.linear() = Eigen::AngleAxisd(0.002 * k, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    graph.push_back(g);
+    odometry.push_back(Eigen::Isometry3d::Identity());
+  }
+  const CorrectionTrack track(stamps, graph, odometry);
+  const auto samples_at = [](std::initializer_list<double> times) {
+    std::vector<MapSample> out;
+    for (double t : times) out.push_back({Eigen::Vector3f(1, 2, 3), 1.0F, t});
+    return out;
+  };
+  // Overlapping, adjacent and far apart; one at a keyframe's own stamp, one past the end.
+  const std::vector<MapSample> a = samples_at({10.0, 30.0, 31.0, 300.0, 975.0});
+  const std::vector<MapSample> b = samples_at({31.5, 49.0, 50.0, 640.0, 2000.0});
+  const CorrectionTrack merged = track.slice_for(a).merged_with(track.slice_for(b));
+  for (const std::vector<MapSample>* part : {&a, &b}) {
+    for (const MapSample& s : *part) {
+      const auto t = static_cast<std::int64_t>(std::llround(s.time_s * 1e9));
+      EXPECT_TRUE(merged.at(t).matrix() == track.at(t).matrix()) << s.time_s;
+    }
+  }
+  EXPECT_LT(merged.stamps_ns().size(), stamps.size());
+  EXPECT_TRUE(std::is_sorted(merged.stamps_ns().begin(), merged.stamps_ns().end()));
+  EXPECT_EQ(std::adjacent_find(merged.stamps_ns().begin(), merged.stamps_ns().end()), merged.stamps_ns().end());
+  EXPECT_TRUE(CorrectionTrack().merged_with(track.slice_for(a)).stamps_ns() == track.slice_for(a).stamps_ns());
+}
+
+}  // namespace
+}  // namespace adit::slam
+
+namespace adit::slam {
+namespace {
+
+Eigen::Isometry3d small_motion(std::mt19937& rng, double metres, double radians) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.translation() = metres * Eigen::Vector3d(n(rng), n(rng), n(rng));
+  m.linear() = Eigen::AngleAxisd(radians * n(rng), Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
+                   .toRotationMatrix();
+  return m;
+}
+
+// The corner gate never says "unmoved" where a sample in the box moves more
+// than the threshold (it would leave a live tile misplaced), and it does
+// say it for small corrections (else it would save nothing).
+TEST(CorrectionTrack, TheCornerGateNeverMissesAMovedSampleAndPassesSmallCorrections) {
+  std::mt19937 rng(11);
+  const Eigen::AlignedBox3d box(Eigen::Vector3d(20, -40, 0), Eigen::Vector3d(40, -20, 20));
+  std::uniform_real_distribution<double> inside(0.0, 1.0);
+  int moved = 0, gated = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    // An old track of 20 keyframes a second apart; the new one has 5 more and
+    // moves the old ones by up to a few cm (scale varies by trial).
+    const double scale = 0.002 * (trial % 10);
+    std::vector<std::int64_t> stamps;
+    std::vector<Eigen::Isometry3d> old_graph, new_graph, odometry;
+    for (int k = 0; k < 25; ++k) {
+      stamps.push_back(std::int64_t{k} * 1'000'000'000 + 500'000'000);
+      const Eigen::Isometry3d g = small_motion(rng, 0.5, 0.01);
+      if (k < 20) old_graph.push_back(g);
+      new_graph.push_back(g * small_motion(rng, scale, scale / 30.0));
+      odometry.push_back(Eigen::Isometry3d::Identity());
+    }
+    const std::vector<std::int64_t> old_stamps(stamps.begin(), stamps.begin() + 20);
+    const CorrectionTrack old_track(old_stamps, old_graph, std::vector(odometry.begin(), odometry.begin() + 20));
+    const CorrectionTrack new_track(stamps, new_graph, odometry);
+    std::vector<MapSample> samples;
+    const double newest = 22.0 * inside(rng);
+    for (int i = 0; i < 200; ++i) {
+      const Eigen::Vector3d u(inside(rng), inside(rng), inside(rng));
+      const Eigen::Vector3d p = box.min() + u.cwiseProduct(box.sizes());
+      samples.push_back({p.cast<float>(), 1.0F, newest * inside(rng)});
+    }
+    samples.push_back({box.max().cast<float>(), 1.0F, newest});
+    const CorrectionTrack slice = old_track.slice_for(samples);
+    const bool moves = correction_moves(samples, &slice, &new_track, 0.02);
+    const bool may = correction_may_move(slice, &new_track, box, newest, 0.02);
+    if (moves) {
+      ++moved;
+      EXPECT_TRUE(may) << "trial " << trial;
+    }
+    if (!may) ++gated;
+  }
+  EXPECT_GT(moved, 30);
+  EXPECT_GT(gated, 30);
+  EXPECT_TRUE(correction_may_move(CorrectionTrack(), nullptr, box, 1.0, 0.02)) << "an empty slice tells nothing";
+}
+
+}  // namespace
+}  // namespace adit::slam

@@ -79,6 +79,9 @@ struct TileUpdate {
   std::int64_t utime = 0;
   protocol::TileKey key;
   std::vector<protocol::MapPoint> points;
+  // `points` are the tile's from this one on; those before it are the ones
+  // of its previous updates (0: the whole tile).
+  std::size_t first_point = 0;
 };
 
 // What commands make the daemon do; each runs on the endpoint thread and must

@@ -88,6 +88,11 @@ class MappingStage {
   // latest correction, is not added (slam/revisit_filter.hpp).
   void follow_graph(const CorrectionBoard* graph);
   static constexpr double kTileMoveM = 0.02;
+  // A new correction places the live tiles only when it moves the sensor's
+  // place by more than kPlacementMoveM, or kPlacementPeriodS of the session
+  // after the last one they took, and at the end (decision 074).
+  static constexpr double kPlacementMoveM = 0.05;
+  static constexpr double kPlacementPeriodS = 30.0;
   static constexpr std::int64_t kReplaceBudgetMs = 20;
   // Before start(): how many points sent as tiles still wait for the tile
   // sink's consumer. Tiles moved by a correction are sent again only while
@@ -136,9 +141,12 @@ class MappingStage {
   void restore_tiles(const std::vector<slam::TileCoord>& coords);
   void evict_tiles(const std::vector<slam::TileCoord>& coords);
   void flush_tiles(bool final = false);
+  bool placement_due(const slam::CorrectionTrack* latest) const;
   std::string whole_tile(const slam::TileCoord& coord, std::vector<slam::MapSample>& buffer,
                          std::span<const slam::MapSample>& samples) const;
-  void send_tile(const slam::TileCoord& coord, std::span<const slam::MapSample> samples);
+  void send_tile(const slam::TileCoord& coord, std::size_t first, std::span<const slam::MapSample> samples);
+  std::size_t unsent_from(const slam::TileCoord& coord, std::size_t stored, std::size_t total) const;
+  void send_unsent(const slam::TileCoord& coord, std::size_t stored, std::span<const slam::MapSample> whole);
   void replace_moved_tiles(bool all);
   bool tile_backlog_full() const { return tile_backlog_ && tile_backlog_() > kTileBacklogPoints; }
   void flush_grid();
@@ -179,14 +187,20 @@ class MappingStage {
   const CorrectionBoard* graph_ = nullptr;
   std::shared_ptr<const slam::CorrectionTrack> placement_;  // the tiles sent now are placed by it (null: identity)
   std::uint64_t placement_version_ = 0;                     // counts placement_'s changes
-  // With graph_: each tile sent and the correction it was placed by, kept at
-  // its samples' times only (CorrectionTrack::slice_for): a tile unmoved by
-  // later corrections does not hold a whole track of its time.
-  struct SentPlacement {
+  std::int64_t placement_stamp_ns_ = 0;                     // the newest scan's stamp when placement_ was taken
+  std::int64_t newest_stamp_ns_ = 0;                        // the newest mapped scan's stamp ...
+  Eigen::Vector3d newest_position_ = Eigen::Vector3d::Zero();  // ... and its position (map frame)
+  // Each tile sent: how many of its points the sink took (its next update
+  // sends only what it gained since) and, with graph_, the correction they
+  // were placed by, kept at their times only (CorrectionTrack::slice_for): a
+  // tile unmoved by later corrections does not hold a whole track of its time.
+  struct SentTile {
     std::uint64_t version = 0;  // placement_version_ when sent
     slam::CorrectionTrack track;
+    double newest_s = 0;  // the newest of its samples' times (with graph_)
+    std::size_t points = 0;
   };
-  std::map<slam::TileCoord, SentPlacement> sent_with_;
+  std::map<slam::TileCoord, SentTile> sent_;
   std::deque<slam::TileCoord> recheck_;  // tiles to check against placement_
   JournalWriter* journal_ = nullptr;
   std::map<slam::TileCoord, std::size_t> journaled_;  // per resident tile: points of tile() already journaled

@@ -64,7 +64,9 @@ struct MapSlot {
 // be quick and not throw; empty = not wanted.
 struct PipelineSinks {
   using PoseSink = std::function<void(const slam::OdometryResult&)>;
-  using TileSink = std::function<void(const slam::TileCoord&, std::span<const slam::MapSample>)>;
+  // A tile's points from `first_point` on (0: the whole tile); true when
+  // taken (false: dropped, so the next update goes whole).
+  using TileSink = std::function<bool(const slam::TileCoord&, std::size_t first_point, std::span<const slam::MapSample>)>;
   using ImuPoseSink = std::function<void(const slam::InertialState&, const slam::Matrix6d& covariance)>;
   // A live-grid patch whose cells changed: its coordinate, version, cells
   // (slam::LiveGrid::read) and the grid's patch count.
@@ -73,7 +75,7 @@ struct PipelineSinks {
   PoseSink pose;  // output thread, once per scan (valid or not)
   // The IMU source's thread, per IMU reading while LiDAR-inertial (imu_pose_feed.hpp): quick, never throws.
   ImuPoseSink imu_pose;
-  TileSink tile;  // mapping thread: the whole current content of a tile that changed
+  TileSink tile;  // mapping thread: what a tile gained since its last update, or its whole content
   // Any thread: points handed to `tile` that its consumer has not taken yet
   // (the LCM thread's queue); the mapping thread holds back re-sends while
   // they are many (MappingStage::kTileBacklogPoints). Empty: not measured.

@@ -83,6 +83,7 @@ struct PipelineStats {
   std::atomic<std::uint64_t> evicted_tiles{0};        // evictions (a tile evicted twice counts twice)
   std::atomic<std::uint64_t> restored_tiles{0};       // evicted tiles read back because the sensor returned
   std::atomic<std::uint64_t> tiles_checked_for_loops{0};  // live tiles checked against a new loop correction
+  std::atomic<std::uint64_t> tiles_checked_by_corners{0};  // ... of them, found unmoved from their corners alone
   std::atomic<std::uint64_t> tiles_moved_by_loops{0};     // ... and sent again, moved (map.loops_move_map)
   std::atomic<std::uint64_t> points_moved_by_loops{0};    // their points
   std::atomic<std::uint64_t> revisit_points{0};           // not added: an earlier pass mapped their place (map.merge_revisits)

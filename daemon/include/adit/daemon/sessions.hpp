@@ -61,7 +61,7 @@ class Sessions {
   struct Outputs {
     std::function<void(const PoseSample&)> pose;
     PipelineSinks::ImuPoseSink imu_pose;  // the IMU source's thread
-    std::function<void(TileUpdate&&)> tile;
+    std::function<bool(TileUpdate&&)> tile;  // true when taken
     std::function<std::uint64_t()> tile_backlog;  // points handed to `tile` not yet taken (PipelineSinks)
     std::function<void(GridPatchUpdate&&)> grid;  // the mapping thread
     std::function<void(const std::string& session)> ended;

@@ -51,6 +51,7 @@ struct TilePublisherCounts {
   std::uint64_t chunk_bytes_published = 0;  // encoded tile_segment_t bytes
   std::uint64_t index_published = 0;
   std::uint64_t segment_read_errors = 0;  // segments not sent: their file could not be read
+  std::uint64_t updates_refused = 0;       // tile updates from a point the tile does not hold
 };
 
 class TilePublisher {
@@ -63,9 +64,13 @@ class TilePublisher {
   // `spool_dir` (the session's folder), full segments' frames are kept in a
   // file there instead of RAM (TileStore).
   void reset(std::string session_id, const std::filesystem::path& spool_dir = {});
-  // The whole new content of tile `key`, append order (its version goes up
-  // by one when it changed).
-  void update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
+  // The new content of tile `key`, append order (its version goes up by one
+  // when it changed): its points from `first_point` on, those before being
+  // the ones it held (0: the whole tile). An update that does not fit what
+  // the tile holds is counted (updates_refused) and logged once; the tile
+  // stays as it was until its next whole content.
+  void update(protocol::TileKey key, std::size_t first_point, std::span<const protocol::MapPoint> points,
+              std::int64_t utime);
   // A client's request (payload already checked by the caller).
   void answer(const tile_request_t& request);
   // Broadcasts changed tiles when the period is up and sends paced chunks.

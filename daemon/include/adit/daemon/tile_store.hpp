@@ -93,6 +93,12 @@ class TileStore {
   // that changed are re-encoded. The version goes up by one when anything
   // changed; returns false (and keeps the version) when nothing did.
   bool update(protocol::TileKey key, std::span<const protocol::MapPoint> points, std::int64_t utime);
+  // The same when the tile's first `first_point` points are those of its
+  // last update and `tail` follows them: costs the tail, not the tile
+  // (protocol::append_segments). Returns "" (with `changed`), or why not,
+  // naming the tile; then the tile is as it was.
+  std::string append(protocol::TileKey key, std::size_t first_point, std::span<const protocol::MapPoint> tail,
+                     std::int64_t utime, bool& changed);
   // Adds a tile encoded earlier (a stored session's tiles/<id>.adt, format 1
   // or 2), as version 1. Returns "", or why the blob is not a usable tile
   // (then nothing is added).
@@ -126,6 +132,10 @@ class TileStore {
  private:
   // Moves the frames of full segments [first, n) of `tile` to the spool.
   // (Full: tile.params.segment_points.)
+  // The bookkeeping once `tile`'s segments hold new content from segment
+  // `first` on: whether anything changed (then its version goes up).
+  bool changed(EncodedTile& tile, std::size_t first, std::uint64_t ram_before, std::size_t n_points,
+               std::int64_t utime);
   void spill_frames(EncodedTile& tile, std::size_t first);
   std::string insert_blob(std::int64_t id, std::span<const std::uint8_t> blob, std::int64_t utime, bool spill);
   FileHandle open_spool(const std::filesystem::path& dir, std::string& problem);

@@ -109,6 +109,18 @@ struct TileSegment {
 std::size_t update_segments(TileKey key, std::span<const MapPoint> points, const TileParams& params,
                             std::int32_t version, std::vector<TileSegment>& segments);
 
+// The same for content whose first `first_point` points are those `segments`
+// hold and `tail` follows them (what a map tile gained since its last update),
+// so an update costs the tail, not the tile. Segments before the one holding
+// `first_point` are kept unread; that segment's earlier points are decoded
+// from its frame, which must be in RAM (`frame` set) unless `first_point` is
+// a segment boundary. Returns "" with the first changed index in `first`, or
+// why not (then `segments` are untouched): `first_point` beyond the points
+// held, content that would shrink, an unreadable frame, too many points.
+std::string append_segments(TileKey key, std::size_t first_point, std::span<const MapPoint> tail,
+                            const TileParams& params, std::int32_t version, std::vector<TileSegment>& segments,
+                            std::size_t& first);
+
 // The first segment changed after `held_version`: a client holding the tile
 // complete at that version lacks exactly segments [first, size).
 std::size_t first_segment_after(std::span<const TileSegment> segments, std::int32_t held_version);

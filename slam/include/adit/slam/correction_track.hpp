@@ -41,6 +41,10 @@ class CorrectionTrack {
   // tile sent placed by it must remember, a few of the session's keyframes.
   // Elsewhere it is an interpolation between the keyframes kept.
   CorrectionTrack slice_for(std::span<const MapSample> samples) const;
+  // Two slices of one track (slice_for of two sets of samples) as one: the
+  // same track at the times of both sets (a tile's earlier points and those
+  // it gained since).
+  CorrectionTrack merged_with(const CorrectionTrack& other) const;
 
  private:
   std::vector<std::int64_t> stamps_;
@@ -70,5 +74,17 @@ void correct_samples(std::span<const MapSample> in, const CorrectionTrack* track
 // by `a` that must be sent again placed by `b`. Stops at the first such sample.
 bool correction_moves(std::span<const MapSample> samples, const CorrectionTrack* a, const CorrectionTrack* b,
                       double min_move_m);
+
+// A cheap gate before correction_moves, without the samples: whether going
+// from `a` (slice_for of samples inside `box`, none newer than `newest_s`) to
+// `b` (null: identity) could move one of them by more than `min_move_m`.
+// At one time the move is affine in the point, so its largest over the box is
+// at a corner. The corners are moved at a's keyframes, midway between them,
+// and at b's keyframes after a's last up to newest_s (a holds its last
+// correction there). False only when none moves more than half of
+// min_move_m, the slack for the times between; true when `a` is empty (its
+// samples' times are not known).
+bool correction_may_move(const CorrectionTrack& a, const CorrectionTrack* b, const Eigen::AlignedBox3d& box,
+                         double newest_s, double min_move_m);
 
 }  // namespace adit::slam
