@@ -5,6 +5,8 @@
 // after it was left keeps its first pass's times.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <tuple>
 
@@ -59,6 +61,29 @@ TEST(TileSpill, ATileSeenAgainLaterKeepsItsFirstPassTimes) {
   ASSERT_EQ(other.read(coord, back), "");
   ASSERT_EQ(back.size(), written.size());
   EXPECT_EQ(back.back().time_s, 0.0);
+}
+
+}  // namespace
+}  // namespace adit::daemon
+
+namespace adit::daemon {
+namespace {
+
+// A tile is written one segment at a time (decision 074): the file holds the
+// bytes the whole-tile encoder gives, partial last segment and empty tile too.
+TEST(TileSpill, ATileWrittenSegmentBySegmentIsTheWholeTilesEncoding) {
+  const test::TempFolder dir;
+  const protocol::TileParams params = stored_tile_params(20.0);
+  TileSpill spill(dir.path() / "tiles", params);
+  const slam::TileCoord coord{1, -2, 0};
+  for (const int n : {0, 1, 4096, 10000}) {
+    std::vector<slam::MapSample> written;
+    for (int i = 0; i < n; ++i) written.push_back(sample(i, kStart + 0.01 * i));
+    ASSERT_EQ(spill.write(coord, written), "") << n;
+    std::ifstream in(spill.file_of(coord), std::ios::binary);
+    const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    EXPECT_EQ(bytes, protocol::encode_tile({1, -2, 0}, map_points_of(written), params)) << n << " points";
+  }
 }
 
 }  // namespace
