@@ -74,7 +74,7 @@ struct StatusSample {
   std::optional<LoopStatus> loops;
 };
 
-// The whole new content of one tile (after voxel downsampling).
+// New content of one tile (after voxel downsampling): what it gained, or all of it.
 struct TileUpdate {
   std::int64_t utime = 0;
   protocol::TileKey key;
