@@ -2,7 +2,6 @@
 #include "adit/slam/correction_track.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 
@@ -148,27 +147,26 @@ bool correction_may_move(const CorrectionTrack& a, const CorrectionTrack* b, con
 CorrectionTrack CorrectionTrack::merged_with(const CorrectionTrack& other) const {
   if (other.stamps_.empty()) return *this;
   if (stamps_.empty()) return other;
-  // Each keyframe of the union, from this slice (0) or the other (1), by stamp.
-  struct From {
-    int slice;
-    std::size_t k;
+  // Each keyframe of the union, by stamp: its index in this slice and in the
+  // other (kNone where it is not).
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  struct Entry {
+    std::size_t mine = kNone;
+    std::size_t theirs = kNone;
   };
-  const std::array<const CorrectionTrack*, 2> slices{this, &other};
-  std::vector<From> order;
+  std::vector<Entry> order;
   order.reserve(stamps_.size() + other.stamps_.size());
   std::size_t i = 0, j = 0;
   while (i < stamps_.size() || j < other.stamps_.size()) {
-    if (j == other.stamps_.size() || (i < stamps_.size() && stamps_[i] <= other.stamps_[j])) {
-      if (j < other.stamps_.size() && stamps_[i] == other.stamps_[j]) ++j;  // the same keyframe in both
-      order.push_back({0, i++});
-    } else {
-      order.push_back({1, j++});
-    }
+    const bool take_mine = j == other.stamps_.size() || (i < stamps_.size() && stamps_[i] <= other.stamps_[j]);
+    const bool take_theirs = i == stamps_.size() || (j < other.stamps_.size() && other.stamps_[j] <= stamps_[i]);
+    order.push_back({take_mine ? i++ : kNone, take_theirs ? j++ : kNone});
   }
   CorrectionTrack merged;
   for (std::size_t n = 0; n < order.size(); ++n) {
-    const CorrectionTrack& t = *slices[static_cast<std::size_t>(order[n].slice)];
-    const std::size_t k = order[n].k;
+    const Entry e = order[n];
+    const CorrectionTrack& t = e.mine != kNone ? *this : other;
+    const std::size_t k = e.mine != kNone ? e.mine : e.theirs;
     merged.stamps_.push_back(t.stamps_[k]);
     merged.positions_.push_back(t.positions_[k]);
     merged.corrections_.push_back(t.corrections_[k]);
@@ -176,20 +174,16 @@ CorrectionTrack CorrectionTrack::merged_with(const CorrectionTrack& other) const
     // A pair next to each other in either slice keeps that slice's step (the
     // same bits at its samples' times); no sample of either falls between
     // any other pair.
-    const From next = order[n + 1];
-    const CorrectionTrack* both = nullptr;
-    for (int s = 0; s < 2 && both == nullptr; ++s) {
-      const CorrectionTrack& c = *slices[static_cast<std::size_t>(s)];
-      const auto a = std::lower_bound(c.stamps_.begin(), c.stamps_.end(), t.stamps_[k]);
-      if (a != c.stamps_.end() && *a == t.stamps_[k] && a + 1 != c.stamps_.end() &&
-          *(a + 1) == slices[static_cast<std::size_t>(next.slice)]->stamps_[next.k]) {
-        both = &c;
-        merged.steps_.push_back(c.steps_[static_cast<std::size_t>(a - c.stamps_.begin())]);
-      }
+    const Entry next = order[n + 1];
+    if (e.mine != kNone && next.mine == e.mine + 1) {
+      merged.steps_.push_back(steps_[e.mine]);
+    } else if (e.theirs != kNone && next.theirs == e.theirs + 1) {
+      merged.steps_.push_back(other.steps_[e.theirs]);
+    } else {
+      const CorrectionTrack& u = next.mine != kNone ? *this : other;
+      const std::size_t m = next.mine != kNone ? next.mine : next.theirs;
+      merged.steps_.push_back(log_se3(t.corrections_[k].inverse() * u.corrections_[m]));
     }
-    if (both == nullptr)
-      merged.steps_.push_back(
-          log_se3(t.corrections_[k].inverse() * slices[static_cast<std::size_t>(next.slice)]->corrections_[next.k]));
   }
   return merged;
 }
