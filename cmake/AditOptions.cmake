@@ -32,14 +32,8 @@ if(ADIT_BUILD_FUZZERS)
   add_compile_options(-fsanitize=fuzzer-no-link)
 endif()
 
-# UBSan without its null, alignment and object-size checks: they were 3/4 of
-# the sanitizer build's extra compile time, and ASan finds the same faults
-# (a null dereference stops on SIGSEGV, an access past an object lands in a
-# red zone); no code of ours loads a wider type from a byte buffer
-# (decision 075).
 if(ADIT_SANITIZE_ADDRESS)
-  add_compile_options(-fsanitize=address,undefined -fno-sanitize=null,alignment,object-size
-                      -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
 if(ADIT_SANITIZE_THREAD)
