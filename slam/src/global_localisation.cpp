@@ -1,7 +1,6 @@
 #include "adit/slam/global_localisation.hpp"
 
 #include <algorithm>
-#include <array>
 #include <limits>
 #include <cmath>
 #include <numbers>
@@ -10,18 +9,12 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "adit/slam/plan_search.hpp"
 #include "adit/slam/registration.hpp"
 #include "adit/slam/voxel_downsample.hpp"
 
 namespace adit::slam {
 namespace {
-
-struct Peak {
-  double score = 0.0;  // mean plan likelihood of the search points
-  int ix = 0;
-  int iy = 0;
-  double yaw = 0.0;
-};
 
 struct Refined {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -34,8 +27,6 @@ struct Refined {
 double angle_between(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
 }
-
-double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
 // The cloud split by its local planes: vertical surfaces, and the floor's height below the origin.
 struct CloudParts {
@@ -81,93 +72,7 @@ double overlap_of(std::span<const Eigen::Vector3f> walls, const Eigen::Isometry3
   return static_cast<double>(inliers) / static_cast<double>(walls.size());
 }
 
-// Exhaustive plan-view search: every free floor cell (in the hint's disc),
-// every yaw step (in its range); the best few distinct peaks.
-std::vector<Peak> search_plan(std::span<const Eigen::Vector3f> walls, const PlanGrid& plan,
-                              const std::optional<LocalisationHint>& hint, const LocalisationConfig& config) {
-  // Search points: the walls' horizontal positions within range, spread evenly.
-  std::vector<Eigen::Vector2f> flat;
-  for (const auto& p : walls)
-    if (p.head<2>().norm() <= config.search_range_m) flat.push_back(p.head<2>());
-  if (flat.size() > config.max_search_points) {
-    std::vector<Eigen::Vector2f> kept;
-    const double step = static_cast<double>(flat.size()) / static_cast<double>(config.max_search_points);
-    for (std::size_t k = 0; k < config.max_search_points; ++k) kept.push_back(flat[static_cast<std::size_t>(static_cast<double>(k) * step)]);
-    flat.swap(kept);
-  }
-  // The likelihood padded by the search range, so that no lookup needs a bounds check.
-  const int pad = static_cast<int>(std::ceil(config.search_range_m / plan.cell_m)) + 2;
-  const int wp = plan.width + 2 * pad;
-  const int hp = plan.height + 2 * pad;
-  std::vector<float> field(static_cast<std::size_t>(wp) * static_cast<std::size_t>(hp), 0.0F);
-  for (int iy = 0; iy < plan.height; ++iy)
-    std::copy_n(plan.likelihood.begin() + static_cast<std::ptrdiff_t>(plan.index(0, iy)), plan.width,
-                field.begin() + static_cast<std::ptrdiff_t>((iy + pad) * wp + pad));
-  // Candidate cells: a floor, clear of walls, in the hint's disc.
-  std::vector<std::int64_t> bases;
-  std::vector<std::pair<int, int>> cells;
-  for (int iy = 0; iy < plan.height; ++iy) {
-    for (int ix = 0; ix < plan.width; ++ix) {
-      const std::size_t c = plan.index(ix, iy);
-      if (std::isnan(plan.floor_z[c]) || plan.wall_distance[c] < config.min_wall_clearance_m) continue;
-      if (hint) {
-        const Eigen::Vector2d centre(plan.origin.x() + (ix + 0.5) * plan.cell_m, plan.origin.y() + (iy + 0.5) * plan.cell_m);
-        if ((centre - hint->position).norm() > hint->radius_m) continue;
-      }
-      bases.push_back(static_cast<std::int64_t>(iy + pad) * wp + ix + pad);
-      cells.emplace_back(ix, iy);
-    }
-  }
-  std::vector<Peak> peaks;
-  if (bases.empty() || flat.empty()) return peaks;
-  double yaw_lo = 0.0, yaw_span = 2.0 * std::numbers::pi;
-  if (hint && hint->yaw_tolerance_rad < std::numbers::pi) {
-    yaw_lo = hint->yaw_rad - hint->yaw_tolerance_rad;
-    yaw_span = 2.0 * hint->yaw_tolerance_rad;
-  }
-  const int yaws = std::max(1, static_cast<int>(std::ceil(yaw_span / config.yaw_step_rad)));
-  std::vector<std::int64_t> offsets(flat.size());
-  const float inv_cell = 1.0F / plan.cell_m;
-  const float inv_n = 1.0F / static_cast<float>(flat.size());
-  constexpr int kPerYaw = 3;
-  for (int k = 0; k < yaws; ++k) {
-    const double yaw = yaw_lo + (k + 0.5) * yaw_span / yaws;
-    const Eigen::Rotation2Df r(static_cast<float>(yaw));
-    const Eigen::Matrix2f m = r.toRotationMatrix();
-    for (std::size_t i = 0; i < flat.size(); ++i) {
-      // The cell centre is the origin: a point's cell is its offset rounded.
-      const Eigen::Vector2f q = m * flat[i] * inv_cell;
-      offsets[i] = static_cast<std::int64_t>(std::lround(q.y())) * wp + std::lround(q.x());
-    }
-    std::array<Peak, kPerYaw> best{};
-    for (std::size_t c = 0; c < bases.size(); ++c) {
-      const float* base = field.data() + bases[c];
-      float sum = 0.0F;
-      for (const std::int64_t o : offsets) sum += base[o];
-      const double score = sum * inv_n;
-      if (score <= best[kPerYaw - 1].score) continue;
-      int j = kPerYaw - 1;
-      for (; j > 0 && best[static_cast<std::size_t>(j - 1)].score < score; --j) best[static_cast<std::size_t>(j)] = best[static_cast<std::size_t>(j - 1)];
-      best[static_cast<std::size_t>(j)] = Peak{score, cells[c].first, cells[c].second, yaw};
-    }
-    for (const Peak& p : best)
-      if (p.score > 0.0) peaks.push_back(p);
-  }
-  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.score > b.score; });
-  // Non-maximum suppression: a peak near a better one is the same place.
-  std::vector<Peak> kept;
-  for (const Peak& p : peaks) {
-    const bool near = std::any_of(kept.begin(), kept.end(), [&](const Peak& q) {
-      const double d = plan.cell_m * std::hypot(p.ix - q.ix, p.iy - q.iy);
-      return d < config.distinct_m && std::abs(wrap(p.yaw - q.yaw)) < config.distinct_rad;
-    });
-    if (!near) kept.push_back(p);
-    if (static_cast<int>(kept.size()) == config.hypotheses) break;
-  }
-  return kept;
-}
-
-Refined refine(const CloudParts& parts, std::span<const Eigen::Vector3f> sparse, const Peak& peak, const PriorMap& prior,
+Refined refine(const CloudParts& parts, std::span<const Eigen::Vector3f> sparse, const PlanPeak& peak, const PriorMap& prior,
                const VoxelHashMap& index, const LocalisationConfig& config) {
   const PlanGrid& plan = prior.plan;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -222,7 +127,7 @@ LocalisationResult localise(std::span<const Eigen::Vector3f> cloud, const PriorM
     result.failure = "no floor seen below the sensor: the height cannot be started";
     return result;
   }
-  const std::vector<Peak> peaks = search_plan(parts.walls, prior.plan, hint, config);
+  const std::vector<PlanPeak> peaks = search_plan(parts.walls, prior.plan, hint, config).peaks;
   if (peaks.empty()) {
     result.failure = hint ? "no free floor in the prior within the hint's disc" : "the prior has no free floor to start on";
     return result;
@@ -232,7 +137,7 @@ LocalisationResult localise(std::span<const Eigen::Vector3f> cloud, const PriorM
   VoxelDownsampler downsampler(parts.points.size());
   sparse.resize(downsampler.downsample(parts.points, 2.0F * config.cloud_voxel_m, sparse));
   std::vector<Refined> refined;
-  for (const Peak& peak : peaks) refined.push_back(refine(parts, sparse, peak, prior, index, config));
+  for (const PlanPeak& peak : peaks) refined.push_back(refine(parts, sparse, peak, prior, index, config));
   result.hypotheses_refined = static_cast<int>(refined.size());
   std::sort(refined.begin(), refined.end(), [](const Refined& a, const Refined& b) { return a.overlap > b.overlap; });
   const Refined& best = refined.front();

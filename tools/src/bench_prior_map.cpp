@@ -23,6 +23,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include <fmt/format.h>
@@ -63,6 +64,8 @@ struct Options {
   bool confirm = true;           // a found try counts once the next found one agrees (aditd's prior_map.confirm)
   double retry_s = 10.0;         // try again as aditd does for this long (sensor time from the start); 0: one try
   double min_overlap = 0.0;      // > 0: the acceptance's overlap threshold instead of slam's default
+  int search_levels = -1;        // >= 0: the plan search's depth instead of slam's default
+  bool exhaustive_baseline = false;  // each try again with every plan cell scored: CPU ratio and same result
 };
 
 struct Start {
@@ -144,6 +147,12 @@ int run(const Options& o) {
   // Each try as aditd makes it: a confirmed pair's acceptance with --confirm.
   slam::LocalisationConfig localisation = o.confirm ? slam::confirmed_localisation() : slam::LocalisationConfig{};
   if (o.min_overlap > 0.0) localisation.min_overlap = o.min_overlap;
+  if (o.search_levels >= 0) localisation.search_levels = o.search_levels;
+  slam::LocalisationConfig exhaustive = localisation;
+  exhaustive.search_levels = 0;
+  // --exhaustive-baseline: each try's CPU time searched both ways, and whether the results are the same.
+  std::vector<double> searched_cpu_s, exhaustive_cpu_s;
+  std::size_t baseline_differs = 0;
   std::vector<Start> starts;
   std::vector<Eigen::Vector3f> cloud;
   // One try: the window of o.scans scans from `first`, levelled at its first
@@ -197,6 +206,15 @@ int run(const Options& o) {
     const std::int64_t c0 = thread_cpu_ns();
     attempt.result = slam::localise(cloud, prior.map, index, hint, localisation);
     attempt.cpu_s = 1e-9 * static_cast<double>(thread_cpu_ns() - c0);
+    if (o.exhaustive_baseline) {
+      const std::int64_t e0 = thread_cpu_ns();
+      const slam::LocalisationResult every_cell = slam::localise(cloud, prior.map, index, hint, exhaustive);
+      exhaustive_cpu_s.push_back(1e-9 * static_cast<double>(thread_cpu_ns() - e0));
+      searched_cpu_s.push_back(attempt.cpu_s);
+      if (every_cell.success != attempt.result.success || !every_cell.pose.isApprox(attempt.result.pose, 0.0) ||
+          every_cell.failure != attempt.result.failure)
+        ++baseline_differs;
+    }
     const Eigen::Isometry3d error = (world_from_prior * attempt.result.pose).inverse() * level;
     attempt.error_m = error.translation().norm();
     attempt.error_deg = Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
@@ -381,6 +399,12 @@ int run(const Options& o) {
     j["false_localisations_retrying"] = wrong_retrying;
     j["median_time_to_localise_s"] = median_time_s;
     j["max_time_to_localise_s"] = max_time_s;
+    if (!searched_cpu_s.empty()) {
+      j["search_levels"] = localisation.search_levels;
+      j["search_cpu_s"] = std::accumulate(searched_cpu_s.begin(), searched_cpu_s.end(), 0.0);
+      j["exhaustive_search_cpu_s"] = std::accumulate(exhaustive_cpu_s.begin(), exhaustive_cpu_s.end(), 0.0);
+      j["exhaustive_results_differ"] = baseline_differs;
+    }
     // Null when not measured (--no-drift), or when the odometry never localised against the prior.
     j["drift_percent_with_prior"] = drift && drift->with_prior.anchored ? nlohmann::json(drift->with_prior.drift_percent) : nlohmann::json();
     j["drift_percent_without_prior"] = drift ? nlohmann::json(drift->without_prior.drift_percent) : nlohmann::json();
@@ -401,6 +425,14 @@ int run(const Options& o) {
   fmt::print("failed {} ({} of them were near the truth)\n", failed, failed_near);
   for (const auto& [why, n] : reasons) fmt::print("  {} x {}\n", n, why);
   fmt::print("median_localisation_s {:.2f} (max {:.2f}, one core, CPU time)\n", median_s, max_s);
+  if (!searched_cpu_s.empty()) {
+    const double searched = std::accumulate(searched_cpu_s.begin(), searched_cpu_s.end(), 0.0);
+    const double every = std::accumulate(exhaustive_cpu_s.begin(), exhaustive_cpu_s.end(), 0.0);
+    fmt::print("search_levels {}: {:.2f} s of CPU over {} tries against {:.2f} s with every plan cell scored "
+               "(ratio {:.3f}; median try {:.2f} s against {:.2f} s); results differ in {}\n",
+               localisation.search_levels, searched, searched_cpu_s.size(), every, searched / every,
+               quantile(searched_cpu_s, 0.5), quantile(exhaustive_cpu_s, 0.5), baseline_differs);
+  }
   fmt::print("localisation_success_rate_retrying {:.3f} ({} of {} found within {:.0f} s of the start, trying again as aditd does)\n",
              rate_retrying, found_retrying, starts.size(), o.retry_s);
   fmt::print("false_localisations_retrying {}\n", wrong_retrying);
@@ -463,6 +495,11 @@ void add_bench_prior_map_command(CLI::App& bench, int& status) {
                   "The acceptance's overlap threshold (0: slam::LocalisationConfig's default)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--json", o->json, "Print the figures as JSON");
+  cmd->add_option("--search-levels", o->search_levels,
+                  "The plan search's branch-and-bound depth (0: every plan cell scored; default: slam's)")
+      ->check(CLI::Range(0, 12));
+  cmd->add_flag("--exhaustive-baseline", o->exhaustive_baseline,
+                "Search each try again with every plan cell scored: the CPU ratio, and whether any result differs");
   cmd->add_option("--prior-sigma-m", o->prior_sigma_m,
                   "σ of a residual against the prior in the anchored odometry (0: the odometry's default)")
       ->check(CLI::NonNegativeNumber);

@@ -5,8 +5,9 @@
 // 1. Plan-view correlative search (Olson, ICRA 2009; Hess et al., ICRA 2016):
 //    the cloud's vertical-surface points, levelled by gravity, are scored
 //    against the prior's plan likelihood field at every free floor cell and
-//    every yaw step (an exhaustive search: the global optimum, and every
-//    rival, is seen). The best few distinct peaks are hypotheses.
+//    every yaw step, by branch and bound over blocks of cells (plan_search.hpp:
+//    the exhaustive search's peaks, the global optimum and its rivals, for a
+//    fraction of its sums). The best few distinct peaks are hypotheses.
 // 2. Each hypothesis is refined in 3-D by the odometry's own registration
 //    (register_scan: point-to-plane, Geman-McClure kernel) against the prior.
 // 3. Checks, so that a wrong pose is never reported as found: the overlap
@@ -43,6 +44,7 @@ struct LocalisationConfig {
   float search_range_m = 30.0F;          // cloud points beyond this horizontal range are left out of the search
   std::size_t max_search_points = 600;   // plan points correlated (spread evenly over the cloud's wall points)
   float min_wall_clearance_m = 0.3F;     // a start cell this close to a wall is not a place a sensor can be
+  int search_levels = 4;                 // the plan search's blocks: 2^4 x 2^4 cells at the top; 0: every cell scored
   int hypotheses = 8;                    // distinct peaks refined in 3-D
   double distinct_m = 1.0;               // peaks closer than this (and distinct_rad) are one
   double distinct_rad = 0.15;
