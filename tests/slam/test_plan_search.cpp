@@ -37,24 +37,28 @@ void expect_same_peaks(const PlanSearch& got, const PlanSearch& exhaustive) {
   EXPECT_EQ(got.cells, exhaustive.cells);
 }
 
+// 200 search points (600 in aditd) and four starts: the exhaustive oracle is
+// slow under the sanitizers (six starts at 600 took 201 s under ASan).
 TEST(PlanSearch, BranchAndBoundFindsTheExhaustiveSearchsPeaksAndSumsFarFewerCells) {
-  const PriorMap prior = prepare_prior_map(sample_plan(two_halves(), 48, 16, 0.1));
-  const std::vector<Eigen::Vector3f> world = sample_plan(two_halves(), 48, 16, 0.07, 0.01, 7);
+  const PriorMap prior = prepare_prior_map(sample_plan(office(), 24, 16, 0.1));
+  const std::vector<Eigen::Vector3f> world = sample_plan(office(), 24, 16, 0.07, 0.01, 7);
   std::mt19937 rng(76);
-  std::uniform_real_distribution<double> x(2.0, 46.0), y(2.0, 14.0), yaw(-std::numbers::pi, std::numbers::pi);
+  std::uniform_real_distribution<double> x(1.5, 22.5), y(1.5, 14.5), yaw(-std::numbers::pi, std::numbers::pi);
+  LocalisationConfig base;
+  base.max_search_points = 200;
   std::uint64_t sums = 0, cells = 0;
-  for (int start = 0; start < 6; ++start) {
+  for (int start = 0; start < 4; ++start) {
     const double sx = x(rng), sy = y(rng), syaw = yaw(rng);
     SCOPED_TRACE(testing::Message() << "start (" << sx << ", " << sy << "), yaw " << syaw);
     const std::vector<Eigen::Vector3f> walls = walls_seen(world, sx, sy, syaw);
-    LocalisationConfig exhaustive;
+    LocalisationConfig exhaustive = base;
     exhaustive.search_levels = 0;
     const PlanSearch reference = search_plan(walls, prior.plan, std::nullopt, exhaustive);
     ASSERT_FALSE(reference.peaks.empty());
     EXPECT_EQ(reference.sums, reference.cells);
-    for (const int levels : {1, 3, 4, 6}) {
+    for (const int levels : {1, 4, 6}) {
       SCOPED_TRACE(testing::Message() << levels << " levels");
-      LocalisationConfig config;
+      LocalisationConfig config = base;
       config.search_levels = levels;
       const PlanSearch got = search_plan(walls, prior.plan, std::nullopt, config);
       expect_same_peaks(got, reference);
@@ -70,7 +74,7 @@ TEST(PlanSearch, BranchAndBoundFindsTheExhaustiveSearchsPeaksAndSumsFarFewerCell
     hint.yaw_rad = syaw + 5.0 * std::numbers::pi / 180.0;
     hint.yaw_tolerance_rad = 0.3;
     const PlanSearch hinted_reference = search_plan(walls, prior.plan, hint, exhaustive);
-    expect_same_peaks(search_plan(walls, prior.plan, hint, LocalisationConfig{}), hinted_reference);
+    expect_same_peaks(search_plan(walls, prior.plan, hint, base), hinted_reference);
     // The best peak is the start, within a cell and a yaw step or two.
     const PlanPeak& best = reference.peaks.front();
     const double cx = prior.plan.origin.x() + (best.ix + 0.5) * prior.plan.cell_m;
