@@ -211,7 +211,7 @@ int run(const Options& o) {
       const slam::LocalisationResult every_cell = slam::localise(cloud, prior.map, index, hint, exhaustive);
       exhaustive_cpu_s.push_back(1e-9 * static_cast<double>(thread_cpu_ns() - e0));
       searched_cpu_s.push_back(attempt.cpu_s);
-      if (every_cell.success != attempt.result.success || !every_cell.pose.isApprox(attempt.result.pose, 0.0) ||
+      if (every_cell.success != attempt.result.success || every_cell.pose.matrix() != attempt.result.pose.matrix() ||
           every_cell.failure != attempt.result.failure)
         ++baseline_differs;
     }
@@ -352,6 +352,8 @@ int run(const Options& o) {
     if (!s.reported) ++reasons[s.failure.substr(0, s.failure.find_first_of(":0123456789"))];
   const double rate = static_cast<double>(found) / static_cast<double>(starts.size());
   const double median_s = quantile(seconds, 0.5);
+  const double searched_total_s = std::accumulate(searched_cpu_s.begin(), searched_cpu_s.end(), 0.0);
+  const double exhaustive_total_s = std::accumulate(exhaustive_cpu_s.begin(), exhaustive_cpu_s.end(), 0.0);
   const double max_s = *std::max_element(seconds.begin(), seconds.end());
   const std::size_t memory = prior_map_bytes(prior.map);
   std::optional<PriorDrift> drift;
@@ -401,8 +403,8 @@ int run(const Options& o) {
     j["max_time_to_localise_s"] = max_time_s;
     if (!searched_cpu_s.empty()) {
       j["search_levels"] = localisation.search_levels;
-      j["search_cpu_s"] = std::accumulate(searched_cpu_s.begin(), searched_cpu_s.end(), 0.0);
-      j["exhaustive_search_cpu_s"] = std::accumulate(exhaustive_cpu_s.begin(), exhaustive_cpu_s.end(), 0.0);
+      j["search_cpu_s"] = searched_total_s;
+      j["exhaustive_search_cpu_s"] = exhaustive_total_s;
       j["exhaustive_results_differ"] = baseline_differs;
     }
     // Null when not measured (--no-drift), or when the odometry never localised against the prior.
@@ -426,11 +428,10 @@ int run(const Options& o) {
   for (const auto& [why, n] : reasons) fmt::print("  {} x {}\n", n, why);
   fmt::print("median_localisation_s {:.2f} (max {:.2f}, one core, CPU time)\n", median_s, max_s);
   if (!searched_cpu_s.empty()) {
-    const double searched = std::accumulate(searched_cpu_s.begin(), searched_cpu_s.end(), 0.0);
-    const double every = std::accumulate(exhaustive_cpu_s.begin(), exhaustive_cpu_s.end(), 0.0);
     fmt::print("search_levels {}: {:.2f} s of CPU over {} tries against {:.2f} s with every plan cell scored "
                "(ratio {:.3f}; median try {:.2f} s against {:.2f} s); results differ in {}\n",
-               localisation.search_levels, searched, searched_cpu_s.size(), every, searched / every,
+               localisation.search_levels, searched_total_s, searched_cpu_s.size(), exhaustive_total_s,
+               searched_total_s / exhaustive_total_s,
                quantile(searched_cpu_s, 0.5), quantile(exhaustive_cpu_s, 0.5), baseline_differs);
   }
   fmt::print("localisation_success_rate_retrying {:.3f} ({} of {} found within {:.0f} s of the start, trying again as aditd does)\n",
