@@ -14,51 +14,57 @@ double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
 constexpr int kPerYaw = 3;
 
+// The likelihood quantised to a byte, so that the fields stay in cache; a
+// score is the sum over the search points, exact in integers.
+using Level = std::uint8_t;
+using Sum = std::uint32_t;
+constexpr float kLevels = 255.0F;
+
 // One yaw's best kPerYaw cells, best first: a higher score, or the same score
 // and an earlier cell in row order (the order the exhaustive search met them).
 class YawBest {
  public:
   // `floor`: a score no cell below which can be among the search's peaks.
-  explicit YawBest(float floor = 0.0F) : floor_(floor) {}
-  void insert(float score, std::size_t order, int ix, int iy) {
-    if (!(score > 0.0F) || !worse_than(kPerYaw - 1, score, order)) return;
+  explicit YawBest(Sum floor = 0) : floor_(floor) {}
+  void insert(Sum score, std::size_t order, int ix, int iy) {
+    if (score == 0 || !worse_than(kPerYaw - 1, score, order)) return;
     int j = kPerYaw - 1;
     for (; j > 0 && worse_than(j - 1, score, order); --j) entries_[j] = entries_[j - 1];
     entries_[j] = Entry{score, order, ix, iy};
   }
   // Whether no cell scoring at most `bound` can enter.
-  bool closed_to(float bound) const {
-    const float third = entries_[kPerYaw - 1].score;
-    return bound <= 0.0F || bound < third || bound < floor_;
+  bool closed_to(Sum bound) const {
+    const Sum third = entries_[kPerYaw - 1].score;
+    return bound == 0 || bound < third || bound < floor_;
   }
   template <typename F>
   void for_each_score(F f) const {
     for (const Entry& e : entries_)
-      if (e.score > 0.0F) f(e.score);
+      if (e.score > 0) f(e.score);
   }
-  void append_to(std::vector<PlanPeak>& peaks, double yaw) const {
+  void append_to(std::vector<PlanPeak>& peaks, double yaw, double to_score) const {
     for (const Entry& e : entries_)
-      if (e.score > 0.0F) peaks.push_back(PlanPeak{e.score, e.ix, e.iy, yaw});
+      if (e.score > 0) peaks.push_back(PlanPeak{e.score * to_score, e.ix, e.iy, yaw});
   }
 
  private:
   struct Entry {
-    float score = 0.0F;  // 0: empty
+    Sum score = 0;  // 0: empty
     std::size_t order = 0;
     int ix = 0;
     int iy = 0;
   };
-  bool worse_than(int j, float score, std::size_t order) const {
+  bool worse_than(int j, Sum score, std::size_t order) const {
     const Entry& e = entries_[static_cast<std::size_t>(j)];
     return e.score < score || (e.score == score && e.order > order);
   }
-  float floor_;
+  Sum floor_;
   std::array<Entry, kPerYaw> entries_{};
 };
 
 // A block of 2^h x 2^h cells from (bx 2^h, by 2^h), and its bound.
 struct Block {
-  float bound = 0.0F;
+  Sum bound = 0;
   int bx = 0;
   int by = 0;
 };
@@ -73,21 +79,22 @@ class BlockFields {
   BlockFields(const PlanGrid& plan, int pad, int levels, std::vector<std::uint8_t> candidate)
       : pad_(pad), wp_(plan.width + 2 * pad), hp_(plan.height + 2 * pad), width_(plan.width) {
     fields_.resize(static_cast<std::size_t>(levels) + 1);
-    std::vector<float>& field = fields_[0];
-    field.assign(static_cast<std::size_t>(wp_) * static_cast<std::size_t>(hp_), 0.0F);
+    std::vector<Level>& field = fields_[0];
+    field.assign(static_cast<std::size_t>(wp_) * static_cast<std::size_t>(hp_), 0);
     for (int iy = 0; iy < plan.height; ++iy)
-      std::copy_n(plan.likelihood.begin() + static_cast<std::ptrdiff_t>(plan.index(0, iy)), plan.width,
-                  field.begin() + static_cast<std::ptrdiff_t>((iy + pad) * wp_ + pad));
+      for (int ix = 0; ix < plan.width; ++ix)
+        field[index(ix + pad, iy + pad)] =
+            static_cast<Level>(std::lround(std::clamp(plan.likelihood[plan.index(ix, iy)], 0.0F, 1.0F) * kLevels));
     // Hess et al.'s precomputation grids, each from the one below: the
     // maximum over 2^h cells is that of four 2^(h-1) windows.
     for (int h = 1; h <= levels; ++h) {
-      const std::vector<float>& below = fields_[static_cast<std::size_t>(h - 1)];
-      std::vector<float>& f = fields_[static_cast<std::size_t>(h)];
-      f.assign(below.size(), 0.0F);
+      const std::vector<Level>& below = fields_[static_cast<std::size_t>(h - 1)];
+      std::vector<Level>& f = fields_[static_cast<std::size_t>(h)];
+      f.assign(below.size(), 0);
       const int s = 1 << (h - 1);
       for (int y = 0; y < hp_; ++y)
         for (int x = 0; x < wp_; ++x) {
-          float m = below[index(x, y)];
+          Level m = below[index(x, y)];
           if (x + s < wp_) m = std::max(m, below[index(x + s, y)]);
           if (y + s < hp_) m = std::max(m, below[index(x, y + s)]);
           if (x + s < wp_ && y + s < hp_) m = std::max(m, below[index(x + s, y + s)]);
@@ -119,20 +126,19 @@ class BlockFields {
     return bx < w && by < ht &&
            has_[static_cast<std::size_t>(h)][static_cast<std::size_t>(by) * static_cast<std::size_t>(w) + static_cast<std::size_t>(bx)] != 0;
   }
-  // The mean over the search points (their cell offsets) of the level-h field
+  // The sum over the search points (their cell offsets) of the level-h field
   // at the block's first cell: the score of the cell at h = 0, otherwise at
-  // least that of every cell of the block (the sums run in the same order
-  // over terms at least as large, and rounding is monotone). Eight partial
-  // sums: one running sum waits on each addition before the next.
-  float bound(int h, int bx, int by, std::span<const std::int64_t> offsets, float inv_n) const {
-    const float* base = fields_[static_cast<std::size_t>(h)].data() + index((bx << h) + pad_, (by << h) + pad_);
-    std::array<float, 8> lane{};
+  // least that of every cell of the block (each term is at least as large;
+  // integer sums are exact). Four partial sums, so that the loads need not
+  // wait on one running sum.
+  Sum bound(int h, int bx, int by, std::span<const std::int64_t> offsets) const {
+    const Level* base = fields_[static_cast<std::size_t>(h)].data() + index((bx << h) + pad_, (by << h) + pad_);
+    std::array<Sum, 4> lane{};
     std::size_t i = 0;
-    for (; i + 8 <= offsets.size(); i += 8)
-      for (std::size_t l = 0; l < 8; ++l) lane[l] += base[offsets[i + l]];
-    for (std::size_t l = 0; i < offsets.size(); ++i, ++l) lane[l] += base[offsets[i]];
-    const float sum = ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
-    return sum * inv_n;
+    for (; i + 4 <= offsets.size(); i += 4)
+      for (std::size_t l = 0; l < 4; ++l) lane[l] += base[offsets[i + l]];
+    for (; i < offsets.size(); ++i) lane[0] += base[offsets[i]];
+    return (lane[0] + lane[1]) + (lane[2] + lane[3]);
   }
   std::size_t order(int ix, int iy) const {
     return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(ix);
@@ -146,13 +152,13 @@ class BlockFields {
   int wp_;
   int hp_;
   int width_;
-  std::vector<std::vector<float>> fields_;
+  std::vector<std::vector<Level>> fields_;
   std::vector<std::vector<std::uint8_t>> has_;
   std::vector<std::pair<int, int>> dims_;
 };
 
 // Depth first, the most promising block first (Hess et al., algorithm 3).
-void descend(const BlockFields& fields, int h, const Block& block, std::span<const std::int64_t> offsets, float inv_n,
+void descend(const BlockFields& fields, int h, const Block& block, std::span<const std::int64_t> offsets,
              YawBest& best, std::uint64_t& sums) {
   std::array<Block, 4> children{};
   std::size_t n = 0;
@@ -161,7 +167,7 @@ void descend(const BlockFields& fields, int h, const Block& block, std::span<con
       const int bx = 2 * block.bx + i;
       const int by = 2 * block.by + j;
       if (!fields.has(h - 1, bx, by)) continue;
-      const Block c{fields.bound(h - 1, bx, by, offsets, inv_n), bx, by};
+      const Block c{fields.bound(h - 1, bx, by, offsets), bx, by};
       ++sums;
       std::size_t at = n++;  // kept in order of bound, highest first
       for (; at > 0 && by_bound(c, children[at - 1]); --at) children[at] = children[at - 1];
@@ -173,7 +179,7 @@ void descend(const BlockFields& fields, int h, const Block& block, std::span<con
     if (h - 1 == 0)
       best.insert(c.bound, fields.order(c.bx, c.by), c.bx, c.by);
     else
-      descend(fields, h - 1, c, offsets, inv_n, best, sums);
+      descend(fields, h - 1, c, offsets, best, sums);
   }
 }
 
@@ -219,7 +225,7 @@ PlanSearch search_plan(std::span<const Eigen::Vector3f> walls, const PlanGrid& p
   out.cells = static_cast<std::uint64_t>(cells.size()) * static_cast<std::uint64_t>(yaws);
   std::vector<std::int64_t> offsets(flat.size());
   const float inv_cell = 1.0F / plan.cell_m;
-  const float inv_n = 1.0F / static_cast<float>(flat.size());
+  const double to_score = 1.0 / (static_cast<double>(kLevels) * static_cast<double>(flat.size()));
   const int top = fields.levels();
   const auto [top_w, top_h] = fields.blocks(top);
   std::vector<Block> blocks;
@@ -238,7 +244,7 @@ PlanSearch search_plan(std::span<const Eigen::Vector3f> walls, const PlanGrid& p
     blocks.clear();
     for (int by = 0; by < top_h; ++by)
       for (int bx = 0; bx < top_w; ++bx)
-        if (fields.has(top, bx, by)) blocks.push_back(Block{fields.bound(top, bx, by, offsets, inv_n), bx, by});
+        if (fields.has(top, bx, by)) blocks.push_back(Block{fields.bound(top, bx, by, offsets), bx, by});
     out.sums += blocks.size();
   };
   std::vector<PlanPeak> peaks;
@@ -246,9 +252,9 @@ PlanSearch search_plan(std::span<const Eigen::Vector3f> walls, const PlanGrid& p
     for (int k = 0; k < yaws; ++k) {
       offsets_at(k);
       YawBest best;
-      for (const auto& [ix, iy] : cells) best.insert(fields.bound(0, ix, iy, offsets, inv_n), fields.order(ix, iy), ix, iy);
+      for (const auto& [ix, iy] : cells) best.insert(fields.bound(0, ix, iy, offsets), fields.order(ix, iy), ix, iy);
       out.sums += cells.size();
-      best.append_to(peaks, yaw_at(k));
+      best.append_to(peaks, yaw_at(k), to_score);
     }
   } else {
     // Across yaws, a floor: the suppression below keeps its peaks among the
@@ -260,33 +266,33 @@ PlanSearch search_plan(std::span<const Eigen::Vector3f> walls, const PlanGrid& p
     const int yaws_near = std::min(yaws, 2 * static_cast<int>(std::ceil(config.distinct_rad / step)) + 1);
     const std::size_t window = static_cast<std::size_t>(std::max(1, config.hypotheses)) * kPerYaw *
                                static_cast<std::size_t>(yaws_near);
-    std::vector<std::pair<float, int>> yaw_order;
+    std::vector<std::pair<Sum, int>> yaw_order;
     yaw_order.reserve(static_cast<std::size_t>(yaws));
     for (int k = 0; k < yaws; ++k) {
       offsets_at(k);
       top_blocks();
-      float most = 0.0F;
+      Sum most = 0;
       for (const Block& b : blocks) most = std::max(most, b.bound);
       yaw_order.emplace_back(most, k);
     }
     std::sort(yaw_order.begin(), yaw_order.end(), [](const auto& a, const auto& b) {
       return a.first > b.first || (a.first == b.first && a.second < b.second);
     });
-    std::priority_queue<float, std::vector<float>, std::greater<>> kept_scores;  // the best `window`, lowest on top
+    std::priority_queue<Sum, std::vector<Sum>, std::greater<>> kept_scores;  // the best `window`, lowest on top
     for (const auto& [most, k] : yaw_order) {
-      const float floor = kept_scores.size() == window ? kept_scores.top() : 0.0F;
-      if (most <= 0.0F || most < floor) break;
+      const Sum floor = kept_scores.size() == window ? kept_scores.top() : 0;
+      if (most == 0 || most < floor) break;
       offsets_at(k);
       top_blocks();
       std::sort(blocks.begin(), blocks.end(), by_bound);
       YawBest best(floor);
       for (const Block& b : blocks) {
         if (best.closed_to(b.bound)) break;
-        descend(fields, top, b, offsets, inv_n, best, out.sums);
+        descend(fields, top, b, offsets, best, out.sums);
       }
-      best.append_to(peaks, yaw_at(k));
+      best.append_to(peaks, yaw_at(k), to_score);
       // Each entry at most the yaw's true one of its rank: the floor stays a lower bound.
-      best.for_each_score([&](float score) {
+      best.for_each_score([&](Sum score) {
         if (kept_scores.size() < window) {
           kept_scores.push(score);
         } else if (score > kept_scores.top()) {

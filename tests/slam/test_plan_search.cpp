@@ -86,5 +86,34 @@ TEST(PlanSearch, BranchAndBoundFindsTheExhaustiveSearchsPeaksAndSumsFarFewerCell
   EXPECT_LT(static_cast<double>(sums), 0.25 * static_cast<double>(cells)) << sums << " sums for " << cells << " cells";
 }
 
+// The fields hold the likelihood in bytes (decision 077): each peak's score is
+// the mean likelihood of its search points to within half a level.
+TEST(PlanSearch, AScoreIsTheMeanLikelihoodToWithinHalfALevel) {
+  const PriorMap prior = prepare_prior_map(sample_plan(office(), 24, 16, 0.1));
+  const std::vector<Eigen::Vector3f> world = sample_plan(office(), 24, 16, 0.07, 0.01, 7);
+  std::vector<Eigen::Vector3f> walls = walls_seen(world, 7.3, 5.1, 0.4);
+  LocalisationConfig config;
+  ASSERT_GT(walls.size(), 120U);
+  walls.resize(120);  // all of them search points (config.max_search_points is more)
+  config.search_levels = 0;
+  const PlanSearch got = search_plan(walls, prior.plan, std::nullopt, config);
+  ASSERT_FALSE(got.peaks.empty());
+  const PlanGrid& plan = prior.plan;
+  for (const PlanPeak& peak : got.peaks) {
+    SCOPED_TRACE(testing::Message() << "peak at (" << peak.ix << ", " << peak.iy << "), yaw " << peak.yaw);
+    // The search's own cell arithmetic: the point turned by the yaw, in cells from the peak's cell.
+    const Eigen::Matrix2f m = Eigen::Rotation2Df(static_cast<float>(peak.yaw)).toRotationMatrix();
+    double sum = 0.0;
+    for (const Eigen::Vector3f& p : walls) {
+      const Eigen::Vector2f q = m * p.head<2>() * (1.0F / plan.cell_m);
+      const long ix = peak.ix + std::lround(q.x());
+      const long iy = peak.iy + std::lround(q.y());
+      if (ix >= 0 && iy >= 0 && ix < plan.width && iy < plan.height)
+        sum += plan.likelihood[plan.index(static_cast<int>(ix), static_cast<int>(iy))];
+    }
+    EXPECT_NEAR(peak.score, sum / static_cast<double>(walls.size()), 0.5 / 255.0 + 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace adit::slam

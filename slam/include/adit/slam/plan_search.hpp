@@ -15,6 +15,10 @@
 // The peaks are exactly the exhaustive search's, equal scores ordered by yaw
 // and then row (tests/slam/test_plan_search.cpp); only the sums differ.
 // Decision 076 has the figures.
+//
+// The likelihood is scored in bytes (255 levels), so that the fields of all
+// levels stay in the core's caches, and a score is an exact integer sum
+// (decision 077).
 
 #include <cstdint>
 #include <optional>
@@ -29,7 +33,7 @@
 namespace adit::slam {
 
 struct PlanPeak {
-  double score = 0.0;  // mean plan likelihood of the search points, (0, 1]
+  double score = 0.0;  // mean plan likelihood of the search points (each in 1/255 steps), (0, 1]
   int ix = 0;          // the plan cell
   int iy = 0;
   double yaw = 0.0;    // rad, the cloud's frame in the prior's
