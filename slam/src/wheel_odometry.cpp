@@ -56,6 +56,7 @@ void WheelOdometry::reset(const Pose2& pose) {
   have_counts_ = false;
   rejected_in_a_row_ = 0;
   slip_since_ = {kNotSlipping, kNotSlipping};
+  slip_ended_ = {kNotSlipping, kNotSlipping};
   speeds_known_ = false;
   earlier_known_ = false;
 }
@@ -128,7 +129,13 @@ WheelOdometry::TractionCheck WheelOdometry::check_traction(double t, double dt, 
     const std::size_t other = 1 - i;
     const bool onset = jump[i] || ramp[i];
     if (!onset && !held_before[i]) continue;
-    if (onset) {
+    const bool other_trusted = !held_before[other] && !jump[other] && !ramp[other];
+    // A slip whose excess fell under the bound (a spin while the vehicle
+    // slows) looked over before it was: the speeds since are the spin's. A
+    // change soon after is judged by that slip's reference, not by them: back
+    // to it, the slip has ended; away from it, the slip goes on.
+    const bool resumed = onset && t - slip_ended_[i] <= limits_.max_slip_duration;
+    if (onset && !resumed) {
       // The speeds from before the slip began, and what they said of the turn.
       const std::array<double, 2>& pre = jump[i] ? trusted : earlier_speed_;
       slip_since_[i] = jump[i] ? t_previous_ : earlier_t_;
@@ -140,11 +147,15 @@ WheelOdometry::TractionCheck WheelOdometry::check_traction(double t, double dt, 
     // the turn rate from before the slip (the vehicle accelerates, the spin
     // does not steer it), or, if the other wheel is not trusted either, this
     // wheel's speed from before the slip.
-    const bool other_trusted = !held_before[other] && !jump[other] && !ramp[other];
     const double reference = other_trusted ? measured[other] + slip_offset_[i] : slip_speed_[i];
-    if (!onset && std::abs(measured[i] - reference) <= bound[i]) {
+    if ((!onset || resumed) && std::abs(measured[i] - reference) <= bound[i]) {
       slip_since_[i] = kNotSlipping;  // grips again
+      slip_ended_[i] = t;
       continue;
+    }
+    if (resumed) {  // the same slip, held again
+      slip_since_[i] = t_previous_;
+      slip_ended_[i] = kNotSlipping;
     }
     if (t - slip_since_[i] > limits_.max_slip_duration) {  // held too long: a real change of speed
       slip_since_[i] = kNotSlipping;
@@ -171,6 +182,7 @@ WheelStep WheelOdometry::step(double t, double v_left, double v_right, bool from
   const auto restart = [&](double vl, double vr, bool known) {
     baseline(vl, vr);
     slip_since_ = {kNotSlipping, kNotSlipping};
+    slip_ended_ = {kNotSlipping, kNotSlipping};
     speeds_known_ = known;
     earlier_known_ = false;
   };

@@ -160,6 +160,7 @@ class WheelOdometry {
   static constexpr double kNotSlipping = std::numeric_limits<double>::quiet_NaN();
   // Per wheel (0 left, 1 right): slipping since when (NaN: not slipping).
   std::array<double, 2> slip_since_{kNotSlipping, kNotSlipping};
+  std::array<double, 2> slip_ended_{kNotSlipping, kNotSlipping};  // when its last slip ended by gripping (NaN: none)
   std::array<double, 2> slip_offset_{};  // this wheel's speed minus the other's before the slip
   std::array<double, 2> slip_speed_{};   // this wheel's speed before the slip
   bool speeds_known_ = false;  // the trusted speeds were measured (counts: after two readings)
