@@ -18,6 +18,17 @@ ScheduleOptions schedule_options(const RobotPathOptions& o) {
   s.hold_start_s = RobotPathOptions::kHoldStart;
   return s;
 }
+// The route's direction where the body is: a chord of one route step either
+// side. Wheels cannot slide sideways, so the body must point along the path
+// its position follows; route_at's heading is smoothed over a metre, and
+// where the curvature changes (a curve's ends, a closed route's start) it
+// turned the body while the position ran straight, a sideways slide of up to
+// 4 cm that no wheel measures (decision 078).
+double tangent_heading(const Route& route, double s, double fallback) {
+  const Eigen::Vector2d d = route_at(route, s + route.step).position - route_at(route, s - route.step).position;
+  return d.squaredNorm() > 0.0 ? std::atan2(d.y(), d.x()) : fallback;
+}
+
 }  // namespace
 
 double robot_min_duration_s() { return min_schedule_duration_s(schedule_options(RobotPathOptions{})); }
@@ -31,9 +42,10 @@ BodyTrack robot_path(const Scene& scene, const RobotPathOptions& o) {
   double travelled = 0.0;  // by the wheels so far (an odometer)
   for (std::size_t i = 0; i < arc.size(); ++i) {
     const RoutePoint r = route_at(route, arc[i]);
-    const Eigen::Vector2d left(-std::sin(r.heading), std::cos(r.heading));
+    const double heading = tangent_heading(route, arc[i], r.heading);
+    const Eigen::Vector2d left(-std::sin(heading), std::cos(heading));
     const Eigen::Vector2d xy = r.position + left * o.lateral_offset_m;
-    const double yaw = r.heading + std::numbers::pi * turn_fraction[i];
+    const double yaw = heading + std::numbers::pi * turn_fraction[i];
     // Bumps: the rough floor under the wheels tilts the body (~1 m wavelengths
     // of the distance the wheels have rolled). Turning on the spot, each wheel
     // rolls half the track per radian, so the tilt changes as slowly as the

@@ -18,6 +18,9 @@ struct Motion {
   // How fast the body tilts (the angle its up axis turns through over 50 ms, per second):
   // anywhere, and while it turns on the spot (slower than 5 cm/s, faster than 0.3 rad/s of yaw).
   double top_tilt_rate = 0, top_tilt_rate_turning_on_spot = 0;
+  // The body's velocity across its heading (levelled), over 50 ms, and how far it
+  // moved across its heading in any one second: a wheeled robot's are nil.
+  double top_sideways_speed = 0, top_sideways_slide_1s = 0;
   Eigen::Vector3d start, end;
 };
 
@@ -29,8 +32,15 @@ Motion measure(const SimOptions& o) {
   m.start = s.front().position;
   m.end = s.back().position;
   const double dt = 1.0 / BodyTrack::kRate;
+  std::vector<double> sideways(s.size(), 0.0);  // each step's move across the body's heading
+  double slide = 0.0;                           // summed over the last second
+  constexpr auto second = static_cast<std::size_t>(BodyTrack::kRate);
   for (std::size_t i = 1; i < s.size(); ++i) {
     const Eigen::Vector3d step = s[i].position - s[i - 1].position;
+    const Eigen::Vector3d forward = s[i - 1].orientation * Eigen::Vector3d::UnitX();
+    sideways[i] = step.dot(Eigen::Vector3d(-forward.y(), forward.x(), 0.0).normalized());
+    slide += sideways[i] - (i >= second ? sideways[i - second] : 0.0);
+    m.top_sideways_slide_1s = std::max(m.top_sideways_slide_1s, std::abs(slide));
     m.length += step.norm();
     // Velocity over 50 ms (the samples' linear interpolation makes 5 ms steps noisy in angle only).
     if (i >= 10) m.top_speed = std::max(m.top_speed, (s[i].position - s[i - 10].position).norm() / (10 * dt));
@@ -44,6 +54,9 @@ Motion measure(const SimOptions& o) {
       const double rate = std::atan2(up0.cross(up1).norm(), up0.dot(up1)) / (10 * dt);
       m.top_tilt_rate = std::max(m.top_tilt_rate, rate);
       const double speed = (s[i].position - s[i - 10].position).norm() / (10 * dt);
+      const Eigen::Vector3d mid = s[i - 5].orientation * Eigen::Vector3d::UnitX();
+      const Eigen::Vector3d left = Eigen::Vector3d(-mid.y(), mid.x(), 0.0).normalized();
+      m.top_sideways_speed = std::max(m.top_sideways_speed, std::abs((s[i].position - s[i - 10].position).dot(left)) / (10 * dt));
       if (speed < 0.05 && std::abs(dyaw) / dt > 0.3)
         m.top_tilt_rate_turning_on_spot = std::max(m.top_tilt_rate_turning_on_spot, rate);
     }
@@ -78,6 +91,24 @@ TEST(SimPaths, RobotDrivesOutAndBackWithinItsLimits) {
   EXPECT_LT((m.end - m.start).head<2>().norm(), 0.05);  // back where it started
   EXPECT_GT(m.length, 60.0);
   EXPECT_LT(m.closest_wall, -0.4);
+}
+
+// Wheels roll, they do not slide: the body points along the path it drives,
+// in the curves and at a closed route's start too (decision 078: the body
+// once turned 14° there while its position ran straight, a 4 cm slide no
+// wheel measured).
+TEST(SimPaths, RobotNeverSlidesSideways) {
+  for (const char* scene : {"mine", "building", "drift"}) {
+    SimOptions o;
+    o.scene = scene;
+    o.duration_s = 60;
+    const Motion m = measure(o);
+    EXPECT_GT(m.length, 30.0) << scene;
+    // A chord of the route's 5 cm step still cuts the mine's tightest curve a
+    // little (the measured figures, before and after: decision 078).
+    EXPECT_LT(m.top_sideways_speed, 0.03) << scene;
+    EXPECT_LT(m.top_sideways_slide_1s, 0.003) << scene;
+  }
 }
 
 TEST(SimPaths, RobotDrivesWholeLapsWhenThereIsTime) {
