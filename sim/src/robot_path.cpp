@@ -18,15 +18,26 @@ ScheduleOptions schedule_options(const RobotPathOptions& o) {
   s.hold_start_s = RobotPathOptions::kHoldStart;
   return s;
 }
-// The route's direction where the body is: a chord of one route step either
-// side. Wheels cannot slide sideways, so the body must point along the path
-// its position follows; route_at's heading is smoothed over a metre, and
-// where the curvature changes (a curve's ends, a closed route's start) it
-// turned the body while the position ran straight, a sideways slide of up to
-// 4 cm that no wheel measures (decision 078).
-double tangent_heading(const Route& route, double s, double fallback) {
-  const Eigen::Vector2d d = route_at(route, s + route.step).position - route_at(route, s - route.step).position;
-  return d.squaredNorm() > 0.0 ? std::atan2(d.y(), d.x()) : fallback;
+// Where the body is at arc length s along the route, and where it points:
+// the route averaged over a metre of it (a box of ±0.5 m), and the direction
+// of that average's derivative, the chord (P(s + h) - P(s - h)) / 2h. Wheels
+// roll, they do not slide: the body points exactly where its position runs,
+// and turns as smoothly as a metre-long chord of the route does (decision 078).
+// The average is a trapezoid sum at half the route's sample spacing (the
+// route is linear between samples: what is left is the corners at its samples).
+struct PathPoint {
+  Eigen::Vector2d position;
+  double heading = 0.0;
+};
+PathPoint smoothed_route_at(const Route& route, double s, double fallback_heading) {
+  constexpr double kHalfWindow = 0.5;  // m, route_at's own heading chord
+  const auto n = static_cast<int>(std::ceil(4.0 * kHalfWindow / route.step));
+  const double step = 2.0 * kHalfWindow / n;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int k = 0; k <= n; ++k)
+    sum += (k == 0 || k == n ? 0.5 : 1.0) * route_at(route, s - kHalfWindow + k * step).position;
+  const Eigen::Vector2d chord = route_at(route, s + kHalfWindow).position - route_at(route, s - kHalfWindow).position;
+  return {sum / n, chord.squaredNorm() > 0.0 ? std::atan2(chord.y(), chord.x()) : fallback_heading};
 }
 
 }  // namespace
@@ -41,11 +52,10 @@ BodyTrack robot_path(const Scene& scene, const RobotPathOptions& o) {
   std::vector<BodySample> samples(arc.size());
   double travelled = 0.0;  // by the wheels so far (an odometer)
   for (std::size_t i = 0; i < arc.size(); ++i) {
-    const RoutePoint r = route_at(route, arc[i]);
-    const double heading = tangent_heading(route, arc[i], r.heading);
-    const Eigen::Vector2d left(-std::sin(heading), std::cos(heading));
+    const PathPoint r = smoothed_route_at(route, arc[i], route_at(route, arc[i]).heading);
+    const Eigen::Vector2d left(-std::sin(r.heading), std::cos(r.heading));
     const Eigen::Vector2d xy = r.position + left * o.lateral_offset_m;
-    const double yaw = heading + std::numbers::pi * turn_fraction[i];
+    const double yaw = r.heading + std::numbers::pi * turn_fraction[i];
     // Bumps: the rough floor under the wheels tilts the body (~1 m wavelengths
     // of the distance the wheels have rolled). Turning on the spot, each wheel
     // rolls half the track per radian, so the tilt changes as slowly as the

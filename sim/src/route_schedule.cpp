@@ -81,6 +81,7 @@ RoutePoint route_at(const Route& route, double s) {
   if (route.closed) {
     x = std::fmod(x, n);
     if (x < 0) x += n;
+    if (x >= n) x = 0.0;  // a negative x within rounding of 0 comes back as n: the first point, not one past the last
   } else {
     x = std::clamp(x, 0.0, n - 1.0001);
   }
